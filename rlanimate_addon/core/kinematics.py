@@ -1,0 +1,41 @@
+"""Forward kinematics of the canonical skeleton in numpy, for planning and checks.
+
+The environment the agent learns in is real Blender (trainer/fk_env.py); this mirrors Blender's
+pose evaluation (pose = parent_pose @ parent_rest^-1 @ rest @ basis) so that bpy-free code, such as
+the clip generator's inverse kinematics, can predict what Blender will show.
+"""
+import numpy as np
+
+from . import skeleton
+from .rotations import rotvec_to_matrix
+
+_INDEX = {name: i for i, name in enumerate(skeleton.BONE_NAMES)}
+_PARENT = np.array([-1 if b.parent is None else _INDEX[b.parent] for b in skeleton.BONES])
+_REST = skeleton.rest_matrices()
+# Rest of each bone relative to its parent's rest: parent_rest^-1 @ rest, (B, 4, 4).
+_REST_LOCAL = np.array([_REST[i] if p < 0 else np.linalg.inv(_REST[p]) @ _REST[i] for i, p in enumerate(_PARENT)])
+
+
+def bone_index(name):
+    return _INDEX[name]
+
+
+def pose_matrices(local_rotvecs):
+    """Armature-space pose matrices (..., B, 4, 4) from {bone name: (..., 3) local rotation vector}.
+
+    Bones not named keep their rest rotation. Every value must share one batch shape.
+    """
+    batch = np.shape(next(iter(local_rotvecs.values())))[:-1] if local_rotvecs else ()
+    basis = np.broadcast_to(np.eye(4), batch + (len(skeleton.BONES), 4, 4)).copy()
+    for name, rotvec in local_rotvecs.items():
+        basis[..., _INDEX[name], :3, :3] = rotvec_to_matrix(rotvec)
+    pose = np.empty_like(basis)
+    for i, parent in enumerate(_PARENT):
+        local = _REST_LOCAL[i] @ basis[..., i, :, :]
+        pose[..., i, :, :] = local if parent < 0 else pose[..., parent, :, :] @ local
+    return pose
+
+
+def head_positions(pose):
+    """(..., B, 4, 4) pose matrices -> (..., B, 3) bone head positions."""
+    return pose[..., :3, 3]

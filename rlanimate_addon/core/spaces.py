@@ -1,0 +1,135 @@
+"""The paper's spaces (Tables 2 and 3) as named, fixed-size numpy encodings.
+
+Objective o_t (7): [type, left_arm, right_arm, attr_x, attr_y, attr_z, t/N]
+    type is 1 for point and 2 for wave (Table 2). For point, the attributes are the unit vector
+    from the pointing arm's rest shoulder joint to the target, in the character frame, so a finger
+    laid along that line from the shoulder passes through the target whatever its distance. For wave,
+    they are the exaggeration in [0, 1], three times. t/N runs over 0..1 (t = 0..N-1, divided by N-1).
+Description d_t (42), in the character frame in metres:
+    [0:12]  unit effector vectors: left eye, right eye, left index, right index (skeleton.EFFECTORS)
+    [12:42] positions of skeleton.DESCRIPTION_JOINTS: collars, shoulders, elbows, wrists, index bases
+Action a_t (45): the local rotations of skeleton.ACTION_JOINTS, 3 numbers each, as the exponential
+    map (rotation vector, radians) of the pose-bone rotation relative to rest, each mapped to [0, 1]
+    by per-channel bounds: a = (r - low) / (high - low).
+
+The character frame is the armature's object space with its scale removed: +X the character's left,
+-Y forward, +Z up, origin on the ground between the feet.
+"""
+import numpy as np
+
+from . import skeleton
+from .errors import RLAnimateError
+
+OBJECTIVE_SIZE = 7
+DESCRIPTION_SIZE = 42
+ACTION_SIZE = 3 * len(skeleton.ACTION_JOINTS)
+
+BEHAVIOURS = ("POINT", "WAVE")
+BEHAVIOUR_TYPE = {"POINT": 1.0, "WAVE": 2.0}
+
+OBJECTIVE_TYPE = 0
+OBJECTIVE_ARM = slice(1, 3)
+OBJECTIVE_ATTRIBUTES = slice(3, 6)
+OBJECTIVE_TIME = 6
+
+DESCRIPTION_EFFECTORS = slice(0, 12)
+DESCRIPTION_POSITIONS = slice(12, 42)
+
+# Per-joint bounds (radians) of each rotation-vector channel, before mapping to [0, 1]. They cover
+# the human range of motion measured from the T-pose rest: an arm hangs at about 1.3 rad and
+# crosses the body at up to about 2.3 rad from rest; the elbow bends to about 2.5 rad.
+_JOINT_BOUNDS = {
+    "Spine": 0.5, "Spine1": 0.5, "Spine2": 0.5, "Neck": 0.7, "Head": 0.9,
+    "Shoulder": 0.7, "Arm": 2.6, "ForeArm": 2.7, "Hand": 1.4, "HandIndex1": 1.6,
+}
+
+
+def _joint_bound(joint):
+    for side in ("Left", "Right"):
+        if joint.startswith(side):
+            return _JOINT_BOUNDS[joint[len(side):]]
+    return _JOINT_BOUNDS[joint]
+
+
+#: (45, 2) default [low, high] per action channel, in action order.
+DEFAULT_ACTION_BOUNDS = np.array(
+    [[-_joint_bound(j), _joint_bound(j)] for j in skeleton.ACTION_JOINTS for _ in range(3)])
+
+
+def make_objective(behaviour, arm, attributes, frame_count):
+    """(N, 7) objectives for a gesture of `frame_count` frames.
+
+    `attributes` is, for POINT, a unit vector (3,) or one per frame (N, 3), so a moving target is
+    tracked; for WAVE, the exaggeration in [0, 1] (scalar or (N,)).
+    """
+    if behaviour not in BEHAVIOURS:
+        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(BEHAVIOURS)}.")
+    if arm not in skeleton.ARMS:
+        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
+    if int(frame_count) < 2:
+        raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}: set a longer length.")
+    n = int(frame_count)
+    attrs = np.asarray(attributes, dtype=np.float64)
+    if behaviour == "POINT":
+        attrs = np.broadcast_to(attrs, (n, 3))
+        norms = np.linalg.norm(attrs, axis=1, keepdims=True)
+        if not np.all(np.isfinite(attrs)) or np.any(norms < 1e-9):
+            raise RLAnimateError("The pointing direction is zero or not a number: move the target away "
+                                 "from the character's shoulder.")
+        attrs = attrs / norms
+    else:
+        exaggeration = np.broadcast_to(attrs, (n,))
+        if not np.all(np.isfinite(exaggeration)) or np.any((exaggeration < 0) | (exaggeration > 1)):
+            raise RLAnimateError("Exaggeration must be a number between 0 and 1.")
+        attrs = np.repeat(exaggeration[:, None], 3, axis=1)
+    objective = np.zeros((n, OBJECTIVE_SIZE))
+    objective[:, OBJECTIVE_TYPE] = BEHAVIOUR_TYPE[behaviour]
+    objective[:, OBJECTIVE_ARM] = (1.0, 0.0) if arm == "LEFT" else (0.0, 1.0)
+    objective[:, OBJECTIVE_ATTRIBUTES] = attrs
+    objective[:, OBJECTIVE_TIME] = np.linspace(0.0, 1.0, n)
+    return objective
+
+
+def pointing_direction(arm, target):
+    """Unit vector (3,) from the arm's rest shoulder joint to `target` (3,), both in the character frame."""
+    offset = np.asarray(target, dtype=np.float64) - skeleton.shoulder_rest_position(arm)
+    norm = np.linalg.norm(offset)
+    if not np.isfinite(norm) or norm < 1e-6:
+        raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
+    return offset / norm
+
+
+def encode_action(rotvecs, bounds=DEFAULT_ACTION_BOUNDS):
+    """(..., 15, 3) rotation vectors -> (..., 45) actions in [0, 1] (clipped to the bounds)."""
+    flat = np.asarray(rotvecs, dtype=np.float64).reshape(np.shape(rotvecs)[:-2] + (ACTION_SIZE,))
+    low, high = bounds[:, 0], bounds[:, 1]
+    return np.clip((flat - low) / (high - low), 0.0, 1.0)
+
+
+def decode_action(action, bounds=DEFAULT_ACTION_BOUNDS):
+    """(..., 45) actions in [0, 1] -> (..., 15, 3) rotation vectors in radians."""
+    a = np.asarray(action, dtype=np.float64)
+    low, high = bounds[:, 0], bounds[:, 1]
+    rot = low + a * (high - low)
+    return rot.reshape(a.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
+
+
+def describe(positions, eye_axes):
+    """Description (..., 42) from world data in the character frame.
+
+    positions: mapping bone name -> (..., 3) head position in metres (DESCRIPTION_JOINTS, fingertips).
+    eye_axes: mapping 'LeftEye'/'RightEye' -> (..., 3) the eye bone's Y axis.
+    """
+    vectors = []
+    for _, start, end in skeleton.EFFECTORS:
+        v = eye_axes[start] if end is None else np.asarray(positions[end]) - np.asarray(positions[start])
+        v = np.asarray(v, dtype=np.float64)
+        vectors.append(v / np.linalg.norm(v, axis=-1, keepdims=True))
+    joints = [np.asarray(positions[bone], dtype=np.float64) for _, bone in skeleton.DESCRIPTION_JOINTS]
+    return np.concatenate(vectors + joints, axis=-1)
+
+
+def description_joint_positions(description):
+    """(..., 42) descriptions -> (..., 10, 3) joint positions, the joints the paper's score compares."""
+    d = np.asarray(description)
+    return d[..., DESCRIPTION_POSITIONS].reshape(d.shape[:-1] + (len(skeleton.DESCRIPTION_JOINTS), 3))
