@@ -1,0 +1,26 @@
+import numpy as np
+
+from rlanimate_addon.core import kinematics, skeleton
+
+
+def test_rest_pose_heads_are_the_spec_heads():
+    heads = kinematics.head_positions(kinematics.pose_matrices({}))
+    np.testing.assert_allclose(heads, [b.head for b in skeleton.BONES], atol=1e-12)
+
+
+def test_lowering_the_left_arm_swings_the_elbow_down():
+    # LeftArm's local X is the character's forward axis (-Y): a negative turn about it lowers the arm.
+    pose = kinematics.pose_matrices({"LeftArm": np.array([-1.3, 0.0, 0.0])})
+    heads = kinematics.head_positions(pose)
+    arm, forearm = kinematics.bone_index("LeftArm"), kinematics.bone_index("LeftForeArm")
+    assert np.isclose(np.linalg.norm(heads[forearm] - heads[arm]), 0.28)
+    assert np.isclose(heads[forearm][2], heads[arm][2] - 0.28 * np.sin(1.3))
+    np.testing.assert_allclose(heads[kinematics.bone_index("RightForeArm")], (-0.45, 0.0, 1.45), atol=1e-12)
+
+
+def test_batched_poses_match_single_poses():
+    rng = np.random.default_rng(3)
+    rot = rng.normal(scale=0.4, size=(4, 3))
+    batched = kinematics.pose_matrices({"LeftForeArm": rot})
+    for i in range(4):
+        np.testing.assert_allclose(batched[i], kinematics.pose_matrices({"LeftForeArm": rot[i]}), atol=1e-12)
