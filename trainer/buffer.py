@@ -1,0 +1,57 @@
+"""The episode buffer B of Algorithm 1: whole rollout episodes in, random fixed-length chunks out.
+
+An episode is a mapping of per-frame arrays that share their first (time) axis:
+    objective (F, 7), action (F, 45), description (F, 42) (the real d'_t from the FK environment),
+    motion (F, 45) (the clip's pose in [0, 1]), motion_description (F, 42) (FK of the clip).
+`sample_chunks` draws C chunks of L consecutive frames, each from an episode chosen uniformly at
+random and starting at a uniformly random frame, and stacks them batch-major: (C, L, ...).
+"""
+import numpy as np
+import torch
+
+EPISODE_KEYS = ("objective", "action", "description", "motion", "motion_description")
+
+
+class EpisodeBuffer:
+    """Stores episodes in order of arrival; unbounded (the paper's runs collect at most a few hundred)."""
+
+    def __init__(self):
+        self.episodes = []
+
+    def __len__(self):
+        return len(self.episodes)
+
+    @property
+    def frames(self):
+        return sum(len(e["objective"]) for e in self.episodes)
+
+    def add(self, episode):
+        lengths = {key: len(episode[key]) for key in EPISODE_KEYS}
+        if len(set(lengths.values())) != 1:
+            raise ValueError(f"Episode arrays disagree on their frame count: {lengths}")
+        self.episodes.append({key: np.asarray(episode[key], dtype=np.float32) for key in EPISODE_KEYS})
+
+    def sample_chunks(self, count, length, rng):
+        """`count` chunks of `length` frames as {key: (C, L, ...) float32 tensor}.
+
+        `length` is capped at the shortest episode, so every chunk is whole. `rng` is a
+        numpy Generator, the only source of randomness, so sampling is reproducible.
+        """
+        if not self.episodes:
+            raise ValueError("The episode buffer is empty: collect an episode before sampling.")
+        length = min(int(length), min(len(e["objective"]) for e in self.episodes))
+        picks = rng.integers(0, len(self.episodes), size=count)
+        chunks = {key: [] for key in EPISODE_KEYS}
+        for index in picks:
+            episode = self.episodes[index]
+            start = int(rng.integers(0, len(episode["objective"]) - length + 1))
+            for key in EPISODE_KEYS:
+                chunks[key].append(episode[key][start:start + length])
+        return {key: torch.from_numpy(np.stack(chunks[key])) for key in EPISODE_KEYS}
+
+    def state_dict(self):
+        """Tensors only, so a checkpoint loads with torch.load(weights_only=True)."""
+        return {"episodes": [{key: torch.from_numpy(e[key]) for key in EPISODE_KEYS} for e in self.episodes]}
+
+    def load_state_dict(self, state):
+        self.episodes = [{key: e[key].numpy().copy() for key in EPISODE_KEYS} for e in state["episodes"]]
