@@ -1,0 +1,75 @@
+"""PNG plots of training runs: loss and score curves, Figure 3, and length flexibility (matplotlib, Agg)."""
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+METHOD_LABELS = {"rlanimate": "RLAnimate", "single_state": "single state",
+                 "single_dynamics": "single dynamics space", "supervised": "supervised loss"}
+COLUMN_LABELS = {"wave": "Wave", "point": "Point", "both": "Wave and Point"}
+
+
+def _series(history, key):
+    points = [(entry["epoch"], entry[key]) for entry in history if key in entry]
+    return [p[0] for p in points], [p[1] for p in points]
+
+
+def training_curves(history, path, title=""):
+    """Losses (log scale) and seen/unseen score over epochs of one run's history."""
+    figure, (losses, scores) = plt.subplots(1, 2, figsize=(11, 4))
+    for key in sorted({k for entry in history for k in entry if k.startswith("loss/")}):
+        epochs, values = _series(history, key)
+        losses.plot(epochs, [max(v, 1e-8) for v in values], label=key[5:])
+    losses.set_yscale("log")
+    losses.set_xlabel("epoch")
+    losses.set_title("losses (mean over the epoch's update steps)")
+    losses.legend(fontsize=8)
+    for split, style in (("seen", "-o"), ("unseen", "-s")):
+        epochs, values = _series(history, f"{split}/score")
+        scores.plot(epochs, values, style, markersize=3, label=f"{split} clips")
+    scores.set_xlabel("epoch")
+    scores.set_ylabel("score")
+    scores.set_title("score (deterministic rollouts)")
+    scores.legend(fontsize=8)
+    figure.suptitle(title)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def figure3(histories, path, split):
+    """The paper's Figure 3 row for `split` ('seen' or 'unseen'): score over epochs, one panel per
+    column (wave, point, both), one line per method. `histories[method][column]` is a run's history."""
+    figure, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    for axis, column in zip(axes, COLUMN_LABELS):
+        for method, label in METHOD_LABELS.items():
+            history = histories.get(method, {}).get(column)
+            if history:
+                epochs, values = _series(history, f"{split}/score")
+                axis.plot(epochs, values, "-o", markersize=3, label=label)
+        axis.set_title(COLUMN_LABELS[column])
+        axis.set_xlabel("epoch")
+        axis.set_ylabel("score")
+        axis.set_ylim(bottom=max(axis.get_ylim()[0], 0))
+        axis.legend(fontsize=8)
+    which = "clips from the training set" if split == "seen" else "clips excluded from the training set"
+    figure.suptitle(f"Imitating {which}")
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def length_flexibility(results, path, threshold):
+    """Smoothness against the time scale of the gesture, one line per behaviour, with the threshold."""
+    figure, axis = plt.subplots(figsize=(6, 4))
+    for behaviour, by_scale in results.items():
+        scales = sorted(by_scale, key=float)
+        axis.plot([float(s) for s in scales], [by_scale[s] for s in scales], "-o", label=behaviour)
+    axis.axhline(threshold, color="grey", linestyle="--", label=f"visible artefacts ({threshold})")
+    axis.set_xlabel("length / class average length")
+    axis.set_ylabel("smoothness")
+    axis.set_title("Length flexibility (held-out clips)")
+    axis.legend(fontsize=8)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
