@@ -33,6 +33,7 @@ class FKEnvironment:
         self._bpy = bpy_support.import_bpy()
         self.rig = bpy_support.load_rig(rig_path)
         self.rig.animation_data_clear()  # an action would override the poses we write
+        self._bpy.context.view_layer.update()  # matrix_world is stale until the depsgraph runs
         self.scale = float(np.mean(self.rig.matrix_world.to_scale()))  # object units -> metres
         rig_names = [skeleton.strip_prefix(b.name) for b in self.rig.data.bones]
         #: Bone names (prefix stripped), the order of bone_heads: skeleton.BONE_NAMES order, then any
