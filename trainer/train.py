@@ -139,7 +139,7 @@ def evaluate_seen_unseen(trainer, session):
 
 
 def run(args, session=None):
-    """Train (or resume) one run as `args` says; returns its report dict. Writes everything to args.output."""
+    """Train (or resume) one run as `args` says; returns (report dict, Trainer). Writes everything to args.output."""
     from trainer.config import load_preset
     from trainer.export import export_agent
     from trainer.models import RLAnimateAgent
@@ -186,7 +186,7 @@ def run(args, session=None):
     plots.training_curves(trainer.history, output / "training_curves.png", title=f"{args.variant}, {args.behaviour}")
     if args.install:
         install(output)
-    return report
+    return report, trainer
 
 
 def install(output):
@@ -246,7 +246,7 @@ def _write_report(report, output):
 def main(argv=None):
     args = build_parser().parse_args(script_args(argv))
     try:
-        report = run(args)
+        report, _ = run(args)
     except RLAnimateError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2

@@ -1,0 +1,119 @@
+"""Regenerate the paper's Section 4 results: Table 4, Figure 3 and length flexibility.
+
+    nice -n 10 python -m trainer.experiments [--preset default] [--epoch-scale 1.0]
+
+Trains the four methods (RLAnimate and its three ablations) on each column (wave, point, both)
+for the paper's 50 / 100 epochs times --epoch-scale, each run in runs/experiments/<method>_<column>/
+(an interrupted experiment resumes from those checkpoints), then writes to docs/results/:
+    table4.json   {method: {column: {score, smoothness, episodes, train_seconds}}} (held-out clips)
+    table4.md     the same as a table, with the training-clip scores and the run settings
+    figure3_seen.png, figure3_unseen.png   score over epochs on seen and unseen clips
+    length_flexibility.json/.png           smoothness of the RLAnimate both-agent's held-out gestures
+                                           time-scaled 0.3x-1.7x the class average length
+"""
+import sys
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+if str(REPO_ROOT) not in sys.path:
+    sys.path.insert(0, str(REPO_ROOT))
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+
+from rlanimate_addon.core import metrics  # noqa: E402
+from trainer import evaluate, plots, train  # noqa: E402
+from trainer.bpy_support import script_args  # noqa: E402
+
+COLUMNS = ("wave", "point", "both")
+LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog="python -m trainer.experiments", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--preset", default="default")
+    parser.add_argument("--epoch-scale", type=float, default=1.0,
+                        help="fraction of the paper's 50 / 100 epochs to train (CPU budget)")
+    parser.add_argument("--methods", nargs="+", choices=train.VARIANTS, default=list(train.VARIANTS))
+    parser.add_argument("--columns", nargs="+", choices=COLUMNS, default=list(COLUMNS))
+    parser.add_argument("--clips", default=str(train.DEFAULT_MANIFEST))
+    parser.add_argument("--runs", default=str(REPO_ROOT / "runs" / "experiments"))
+    parser.add_argument("--results", default=str(train.RESULTS_DIR))
+    parser.add_argument("--eval-every", type=int, default=5)
+    parser.add_argument("--seed", type=int, default=0)
+    return parser
+
+
+def run_arguments(options, method, column):
+    output = Path(options.runs) / f"{method}_{column}"
+    epochs = max(1, int(round(train.PAPER_EPOCHS[column] * options.epoch_scale)))
+    argv = ["--behaviour", column, "--variant", method, "--preset", options.preset, "--clips", options.clips,
+            "--epochs", str(epochs), "--seed", str(options.seed), "--output", str(output),
+            "--eval-every", str(options.eval_every), "--quiet"]
+    if (output / "checkpoint.pt").is_file():
+        argv.append("--resume")
+    return train.build_parser().parse_args(argv)
+
+
+def table4_markdown(table, seen, settings):
+    lines = ["# Table 4: final score and smoothness imitating held-out clips", "",
+             settings, "",
+             "| method | wave score | wave smooth. | point score | point smooth. | both score | both smooth. |",
+             "|---|---|---|---|---|---|---|"]
+    for method, columns in table.items():
+        cells = []
+        for column in COLUMNS:
+            entry = columns.get(column)
+            cells += [f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}"] if entry else ["-", "-"]
+        lines.append(f"| {plots.METHOD_LABELS[method]} | " + " | ".join(cells) + " |")
+    lines += ["", "Sample episodes and training time (s) per run; score on 10 training (seen) clips:", "",
+              "| method | column | episodes | train seconds | seen score | seen smooth. |", "|---|---|---|---|---|---|"]
+    for method, columns in table.items():
+        for column, entry in columns.items():
+            lines.append(f"| {plots.METHOD_LABELS[method]} | {column} | {entry['episodes']} | "
+                         f"{entry['train_seconds']:.0f} | {seen[method][column]['score']:.2f} | "
+                         f"{seen[method][column]['smoothness']:.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    options = build_parser().parse_args(script_args(argv))
+    torch.set_num_threads(1)
+    results = Path(options.results)
+    results.mkdir(parents=True, exist_ok=True)
+    session = train.Session(train.manifest_path(options.clips))
+    table, seen, histories, flexibility = {}, {}, {}, None
+    for method in options.methods:
+        for column in options.columns:
+            report, trainer = train.run(run_arguments(options, method, column), session)
+            print(f"{method:16s} {column:5s} held-out score {report['held_out']['score']:6.2f} "
+                  f"smoothness {report['held_out']['smoothness']:6.2f} "
+                  f"episodes {report['episodes']} {report['train_seconds']:.0f}s", flush=True)
+            table.setdefault(method, {})[column] = {
+                "score": report["held_out"]["score"], "smoothness": report["held_out"]["smoothness"],
+                "episodes": report["episodes"], "train_seconds": report["train_seconds"]}
+            seen.setdefault(method, {})[column] = report["training"]
+            histories.setdefault(method, {})[column] = trainer.history
+            if method == "rlanimate" and column == "both":
+                test = evaluate.select_clips(session.test_clips, "both")
+                flexibility = evaluate.length_flexibility(trainer.agent, session.env, test,
+                                                          session.train_clips, LENGTH_SCALES, trainer.bounds)
+    settings = (f"Preset `{options.preset}`, seed {options.seed}, epochs = {options.epoch_scale:g} x the paper's "
+                f"(50 one behaviour, 100 both; an epoch is one iteration of Algorithm 1). "
+                f"Regenerate: `nice -n 10 python -m trainer.experiments --preset {options.preset} "
+                f"--epoch-scale {options.epoch_scale:g}`.")
+    (results / "table4.json").write_text(json.dumps(table, indent=2) + "\n")
+    (results / "table4.md").write_text(table4_markdown(table, seen, settings))
+    for split in ("seen", "unseen"):
+        plots.figure3(histories, results / f"figure3_{split}.png", split)
+    if flexibility is not None:
+        (results / "length_flexibility.json").write_text(json.dumps(flexibility, indent=2) + "\n")
+        plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
