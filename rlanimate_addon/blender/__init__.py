@@ -1,0 +1,1 @@
+"""The Blender edge: properties, preferences, panel, operators, and the rig and action adapters."""

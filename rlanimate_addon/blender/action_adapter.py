@@ -1,0 +1,139 @@
+"""The one place that knows how Blender versions store keyframes.
+
+Blender 4.2 keeps F-curves on the action (`action.fcurves`). Blender 4.4+ (and 5.0, which removed
+`action.fcurves`) uses layered actions: an action has slots, one per animated data-block, and its
+F-curves live in a channelbag of a keyframe strip of a layer, one channelbag per slot. Callers get
+an `ActionTarget` (the action and, where slots exist, the slot) and never touch either layout.
+"""
+import bpy
+
+LAYERED = "slots" in bpy.types.Action.bl_rna.properties
+
+
+class ActionTarget:
+    """An action and the slot whose channels it writes (None before layered actions)."""
+
+    def __init__(self, action, slot=None):
+        self.action, self.slot = action, slot
+        self._channelbag = None
+
+    def _fcurves(self, create=False):
+        if not LAYERED:
+            return self.action.fcurves
+        if self._channelbag is None:
+            self._channelbag = _channelbag(self.action, self.slot, create)
+        return None if self._channelbag is None else self._channelbag.fcurves
+
+    def new_fcurve(self, data_path, index, group):
+        """A new F-curve of this target, in the named channel group."""
+        fcurves = self._fcurves(create=True)
+        if LAYERED:
+            return fcurves.new(data_path, index=index, group_name=group)
+        return fcurves.new(data_path, index=index, action_group=group)
+
+    def fcurves(self):
+        """The F-curves of this target (a list, empty when there are none)."""
+        fcurves = self._fcurves()
+        return [] if fcurves is None else list(fcurves)
+
+
+def _channelbag(action, slot, create):
+    if slot is None:
+        return None
+    if not action.layers:
+        if not create:
+            return None
+        action.layers.new("Layer")
+    layer = action.layers[0]
+    if not layer.strips:
+        if not create:
+            return None
+        layer.strips.new(type="KEYFRAME")
+    return layer.strips[0].channelbag(slot, ensure=create)
+
+
+def new_action(name, obj):
+    """A new, empty action for `obj` (with a slot for it on layered actions)."""
+    action = bpy.data.actions.new(name)
+    if LAYERED:
+        return ActionTarget(action, action.slots.new(id_type=obj.id_type, name=obj.name))
+    action.id_root = obj.id_type
+    return ActionTarget(action)
+
+
+def write_keys(fcurve, frames, values):
+    """Bulk-write keys (frames (N,), values (N,)) into an empty F-curve, linear between frames."""
+    count = len(frames)
+    points = fcurve.keyframe_points
+    points.add(count)
+    co = [0.0] * (2 * count)
+    co[0::2], co[1::2] = list(map(float, frames)), list(map(float, values))
+    points.foreach_set("co", co)
+    linear = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
+    points.foreach_set("interpolation", [linear] * count)
+    fcurve.update()
+
+
+def active_target(obj):
+    """The ActionTarget the object's active action plays through, or None without one."""
+    data = obj.animation_data
+    if data is None or data.action is None:
+        return None
+    return ActionTarget(data.action, data.action_slot if LAYERED else None)
+
+
+def strip_targets(obj):
+    """ActionTargets of every NLA strip of the object, bottom track first."""
+    data = obj.animation_data
+    if data is None:
+        return []
+    return [ActionTarget(strip.action, getattr(strip, "action_slot", None) if LAYERED else None)
+            for track in data.nla_tracks for strip in track.strips if strip.action is not None]
+
+
+def is_animated(obj):
+    """True when the object has an active action, NLA strips or drivers."""
+    data = obj.animation_data
+    return data is not None and (data.action is not None or len(data.drivers) > 0
+                                 or any(len(track.strips) for track in data.nla_tracks))
+
+
+def assign(obj, target):
+    """Make `target` the object's active action."""
+    data = obj.animation_data or obj.animation_data_create()
+    data.action = target.action
+    if LAYERED:
+        data.action_slot = target.slot
+
+
+def push_down(obj):
+    """Move the object's active action onto a new NLA track, as Blender's Push Down does; keys untouched."""
+    data = obj.animation_data
+    target = active_target(obj)
+    if target is None:
+        return
+    start = int(target.action.frame_range[0])
+    track = data.nla_tracks.new()
+    track.name = target.action.name
+    strip = _new_strip(track, target, start)
+    strip.blend_type = data.action_blend_type
+    strip.extrapolation = "HOLD"
+    data.action = None
+
+
+def add_strip(obj, target, start_frame, name):
+    """Put `target` on a new NLA track on top, starting at start_frame, with no effect outside it."""
+    data = obj.animation_data or obj.animation_data_create()
+    track = data.nla_tracks.new()
+    track.name = name
+    strip = _new_strip(track, target, start_frame)
+    strip.name = name
+    strip.extrapolation = "NOTHING"
+    return strip
+
+
+def _new_strip(track, target, start):
+    strip = track.strips.new(target.action.name, int(start), target.action)
+    if LAYERED:
+        strip.action_slot = target.slot
+    return strip

@@ -1,0 +1,90 @@
+"""Export FBX: the active armature, its meshes and its baked animation, through Blender's FBX exporter."""
+import bpy
+from bpy_extras.io_utils import ExportHelper
+
+from ..core.errors import RLAnimateError
+
+#: Settings a Mixamo-style consumer (Unity, Unreal, Mixamo itself) reads back as it was baked: no leaf
+#: bones, Blender's bone axes, one take of the evaluated scene animation (NLA strips included),
+#: a key on every frame and no curve simplification.
+FBX_SETTINGS = dict(
+    use_selection=True, object_types={"ARMATURE", "MESH"}, use_mesh_modifiers=False,
+    add_leaf_bones=False, armature_nodetype="NULL", use_armature_deform_only=False,
+    primary_bone_axis="Y", secondary_bone_axis="X", axis_forward="-Z", axis_up="Y",
+    apply_unit_scale=True, apply_scale_options="FBX_SCALE_NONE", global_scale=1.0,
+    bake_anim=True, bake_anim_use_all_bones=True, bake_anim_use_nla_strips=False,
+    bake_anim_use_all_actions=False, bake_anim_force_startend_keying=True, bake_anim_step=1.0,
+    bake_anim_simplify_factor=0.0, path_mode="AUTO",
+)
+
+
+def rig_meshes(rig, scene):
+    """Meshes deformed by, or parented to, the rig."""
+    return [obj for obj in scene.objects if obj.type == "MESH" and (
+        obj.parent == rig or any(m.type == "ARMATURE" and m.object == rig for m in obj.modifiers))]
+
+
+def animation_range(rig):
+    """(first, last) frame of the rig's active action and NLA strips, or None without animation."""
+    data = rig.animation_data
+    if data is None:
+        return None
+    ranges = [tuple(data.action.frame_range)] if data.action is not None else []
+    ranges += [(s.frame_start, s.frame_end) for t in data.nla_tracks for s in t.strips]
+    if not ranges:
+        return None
+    return int(min(r[0] for r in ranges)), int(round(max(r[1] for r in ranges)))
+
+
+def export_rig(context, filepath):
+    """Write the active armature and its meshes to `filepath`; returns a one-line summary.
+
+    The scene's frame range is widened for the export to take in all of the rig's animation, then
+    restored along with the selection.
+    """
+    rig = context.active_object
+    if rig is None or rig.type != "ARMATURE":
+        raise RLAnimateError("The active object is not an armature: select the character's armature.")
+    if not filepath:
+        raise RLAnimateError("No file chosen: give a path ending in .fbx.")
+    scene, view_layer = context.scene, context.view_layer
+    objects = [rig] + rig_meshes(rig, scene)
+    selected = [o for o in view_layer.objects if o.select_get()]
+    frame_range = (scene.frame_start, scene.frame_end)
+    keyed = animation_range(rig)
+    try:
+        for obj in selected:
+            obj.select_set(False)
+        for obj in objects:
+            obj.select_set(True)
+        if keyed is not None:
+            scene.frame_start, scene.frame_end = min(frame_range[0], keyed[0]), max(frame_range[1], keyed[1])
+        bpy.ops.export_scene.fbx(filepath=bpy.path.abspath(filepath), **FBX_SETTINGS)
+    except RuntimeError as error:
+        raise RLAnimateError(f"Could not write {filepath}: {error}. Choose a folder you can write to.") from None
+    finally:
+        scene.frame_start, scene.frame_end = frame_range
+        for obj in objects:
+            obj.select_set(False)
+        for obj in selected:
+            obj.select_set(True)
+    return f"Exported {rig.name!r} with {len(objects) - 1} mesh(es) to {filepath}"
+
+
+class RLANIMATE_OT_export_fbx(bpy.types.Operator, ExportHelper):
+    """Export the active armature, its meshes and its baked gestures as a Mixamo-compatible FBX"""
+    bl_idname = "rlanimate.export_fbx"
+    bl_label = "Export FBX"
+    bl_options = {"REGISTER"}
+
+    filename_ext = ".fbx"
+    filter_glob: bpy.props.StringProperty(default="*.fbx", options={"HIDDEN"})
+
+    def execute(self, context):
+        try:
+            summary = export_rig(context, self.filepath)
+        except RLAnimateError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, summary)
+        return {"FINISHED"}

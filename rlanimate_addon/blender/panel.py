@@ -1,0 +1,51 @@
+"""The N-panel: View3D > Sidebar > RLAnimate."""
+import bpy
+
+from ..core import gesture
+from ..core.errors import RLAnimateError
+from . import preferences
+
+
+def _agent_summary(context, behaviour):
+    """(label, error): the agent's name and its learned lengths for the behaviour, or why it won't load."""
+    path = preferences.selected_agent_path(context)
+    name = "Bundled default" if path == preferences.BUNDLED_AGENT else path.name
+    try:
+        average = preferences.selected_agent(context).average_frames[behaviour]
+    except RLAnimateError as error:
+        return name, str(error)
+    shortest, longest = gesture.supported_length_range(average)
+    return f"{name}: learned {int(round(average))} frames, supported {shortest}-{longest}", None
+
+
+class VIEW3D_PT_rlanimate(bpy.types.Panel):
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "RLAnimate"
+    bl_label = "RLAnimate"
+
+    def draw(self, context):
+        layout = self.layout
+        settings = context.scene.rlanimate
+        layout.prop(settings, "behaviour", expand=True)
+        layout.prop(settings, "arm", expand=True)
+        if settings.behaviour == "POINT":
+            layout.prop(settings, "target")
+            if settings.target is None:
+                layout.prop(settings, "use_cursor")
+        else:
+            layout.prop(settings, "exaggeration", slider=True)
+
+        column = layout.column(align=True)
+        column.prop(settings, "frame_count")
+        column.prop(settings, "start_frame")
+        column.prop(settings, "seed")
+
+        label, error = _agent_summary(context, settings.behaviour)
+        box = layout.box()
+        box.label(text=label, icon="INFO")
+        if error:
+            box.label(text=error, icon="ERROR")
+
+        layout.operator("rlanimate.generate_gesture", icon="ARMATURE_DATA")
+        layout.operator("rlanimate.export_fbx", icon="EXPORT")

@@ -1,0 +1,60 @@
+"""Add-on preferences (which agent file to use) and loading of the selected agent.
+
+The preferences are looked up under the add-on's own module name, derived from `__package__`, so
+they are found both as a legacy add-on (`rlanimate_addon`) and as an extension
+(`bl_ext.<repository>.rlanimate`).
+"""
+import os
+from pathlib import Path
+
+import bpy
+
+from ..core.errors import RLAnimateError
+
+_PARTS = __package__.split(".")
+#: The add-on's module name: the package above rlanimate_addon (the extension), else rlanimate_addon.
+ADDON_PACKAGE = ".".join(_PARTS[:_PARTS.index("rlanimate_addon")]) or "rlanimate_addon"
+BUNDLED_AGENT = Path(__file__).resolve().parents[1] / "agents" / "default.npz"
+
+_cache = {}
+
+
+class RLANIMATE_AP_preferences(bpy.types.AddonPreferences):
+    bl_idname = ADDON_PACKAGE
+
+    agent_path: bpy.props.StringProperty(
+        name="Agent File", subtype="FILE_PATH",
+        description="An agent exported by the RLAnimate trainer (.npz); leave empty for the bundled agent")
+
+    def draw(self, context):
+        self.layout.prop(self, "agent_path")
+        self.layout.label(text="Empty: the bundled default agent.", icon="INFO")
+
+
+def selected_agent_path(context):
+    """Path of the agent chosen in the preferences, or the bundled default."""
+    addon = context.preferences.addons.get(ADDON_PACKAGE)
+    chosen = addon.preferences.agent_path if addon is not None and addon.preferences else ""
+    return Path(bpy.path.abspath(chosen)) if chosen else BUNDLED_AGENT
+
+
+def load_agent(path):
+    """The agent at `path`, loaded once per file version; RLAnimateError when missing or damaged."""
+    from ..core import runtime
+
+    path = Path(path)
+    try:
+        stat = os.stat(path)
+    except OSError:
+        raise RLAnimateError(f"Agent file {path} does not exist: choose another in Preferences > Add-ons > "
+                             "RLAnimate, or clear it to use the bundled agent.") from None
+    key = (str(path), stat.st_mtime_ns, stat.st_size)
+    if key not in _cache:
+        _cache.clear()
+        _cache[key] = runtime.load_agent(path)
+    return _cache[key]
+
+
+def selected_agent(context):
+    """The agent chosen in the preferences (or the bundled one), loaded."""
+    return load_agent(selected_agent_path(context))

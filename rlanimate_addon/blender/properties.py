@@ -1,0 +1,47 @@
+"""`Scene.rlanimate`: the gesture settings the panel shows and Generate Gesture reads.
+
+The names behaviour, arm, target, exaggeration, frame_count, start_frame and seed are a contract
+that outside tools and checks use: keep them.
+"""
+import bpy
+
+from ..core.errors import RLAnimateError
+from . import preferences
+
+#: Length used when the bundled agent cannot be read at start-up.
+FALLBACK_LENGTH = 60
+
+
+def learned_length(behaviour="POINT"):
+    """The bundled agent's average gesture length for the behaviour, in frames."""
+    try:
+        return int(round(preferences.load_agent(preferences.BUNDLED_AGENT).average_frames[behaviour]))
+    except (RLAnimateError, ImportError):
+        return FALLBACK_LENGTH
+
+
+class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
+    behaviour: bpy.props.EnumProperty(
+        name="Behaviour", default="POINT",
+        items=[("POINT", "Point", "Point the index finger at the target"),
+               ("WAVE", "Wave", "Wave the hand; exaggeration sets its size")])
+    arm: bpy.props.EnumProperty(
+        name="Arm", default="RIGHT",
+        items=[("LEFT", "Left", "The character's left arm"), ("RIGHT", "Right", "The character's right arm")])
+    target: bpy.props.PointerProperty(
+        name="Target", type=bpy.types.Object,
+        description="Object to point at; it is read at every frame, so an animated target is tracked")
+    use_cursor: bpy.props.BoolProperty(
+        name="Use 3D Cursor", default=False,
+        description="Point at the 3D cursor when no target object is picked")
+    exaggeration: bpy.props.FloatProperty(
+        name="Exaggeration", min=0.0, max=1.0, default=0.5, subtype="FACTOR",
+        description="How big and high the wave is, from a small wave (0) to a whole-arm wave (1)")
+    frame_count: bpy.props.IntProperty(
+        name="Length", min=0, soft_min=2, max=100000, default=learned_length(),
+        description="Length of the gesture in frames; the agent learned its average from the clips")
+    start_frame: bpy.props.IntProperty(
+        name="Start Frame", default=1, description="First frame of the gesture")
+    seed: bpy.props.IntProperty(
+        name="Variation Seed", min=0, default=0,
+        description="0 gives the agent's most likely gesture; other values give variations")

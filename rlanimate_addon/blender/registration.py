@@ -1,0 +1,25 @@
+"""Registration in one place: the ordered class list and the one Scene property namespace."""
+import bpy
+
+from . import export, generate, panel, preferences, properties
+
+#: Registered in this order, unregistered in reverse (property groups before what points at them).
+CLASSES = (
+    preferences.RLANIMATE_AP_preferences,
+    properties.RLANIMATE_PG_settings,
+    generate.RLANIMATE_OT_generate_gesture,
+    export.RLANIMATE_OT_export_fbx,
+    panel.VIEW3D_PT_rlanimate,
+)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Scene.rlanimate = bpy.props.PointerProperty(type=properties.RLANIMATE_PG_settings)
+
+
+def unregister():
+    del bpy.types.Scene.rlanimate
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)
