@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The project's test command: the whole suite on Blender 5.0 (bpy 5.0.1), then the Blender-facing
+# extension tests again on Blender 4.2 LTS from the second environment made by scripts/setup.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+python -m pytest -q "$@"
+if [ -x .venv-bpy42/bin/python ]; then
+    echo "== Blender 4.2 LTS: extension tests =="
+    .venv-bpy42/bin/python -m pytest -q tests/addon -p no:cacheprovider
+else
+    echo "scripts/run_tests.sh: .venv-bpy42 is missing; run scripts/setup.sh to test Blender 4.2 too" >&2
+    exit 1
+fi
