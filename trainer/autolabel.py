@@ -1,0 +1,138 @@
+"""Labels from motion, for clips that come without them (real capture, a user's own takes).
+
+Everything is measured on the canonical rig (numpy FK of the clip's (F, 15, 3) action rotations,
+core.kinematics), relative to the shoulder and in arm lengths L (rest shoulder-to-wrist distance),
+so the labels do not depend on the actor's height or where they stood.
+
+Arm: the one whose wrist travels further relative to its shoulder ("which hand moves more").
+
+Wave exaggeration in [0, 1], from how high the arm goes and how wide the hand strokes:
+    elevation_t  = angle between shoulder->wrist and straight down (0 hanging, 90 level, 180 overhead)
+    elevation    = ELEVATION_PERCENTILE-th percentile of elevation_t over the clip (the raised arm)
+    raised       = frames with elevation_t >= rest + RAISED_SHARE * (elevation - rest)
+    stroke       = 2 sqrt(2) RMS over `raised` of (wrist - shoulder) minus its centred moving average
+                   over STROKE_WINDOW_S seconds, divided by L (peak-to-peak of a sinusoidal wave)
+    exaggeration = clip(ELEVATION_WEIGHT * e + STROKE_WEIGHT * s, 0, 1), with
+                   e = clip((elevation - ELEVATION_LOW) / (ELEVATION_HIGH - ELEVATION_LOW), 0, 1)
+                   s = clip(stroke / STROKE_FULL, 0, 1)
+The constants were set on the real capture (docs/REALMOCAP.md): a small, low, bent-armed wave (wrist
+about 80 deg up, strokes of 0.1 L) labels near 0.1, a straight overhead wave with strokes of 0.45 L
+near 0.75, and one with whole-arm sweeps wider than L near 1.
+
+Pointing direction: at the hold (the stillest frame while the arm is raised), the unit vector from the
+arm's rest shoulder to the index-finger base, i.e. the objective `spaces.pointing_direction` whose
+ray the finger base lies on.
+"""
+from collections import namedtuple
+
+import numpy as np
+
+from rlanimate_addon.core import kinematics, skeleton, spaces
+from rlanimate_addon.core.errors import RLAnimateError
+
+ELEVATION_PERCENTILE = 90
+RAISED_SHARE = 0.8
+STROKE_WINDOW_S = 0.5
+ELEVATION_LOW, ELEVATION_HIGH = 60.0, 170.0  # degrees
+STROKE_FULL = 1.0  # arm lengths, peak to peak
+ELEVATION_WEIGHT, STROKE_WEIGHT = 0.6, 0.4
+
+#: arm 'LEFT'/'RIGHT'; exaggeration in [0, 1]; elevation in degrees; stroke in arm lengths;
+#: travel {arm: wrist path length in arm lengths}.
+WaveLabel = namedtuple("WaveLabel", "arm exaggeration elevation stroke travel")
+#: arm; direction (3,) unit vector from the rest shoulder to the index base; hold_frame index.
+PointLabel = namedtuple("PointLabel", "arm direction hold_frame")
+
+_SIDES = {"LEFT": "Left", "RIGHT": "Right"}
+
+
+def arm_length(side="Left"):
+    """Rest shoulder-to-wrist distance of the canonical rig, metres."""
+    shoulder = np.asarray(skeleton.BONE_BY_NAME[side + "Arm"].head)
+    return float(np.linalg.norm(np.asarray(skeleton.BONE_BY_NAME[side + "Hand"].head) - shoulder))
+
+
+def joint_heads(rotvecs, bones):
+    """{bone: (F, 3)} head positions, character frame, metres, of a (F, 15, 3) action clip."""
+    rotvecs = _checked(rotvecs)
+    pose = kinematics.pose_matrices({j: rotvecs[:, k] for k, j in enumerate(skeleton.ACTION_JOINTS)})
+    heads = kinematics.head_positions(pose)  # (F, B, 3)
+    return {bone: heads[:, kinematics.bone_index(bone)] for bone in bones}
+
+
+def _checked(rotvecs):
+    r = np.asarray(rotvecs, dtype=np.float64)
+    joints = len(skeleton.ACTION_JOINTS)
+    if r.ndim != 3 or r.shape[1:] != (joints, 3) or len(r) < 2:
+        raise RLAnimateError(f"Auto-labelling needs a clip of shape (frames >= 2, {joints}, 3), got {r.shape}.")
+    if not np.all(np.isfinite(r)):
+        raise RLAnimateError("The clip has NaN or infinite rotations: re-import it before labelling.")
+    return r
+
+
+def _arm_vectors(rotvecs):
+    """{arm: (F, 3) wrist minus shoulder, in arm lengths}."""
+    bones = [s + b for s in _SIDES.values() for b in ("Arm", "Hand")]
+    heads = joint_heads(rotvecs, bones)
+    return {arm: (heads[side + "Hand"] - heads[side + "Arm"]) / arm_length(side) for arm, side in _SIDES.items()}
+
+
+def _travel(vectors):
+    return float(np.linalg.norm(np.diff(vectors, axis=0), axis=-1).sum())
+
+
+def _elevation(vectors):
+    """(F,) degrees between each shoulder->wrist vector and straight down."""
+    unit = vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+    return np.degrees(np.arccos(np.clip(-unit[:, 2], -1.0, 1.0)))
+
+
+def _raised(elevation_t, elevation):
+    rest = float(np.min(elevation_t))
+    return elevation_t >= rest + RAISED_SHARE * (elevation - rest)
+
+
+def _moving_average(values, window):
+    """Centred moving average along axis 0 of (F, D), with edge padding."""
+    half = window // 2
+    padded = np.pad(values, ((half, half), (0, 0)), mode="edge")
+    kernel = np.ones(2 * half + 1) / (2 * half + 1)
+    return np.stack([np.convolve(padded[:, d], kernel, mode="valid") for d in range(values.shape[1])], axis=1)
+
+
+def moving_arm(rotvecs):
+    """'LEFT' or 'RIGHT': the arm whose wrist travels further relative to its shoulder."""
+    vectors = _arm_vectors(rotvecs)
+    return max(vectors, key=lambda arm: _travel(vectors[arm]))
+
+
+def label_wave(rotvecs, fps=30.0):
+    """WaveLabel of a (F, 15, 3) waving clip (see the module docstring for the formula)."""
+    vectors = _arm_vectors(rotvecs)
+    travel = {arm: _travel(v) for arm, v in vectors.items()}
+    arm = max(travel, key=travel.get)
+    elevation_t = _elevation(vectors[arm])
+    elevation = float(np.percentile(elevation_t, ELEVATION_PERCENTILE))
+    raised = _raised(elevation_t, elevation)
+    window = max(3, int(round(STROKE_WINDOW_S * float(fps))) | 1)
+    residual = vectors[arm] - _moving_average(vectors[arm], window)  # (F, 3)
+    stroke = float(2.0 * np.sqrt(2.0) * np.sqrt(np.mean(np.sum(residual[raised] ** 2, axis=-1))))
+    e = np.clip((elevation - ELEVATION_LOW) / (ELEVATION_HIGH - ELEVATION_LOW), 0.0, 1.0)
+    s = np.clip(stroke / STROKE_FULL, 0.0, 1.0)
+    exaggeration = float(np.clip(ELEVATION_WEIGHT * e + STROKE_WEIGHT * s, 0.0, 1.0))
+    return WaveLabel(arm, exaggeration, elevation, stroke, travel)
+
+
+def label_point(rotvecs, arm=None):
+    """PointLabel of a (F, 15, 3) pointing or directing clip; `arm` defaults to the moving arm."""
+    arm = arm or moving_arm(rotvecs)
+    side = _SIDES[arm]
+    heads = joint_heads(rotvecs, [side + "Arm", side + "Hand", side + "HandIndex1"])
+    vectors = (heads[side + "Hand"] - heads[side + "Arm"]) / arm_length(side)
+    elevation_t = _elevation(vectors)
+    raised = _raised(elevation_t, float(np.max(elevation_t)))
+    speed = np.linalg.norm(np.gradient(vectors, axis=0), axis=-1)  # (F,) arm lengths per frame
+    speed = _moving_average(speed[:, None], 5)[:, 0]
+    hold = int(np.flatnonzero(raised)[np.argmin(speed[raised])])
+    direction = spaces.pointing_direction(arm, heads[side + "HandIndex1"][hold])
+    return PointLabel(arm, direction, hold)
