@@ -1,0 +1,112 @@
+"""Helpers for the extension tests: enabling the add-on, rigs, targets, running Generate, reading poses.
+
+Rigs come from the committed sample character, or are built from the canonical skeleton with other
+units, another armature-space orientation and other bone rolls, as a Mixamo FBX import has them.
+"""
+from pathlib import Path
+
+import addon_utils  # Blender's own module, importable once bpy is
+import bpy
+import numpy as np
+
+from rlanimate_addon.core import skeleton
+
+ROOT = Path(__file__).resolve().parents[2]
+SAMPLE_BLEND = ROOT / "sample_rigs" / "character.blend"
+SAMPLE_RIG = "RLAnimate_Character"
+ADDON = "rlanimate_addon"
+
+
+def enable_addon():
+    """Reset to a factory-fresh empty scene and enable the add-on; returns Scene.rlanimate."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon_utils.enable(ADDON, default_set=True, handle_error=_raise)
+    return bpy.context.scene.rlanimate
+
+
+def disable_addon():
+    addon_utils.disable(ADDON, default_set=True, handle_error=_raise)
+
+
+def _raise(error):
+    raise error
+
+
+def addon_preferences():
+    return bpy.context.preferences.addons[ADDON].preferences
+
+
+def activate(obj):
+    bpy.context.view_layer.objects.active = obj
+    return obj
+
+
+def load_sample_rig():
+    """The sample character (armature and skinned mesh) appended into the scene; returns the armature."""
+    with bpy.data.libraries.load(str(SAMPLE_BLEND), link=False) as (source, target):
+        target.objects = list(source.objects)
+    for obj in target.objects:
+        bpy.context.scene.collection.objects.link(obj)
+    return activate(bpy.data.objects[SAMPLE_RIG])
+
+
+def build_rig(name, *, units=1.0, axes=np.eye(3), roll_to_x=False, prefix=skeleton.PREFIX, skip=()):
+    """A Mixamo-named armature from the canonical skeleton, standing where the canonical one stands.
+
+    Its armature space is `units` times the canonical and rotated by `axes` (3, 3), and its object
+    transform undoes both. roll_to_x turns every bone's roll by 90 degrees; `skip` leaves bones out.
+    """
+    data = bpy.data.armatures.new(name)
+    rig = bpy.data.objects.new(name, data)
+    bpy.context.scene.collection.objects.link(rig)
+    activate(rig)
+    bpy.ops.object.mode_set(mode="EDIT")
+    for bone in skeleton.BONES:
+        if bone.name in skip:
+            continue
+        edit = data.edit_bones.new(prefix + bone.name)
+        edit.head = units * axes @ np.asarray(bone.head)
+        edit.tail = units * axes @ np.asarray(bone.tail)
+        hint = skeleton.rest_frame(bone)[:, 0] if roll_to_x else np.asarray(bone.z_hint)
+        edit.align_roll(axes @ hint)
+        if bone.parent is not None and bone.parent not in skip:
+            edit.parent = data.edit_bones[prefix + bone.parent]
+    bpy.ops.object.mode_set(mode="OBJECT")
+    world = np.eye(4)
+    world[:3, :3] = axes.T / units
+    rig.matrix_world = world.T.tolist()  # mathutils takes rows
+    for pose_bone in rig.pose.bones:
+        pose_bone.rotation_mode = "QUATERNION"
+    return rig
+
+
+def add_empty(name, location):
+    empty = bpy.data.objects.new(name, None)
+    empty.location = location
+    bpy.context.scene.collection.objects.link(empty)
+    return empty
+
+
+def generate(rig, settings, **values):
+    """Set Scene.rlanimate from `values` and run Generate Gesture on `rig`; returns the operator result."""
+    for key, value in values.items():
+        setattr(settings, key, value)
+    activate(rig)
+    return bpy.ops.rlanimate.generate_gesture()
+
+
+def bone_heads(rig, bones, frames):
+    """(F, len(bones), 3) world positions of the bones' heads at each frame (evaluated by frame_set)."""
+    scene = bpy.context.scene
+    world = np.array(rig.matrix_world)
+    out = []
+    for frame in frames:
+        scene.frame_set(int(frame))
+        heads = [world @ np.append(rig.pose.bones[b].head, 1.0) for b in bones]
+        out.append(np.array(heads)[:, :3])
+    return np.array(out)
+
+
+def rig_bone(rig, canonical):
+    """The rig's bone name for a canonical bone name."""
+    return next(b.name for b in rig.data.bones if skeleton.strip_prefix(b.name) == canonical)

@@ -1,0 +1,248 @@
+"""Generate Gesture on real rigs: pointing accuracy, wave size, return to start, other rigs, undo-safe errors."""
+import math
+
+import addon_helpers as helpers
+import bpy
+import numpy as np
+import pytest
+
+from rlanimate_addon.core import skeleton
+
+RNG = np.random.default_rng()
+MAX_APEX_ANGLE_DEG = 5.0
+
+
+def random_target(arm, rng=RNG):
+    """World position of an unseen target 1.5-4 m from the pointing shoulder, in the front hemisphere.
+
+    Azimuth runs from 70 degrees out to the arm's side to 30 degrees across the body; elevation from
+    -30 to +45 degrees.
+    """
+    side = 1.0 if arm == "LEFT" else -1.0
+    azimuth = math.radians(rng.uniform(-30.0, 70.0)) * side  # + is towards the arm's side
+    elevation = math.radians(rng.uniform(-30.0, 45.0))
+    distance = rng.uniform(1.5, 4.0)
+    direction = np.array([math.sin(azimuth) * math.cos(elevation), -math.cos(azimuth) * math.cos(elevation),
+                          math.sin(elevation)])
+    return skeleton.shoulder_rest_position(arm) + distance * direction
+
+
+def finger_angles(rig, arm, target, frames):
+    """(F,) angle in degrees between the index finger and the line from its base to the target."""
+    prefix = skeleton.ARM_PREFIX[arm]
+    bones = [helpers.rig_bone(rig, prefix + "HandIndex1"), helpers.rig_bone(rig, prefix + "HandIndex4")]
+    heads = helpers.bone_heads(rig, bones, frames)  # (F, 2, 3)
+    finger = heads[:, 1] - heads[:, 0]
+    to_target = np.asarray(target) - heads[:, 0]
+    cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(finger, axis=1) / np.linalg.norm(to_target, axis=1)
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))), heads[:, 0]
+
+
+def apex(base_positions):
+    """Index of the frame where the finger base is farthest from where it started."""
+    return int(np.argmax(np.linalg.norm(base_positions - base_positions[0], axis=1)))
+
+
+@pytest.mark.parametrize("arm", ["LEFT", "RIGHT"])
+def test_point_aims_the_index_finger_at_unseen_targets_and_returns(settings, arm):
+    rig = helpers.load_sample_rig()
+    for k in range(2):
+        location = random_target(arm)
+        target = helpers.add_empty(f"Target{k}", location)
+        start = 1 + 200 * k
+        assert helpers.generate(rig, settings, behaviour="POINT", arm=arm, target=target,
+                                start_frame=start) == {"FINISHED"}
+        frames = np.arange(start, start + settings.frame_count)
+        angles, bases = finger_angles(rig, arm, location, frames)
+        peak = apex(bases)
+        assert angles[peak] <= MAX_APEX_ANGLE_DEG, (
+            f"{arm} finger misses the target at {np.round(location, 2)} by {angles[peak]:.1f} deg at the apex")
+        assert np.linalg.norm(bases[-1] - bases[0]) < 0.02, "the gesture must end where it started"
+
+
+@pytest.mark.parametrize("arm", ["LEFT", "RIGHT"])
+def test_a_bigger_exaggeration_gives_a_wider_and_higher_wave(settings, arm):
+    rig = helpers.load_sample_rig()
+    hand = helpers.rig_bone(rig, skeleton.ARM_PREFIX[arm] + "Hand")
+    sizes = []
+    for k, exaggeration in enumerate((0.1, 0.9)):
+        start = 1 + 300 * k
+        assert helpers.generate(rig, settings, behaviour="WAVE", arm=arm, exaggeration=exaggeration,
+                                start_frame=start) == {"FINISHED"}
+        wrist = helpers.bone_heads(rig, [hand], np.arange(start, start + settings.frame_count))[:, 0]
+        assert np.linalg.norm(wrist[-1] - wrist[0]) < 0.02, "the gesture must end where it started"
+        raised = wrist[wrist[:, 2] > np.percentile(wrist[:, 2], 60)]  # the waving part, hand up
+        sizes.append((np.ptp(raised[:, 0]), wrist[:, 2].max()))
+    (width_small, height_small), (width_big, height_big) = sizes
+    assert width_big > width_small, f"wave width {width_big:.3f} m should exceed {width_small:.3f} m"
+    assert height_big > height_small, f"wave height {height_big:.3f} m should exceed {height_small:.3f} m"
+
+
+def _animated_bones(rig, names):
+    return [helpers.rig_bone(rig, n) for n in names]
+
+
+@pytest.mark.parametrize("rig_kind", ["centimetres_y_up_rolled", "fbx_reimport_scaled"])
+@pytest.mark.parametrize("behaviour", ["POINT", "WAVE"])
+def test_other_rigs_move_as_the_sample_rig_does(settings, rig_kind, behaviour, tmp_path):
+    """A rig in other units, axes and rolls gets the same world-space motion as the sample rig."""
+    sample = helpers.load_sample_rig()
+    if rig_kind == "centimetres_y_up_rolled":
+        y_up = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+        other = helpers.build_rig("Other", units=100.0, axes=y_up, roll_to_x=True, prefix="mixamorig1:")
+        scale = 1.0
+    else:
+        other = _reimport_sample_fbx(scale=0.01)
+        scale = 0.01
+    target = helpers.add_empty("Target", random_target("RIGHT"))
+    values = dict(behaviour=behaviour, arm="RIGHT", target=target, exaggeration=0.7, seed=0)
+    assert helpers.generate(sample, settings, **values) == {"FINISHED"}
+    # The same target relative to the other rig: scale its offset from the origin with the rig.
+    target.location = np.array(target.location) * scale
+    assert helpers.generate(other, settings, **values) == {"FINISHED"}
+    names = ["RightHand", "RightHandIndex1", "RightHandIndex4", "LeftHand", "Head"]
+    frames = np.arange(1, settings.frame_count + 1)
+    expected = helpers.bone_heads(sample, _animated_bones(sample, names), frames)
+    got = helpers.bone_heads(other, _animated_bones(other, names), frames) / scale
+    assert np.abs(got - expected).max() < 0.01, "world-space motion differs by more than 1 cm"
+
+
+def _reimport_sample_fbx(scale):
+    before = set(bpy.data.objects)
+    bpy.ops.import_scene.fbx(filepath=str(helpers.ROOT / "sample_rigs" / "character.fbx"),
+                             global_scale=scale, automatic_bone_orientation=True)
+    return next(o for o in bpy.data.objects if o not in before and o.type == "ARMATURE")
+
+
+def _pose_snapshot(rig, frames):
+    every = [b.name for b in rig.pose.bones]
+    return every, helpers.bone_heads(rig, every, frames)
+
+
+def _keys(action):
+    from rlanimate_addon.blender import action_adapter
+
+    target = action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None)
+    return {(f.data_path, f.array_index): [tuple(p.co) for p in f.keyframe_points] for f in target.fcurves()}
+
+
+def _key_existing_animation(rig):
+    """An action keying a leg and the right arm over frames 1-120, active on the rig; returns it."""
+    arm, leg = rig.pose.bones[helpers.rig_bone(rig, "RightArm")], rig.pose.bones[helpers.rig_bone(rig, "LeftUpLeg")]
+    for frame, angle in ((1, 0.0), (60, 0.6), (120, -0.3)):
+        arm.rotation_quaternion = (math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0)
+        leg.rotation_quaternion = (math.cos(angle / 2), math.sin(angle / 2), 0.0, 0.0)
+        arm.keyframe_insert("rotation_quaternion", frame=frame)
+        leg.keyframe_insert("rotation_quaternion", frame=frame)
+    return rig.animation_data.action
+
+
+def test_existing_animation_other_frames_and_other_actions_are_preserved(settings):
+    rig = helpers.load_sample_rig()
+    existing = _key_existing_animation(rig)
+    other_action = bpy.data.actions.new("Unrelated")
+    other_action.use_fake_user = True
+    existing_keys = _keys(existing)
+    outside = np.r_[1:40, 81:130]
+    names, before_outside = _pose_snapshot(rig, outside)
+    leg = [helpers.rig_bone(rig, "LeftUpLeg"), helpers.rig_bone(rig, "LeftFoot")]
+    leg_before = helpers.bone_heads(rig, leg, np.arange(40, 81))
+
+    result = helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=40, frame_count=41)
+    assert result == {"FINISHED"}
+    assert _keys(existing) == existing_keys, "keys of the existing action changed"
+    assert len(other_action.fcurves if hasattr(other_action, "fcurves") else other_action.layers) == 0
+    gesture = [a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Left")]
+    assert len(gesture) == 1
+    strips = [s for t in rig.animation_data.nla_tracks for s in t.strips]
+    assert {s.action for s in strips} == {existing, gesture[0]}
+    _, after_outside = _pose_snapshot(rig, outside)
+    assert np.abs(after_outside - before_outside).max() < 1e-5, "frames outside the gesture changed"
+    assert np.abs(helpers.bone_heads(rig, leg, np.arange(40, 81)) - leg_before).max() < 1e-5, \
+        "bones the gesture does not drive changed"
+    hand = helpers.rig_bone(rig, "LeftHand")
+    moved = helpers.bone_heads(rig, [hand], np.arange(40, 81))[:, 0]
+    assert np.ptp(moved[:, 2]) > 0.05, "the gesture did not move the waving hand"
+
+    # A second gesture stacks on top and leaves the first one alone.
+    first_keys = _keys(gesture[0])
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT", start_frame=200) == {"FINISHED"}
+    assert _keys(gesture[0]) == first_keys and _keys(existing) == existing_keys
+
+
+def _state(rig):
+    """What a failed Generate must leave as it was."""
+    data = rig.animation_data
+    return (sorted(a.name for a in bpy.data.actions), bpy.context.scene.frame_current,
+            None if data is None else (data.action, len(data.nla_tracks)),
+            [tuple(pb.rotation_quaternion) for pb in rig.pose.bones])
+
+
+def _assert_refused(rig, message):
+    before = _state(rig)
+    with pytest.raises(RuntimeError, match=message):
+        bpy.ops.rlanimate.generate_gesture()
+    assert _state(rig) == before
+
+
+def test_every_bad_input_is_refused_with_its_message_and_changes_nothing(settings, tmp_path):
+    rig = helpers.load_sample_rig()
+    _key_existing_animation(rig)
+    bpy.context.scene.frame_set(17)
+    target = helpers.add_empty("Target", (1.0, -2.0, 1.5))
+
+    helpers.activate(target)
+    _assert_refused(rig, "not an armature")
+
+    helpers.activate(rig)
+    settings.behaviour, settings.target, settings.use_cursor = "POINT", None, False
+    _assert_refused(rig, "needs a target")
+
+    settings.target = target
+    settings.frame_count = 0
+    _assert_refused(rig, "at least 2 frames")
+    settings.frame_count = 1
+    _assert_refused(rig, "at least 2 frames")
+    settings.frame_count = 50
+
+    damaged = tmp_path / "damaged.npz"
+    damaged.write_bytes(b"PK\x03\x04 truncated")
+    helpers.addon_preferences().agent_path = str(damaged)
+    _assert_refused(rig, "damaged.npz")
+    helpers.addon_preferences().agent_path = str(tmp_path / "missing.npz")
+    _assert_refused(rig, "does not exist")
+    helpers.addon_preferences().agent_path = ""
+
+    partial = helpers.build_rig("Partial", skip=("LeftHandIndex4", "LeftHandIndex3", "Neck", "Head"))
+    helpers.activate(partial)
+    _assert_refused(partial, "Head, LeftHandIndex4, Neck")
+
+    helpers.activate(rig)
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}, "valid settings must work after refusals"
+
+
+def test_cursor_fallback_and_an_animated_target_is_tracked(settings):
+    rig = helpers.load_sample_rig()
+    bpy.context.scene.cursor.location = (-1.5, -2.5, 1.2)
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=None,
+                            use_cursor=True) == {"FINISHED"}
+    target = helpers.add_empty("Moving", (-2.0, -2.0, 1.0))
+    target.keyframe_insert("location", frame=300)
+    target.location = (1.0, -2.0, 2.0)
+    target.keyframe_insert("location", frame=360)
+    bpy.context.scene.frame_set(5)
+    assert helpers.generate(rig, settings, target=target, start_frame=300, frame_count=61) == {"FINISHED"}
+    assert bpy.context.scene.frame_current == 5, "the scene frame must be restored"
+
+
+def test_generate_120_frames_on_the_sample_rig_is_fast(settings):
+    import time
+
+    rig = helpers.load_sample_rig()
+    target = helpers.add_empty("Target", (-1.0, -2.5, 1.6))
+    helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, frame_count=120)  # warm
+    bpy.data.actions.remove(rig.animation_data.action)
+    start = time.perf_counter()
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
+    elapsed = time.perf_counter() - start
+    assert elapsed < 0.1 * 3, f"120 frames took {elapsed * 1000:.0f} ms (budget 100 ms; 3x slack for a busy CI)"

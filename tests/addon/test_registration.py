@@ -1,0 +1,120 @@
+"""Registration, the Scene.rlanimate contract, and the N-panel's placement and draw()."""
+import addon_helpers
+import bpy
+import pytest
+
+import rlanimate_addon
+from rlanimate_addon.blender import panel, registration
+
+CONTRACT = {
+    "behaviour": ("ENUM", {"POINT", "WAVE"}),
+    "arm": ("ENUM", {"LEFT", "RIGHT"}),
+    "target": ("POINTER", None),
+    "exaggeration": ("FLOAT", None),
+    "frame_count": ("INT", None),
+    "start_frame": ("INT", None),
+    "seed": ("INT", None),
+}
+
+
+def _registered():
+    return (hasattr(bpy.types.Scene, "rlanimate"), hasattr(bpy.types, "VIEW3D_PT_rlanimate"),
+            hasattr(bpy.ops.rlanimate, "generate_gesture") and "generate_gesture" in dir(bpy.ops.rlanimate))
+
+
+def test_register_and_unregister_twice():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    for _ in range(2):
+        rlanimate_addon.register()
+        assert _registered() == (True, True, True)
+        for cls in registration.CLASSES:
+            assert cls.is_registered
+        rlanimate_addon.unregister()
+        assert not hasattr(bpy.types.Scene, "rlanimate")
+        assert not any(cls.is_registered for cls in registration.CLASSES)
+
+
+def test_scene_settings_keep_the_contract(settings):
+    properties = settings.bl_rna.properties
+    for name, (kind, items) in CONTRACT.items():
+        assert properties[name].type == kind, name
+        if items is not None:
+            assert {item.identifier for item in properties[name].enum_items} == items
+    assert properties["target"].fixed_type.identifier == "Object"
+    assert (properties["exaggeration"].hard_min, properties["exaggeration"].hard_max) == (0.0, 1.0)
+    assert settings.frame_count >= 2, "the default length must be a usable gesture"
+    assert {"REGISTER", "UNDO"} <= set(bpy.types.RLANIMATE_OT_generate_gesture.bl_options)
+    export = bpy.ops.rlanimate.export_fbx.get_rna_type()
+    assert "filepath" in export.properties
+
+
+def test_panel_sits_in_the_3d_view_sidebar_under_rlanimate(settings):
+    cls = bpy.types.VIEW3D_PT_rlanimate
+    assert (cls.bl_space_type, cls.bl_region_type, cls.bl_category) == ("VIEW_3D", "UI", "RLAnimate")
+
+
+class RecordingLayout:
+    """Stands in for bpy.types.UILayout: records prop(), operator() and label() calls from draw()."""
+
+    def __init__(self, calls=None):
+        self.calls = [] if calls is None else calls
+
+    def _nested(self, *args, **kwargs):
+        return RecordingLayout(self.calls)
+
+    row = column = box = split = column_flow = grid_flow = _nested
+
+    def prop(self, data, name, **kwargs):
+        self.calls.append(("prop", data, name, kwargs))
+
+    def operator(self, idname, **kwargs):
+        self.calls.append(("operator", idname, kwargs))
+
+    def label(self, **kwargs):
+        self.calls.append(("label", kwargs))
+
+    def separator(self, **kwargs):
+        pass
+
+
+def _draw(settings):
+    layout = RecordingLayout()
+    stand_in = type("PanelStandIn", (), {"layout": layout})()
+    panel.VIEW3D_PT_rlanimate.draw(stand_in, bpy.context)
+    return layout.calls
+
+
+_ICONS = bpy.types.UILayout.bl_rna.functions["prop"].parameters["icon"].enum_items.keys()
+
+
+@pytest.mark.parametrize("behaviour", ["POINT", "WAVE"])
+def test_panel_draw_uses_only_existing_properties_operators_and_icons(settings, behaviour):
+    settings.behaviour = behaviour
+    calls = _draw(settings)
+    shown = set()
+    for call in calls:
+        if call[0] == "prop":
+            _, data, name, kwargs = call
+            assert name in data.bl_rna.properties, f"draw() shows a missing property {name!r}"
+            shown.add(name)
+        elif call[0] == "operator":
+            group, op = call[1].split(".")
+            assert op in dir(getattr(bpy.ops, group)), f"draw() shows a missing operator {call[1]!r}"
+        kwargs = call[-1]
+        assert kwargs.get("icon", "NONE") in _ICONS
+    assert {"behaviour", "arm", "frame_count", "start_frame", "seed"} <= shown
+    assert ("exaggeration" in shown) == (behaviour == "WAVE")
+    assert ("target" in shown) == (behaviour == "POINT")
+    operators = [c[1] for c in calls if c[0] == "operator"]
+    assert operators == ["rlanimate.generate_gesture", "rlanimate.export_fbx"]
+    labels = " ".join(c[1].get("text", "") for c in calls if c[0] == "label")
+    assert "supported" in labels, "the panel must show the supported length range"
+
+
+def test_panel_names_a_damaged_agent_file_instead_of_failing(settings, tmp_path):
+    damaged = tmp_path / "broken.npz"
+    damaged.write_bytes(b"not an agent")
+    addon_helpers.addon_preferences().agent_path = str(damaged)
+    labels = [c[1] for c in _draw(settings) if c[0] == "label"]
+    assert any(label.get("icon") == "ERROR" for label in labels)
+    assert any("broken.npz" in label.get("text", "") for label in labels)
