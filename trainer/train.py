@@ -181,7 +181,7 @@ def run(args, session=None):
         final = evaluate_seen_unseen(trainer, session)
     log.close()
     report = _report(args, trainer, final, epochs)
-    export_agent(agent, output / "agent.npz", _agent_metadata(args, report))
+    export_agent(agent, output / "agent.npz", _agent_metadata(report, trainer))
     _write_report(report, output)
     plots.training_curves(trainer.history, output / "training_curves.png", title=f"{args.variant}, {args.behaviour}")
     if args.install:
@@ -218,9 +218,16 @@ def _report(args, trainer, final, epochs):
     }
 
 
-def _agent_metadata(args, report):
+def _agent_metadata(report, trainer):
+    lengths = {}
+    for group in trainer.clip_groups:
+        for clip in group:
+            lengths.setdefault(clip.behaviour.upper(), []).append(len(clip.rotvecs))
     return {"training": {key: report[key] for key in ("behaviour", "variant", "preset", "seed", "clips",
                                                        "epochs", "episodes", "train_seconds")},
+            "train_config": trainer.train_config,
+            "action_bounds": trainer.bounds,
+            "average_frames": {name: float(np.mean(values)) for name, values in lengths.items()},
             "evaluation": {"held_out_score": report["held_out"]["score"],
                            "held_out_smoothness": report["held_out"]["smoothness"]}}
 
