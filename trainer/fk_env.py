@@ -27,7 +27,12 @@ _COLLECTION_NAME = "RLAnimate_FK_instances"
 class FKEnvironment:
     """Blender as a batched FK function from local joint rotations to descriptions and joint positions."""
 
-    def __init__(self, rig_path=bpy_support.SAMPLE_RIG_BLEND, instances=64):
+    def __init__(self, rig_path=bpy_support.SAMPLE_RIG_BLEND, instances=8):
+        """Load the rig at `rig_path` (.blend or .fbx) and make `instances` armature objects of it.
+
+        8 instances measured fastest on one core (docs/BENCHMARKS.md, "FK environment"): each depsgraph
+        update pays a cost per armature object in the scene, so more instances are slower per pose.
+        """
         if int(instances) < 1:
             raise RLAnimateError(f"FKEnvironment needs at least 1 instance, got {instances}.")
         self._bpy = bpy_support.import_bpy()
