@@ -1,0 +1,45 @@
+"""Export FBX: Blender's exporter writes the rig, its mesh and the baked gesture, and they read back."""
+import addon_helpers as helpers
+import bpy
+import numpy as np
+import pytest
+
+from rlanimate_addon.core import skeleton
+
+
+def _imported(path):
+    """Objects read from the FBX; keys land on the frames they were exported from (no import offset)."""
+    before = set(bpy.data.objects)
+    bpy.ops.import_scene.fbx(filepath=str(path), automatic_bone_orientation=False, anim_offset=0.0)
+    return [o for o in bpy.data.objects if o not in before]
+
+
+def test_fbx_round_trip_reproduces_every_joint_within_a_millimetre(settings, tmp_path):
+    rig = helpers.load_sample_rig()
+    target = helpers.add_empty("Target", (-1.2, -2.0, 1.7))
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, start_frame=1,
+                            frame_count=40) == {"FINISHED"}
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=30,
+                            frame_count=50) == {"FINISHED"}
+    bpy.context.scene.frame_end = 20  # the export must still take in every baked frame
+    path = tmp_path / "gesture.fbx"
+    assert bpy.ops.rlanimate.export_fbx(filepath=str(path)) == {"FINISHED"}
+    assert bpy.context.scene.frame_end == 20 and rig.select_get() is False
+
+    imported = _imported(path)
+    assert sorted(o.type for o in imported) == ["ARMATURE", "MESH"], "armature and mesh, nothing else"
+    copy = next(o for o in imported if o.type == "ARMATURE")
+    assert sorted(b.name for b in copy.data.bones) == sorted(b.name for b in rig.data.bones), "no leaf bones"
+    frames = np.arange(1, 80)
+    names = [skeleton.PREFIX + b.name for b in skeleton.BONES]
+    baked = helpers.bone_heads(rig, names, frames)
+    read_back = helpers.bone_heads(copy, names, frames)
+    assert np.ptp(baked[:, :, 2], axis=0).max() > 0.1, "the gesture should move the hands"
+    assert np.abs(read_back - baked).max() < 1e-3
+
+
+def test_export_refuses_without_an_armature(settings, tmp_path):
+    helpers.activate(helpers.add_empty("NotARig", (0, 0, 0)))
+    with pytest.raises(RuntimeError, match="not an armature"):
+        bpy.ops.rlanimate.export_fbx(filepath=str(tmp_path / "x.fbx"))
+    assert not (tmp_path / "x.fbx").exists()
