@@ -41,7 +41,7 @@ def uses_task_state(variant):
 
 
 def mlp_shapes(name, inputs, hidden, layers, outputs):
-    """Shapes of an MLP's arrays: `layers` hidden Linear(+ELU) layers of width `hidden`, then a Linear."""
+    """Shapes of an MLP's arrays: `layers` hidden Linear(+tanh) layers of width `hidden`, then a Linear."""
     widths = [inputs] + [hidden] * layers + [outputs]
     shapes = {}
     for k, (n_in, n_out) in enumerate(zip(widths[:-1], widths[1:])):

@@ -26,10 +26,6 @@ def load_agent(path):
     return GestureAgent(weights, metadata)
 
 
-def _elu(x):
-    return np.where(x > 0.0, x, np.expm1(np.minimum(x, 0.0)))
-
-
 def _softplus(x):
     return np.logaddexp(0.0, x)
 
@@ -38,59 +34,51 @@ def _sigmoid(x):
     return 0.5 * (1.0 + np.tanh(0.5 * x))
 
 
-class _MLP:
-    """Linear layers (weights transposed to (in, out)) with ELU between them; the first layer's
-    weight can be split by input blocks so that each block is applied where it is known."""
-
-    def __init__(self, weights, name, layers):
-        self.weights = [weights[f"{name}.layers.{k}.weight"].T.copy() for k in range(layers + 1)]
-        self.biases = [weights[f"{name}.layers.{k}.bias"] for k in range(layers + 1)]
-
-    def first_blocks(self, sizes):
-        """The first layer's weight cut into row blocks of `sizes` (one per concatenated input)."""
-        return np.split(self.weights[0], np.cumsum(sizes)[:-1], axis=0)
-
-    def rest(self, first_layer_preactivation):
-        x = first_layer_preactivation
-        for weight, bias in zip(self.weights[1:], self.biases[1:]):
-            x = _elu(x) @ weight + bias
-        return x
-
-    def __call__(self, x):
-        return self.rest(x @ self.weights[0] + self.biases[0])
+def _mlp_arrays(weights, name, layers):
+    """[(weight (in, out), bias (out,))] of an MLP: Linear layers with tanh between them."""
+    return [(weights[f"{name}.layers.{k}.weight"].T.copy(), weights[f"{name}.layers.{k}.bias"])
+            for k in range(layers + 1)]
 
 
-class _GRU:
-    """torch's GRU cell: gates r, z, n; h' = (1 - z) n + z h."""
+def _mlp_tail(layers, first_preactivation):
+    """An MLP from its first layer's pre-activation on: tanh, then the remaining Linear layers."""
+    x = first_preactivation
+    for weight, bias in layers[1:]:
+        x = np.tanh(x) @ weight + bias
+    return x
 
-    def __init__(self, weights, name, suffix=""):
-        self.input_weight = weights[f"{name}.weight_ih{suffix}"].T.copy()  # (in, 3H)
-        self.hidden_weight = weights[f"{name}.weight_hh{suffix}"].T.copy()  # (H, 3H)
-        self.input_bias = weights[f"{name}.bias_ih{suffix}"]
-        self.hidden_bias = weights[f"{name}.bias_hh{suffix}"]
-        self.size = self.hidden_weight.shape[0]
 
-    def step(self, input_gates, h):
-        """input_gates: W_ih x + b_ih (3H,) for this step; h (H,) -> h' (H,)."""
-        H = self.size
-        hidden_gates = h @ self.hidden_weight + self.hidden_bias
-        reset = _sigmoid(input_gates[:H] + hidden_gates[:H])
-        update = _sigmoid(input_gates[H:2 * H] + hidden_gates[H:2 * H])
-        candidate = np.tanh(input_gates[2 * H:] + reset * hidden_gates[2 * H:])
-        return candidate + update * (h - candidate)
+def _gru_arrays(weights, name, suffix=""):
+    """(W_ih (in, 3H), W_hh (H, 3H), b_ih, b_hh) of a torch GRU / GRUCell; gates r, z, n."""
+    return (weights[f"{name}.weight_ih{suffix}"].T.copy(), weights[f"{name}.weight_hh{suffix}"].T.copy(),
+            weights[f"{name}.bias_ih{suffix}"], weights[f"{name}.bias_hh{suffix}"])
 
-    def sequence(self, inputs):
-        """(N, in) -> (N, H), from h_0 = 0."""
-        gates = inputs @ self.input_weight + self.input_bias  # (N, 3H)
-        h = np.zeros(self.size)
-        states = np.empty((len(inputs), self.size))
-        for t in range(len(inputs)):
-            h = states[t] = self.step(gates[t], h)
-        return states
+
+def _gru_step(input_gates, hidden_gates, h):
+    """torch's GRU update from W_ih x + b_ih and W_hh h + b_hh (3H,) each: h' = (1 - z) n + z h."""
+    H = len(h)
+    reset_update = _sigmoid(input_gates[:2 * H] + hidden_gates[:2 * H])
+    candidate = np.tanh(input_gates[2 * H:] + reset_update[:H] * hidden_gates[2 * H:])
+    return candidate + reset_update[H:] * (h - candidate)
+
+
+def _gru_sequence(inputs, gru):
+    """(N, in) -> (N, H) states of a GRU from h_0 = 0."""
+    input_weight, hidden_weight, input_bias, hidden_bias = gru
+    input_gates = inputs @ input_weight + input_bias  # (N, 3H)
+    h = np.zeros(hidden_weight.shape[0])
+    states = np.empty((len(inputs), len(h)))
+    for t in range(len(inputs)):
+        h = states[t] = _gru_step(input_gates[t], h @ hidden_weight + hidden_bias, h)
+    return states
 
 
 class GestureAgent:
-    """An exported agent ready to play: `rollout` objectives (N, 7) -> actions (N, 45) in [0, 1]."""
+    """An exported agent ready to play: `rollout` objectives (N, 7) -> actions (N, 45) in [0, 1].
+
+    The per-frame loop does one matrix product per input that changes in it (e_t, z_t, a_t): each
+    input's weights into every layer it feeds are joined side by side at load time.
+    """
 
     def __init__(self, weights, metadata):
         self.metadata = metadata
@@ -98,58 +86,66 @@ class GestureAgent:
         self.action_bounds = np.asarray(metadata["action_bounds"], dtype=np.float64)  # (45, 2)
         self.average_frames = {b: float(metadata["average_frames"][b]) for b in spaces.BEHAVIOURS}
         config = metadata["agent_config"]
-        self._min_std = float(config["min_std"])
-        self._floor = float(config["concentration_floor"])
-        self._stochastic_size = int(config["stochastic_size"])
         w = {name: np.asarray(array, dtype=np.float64) for name, array in weights.items()}
         layers = int(config["hidden_layers"])
+        E, Z, A = int(config["behaviour_size"]), int(config["stochastic_size"]), spaces.ACTION_SIZE
+        self._sizes = (E, Z)
+        self._min_std = float(config["min_std"])
+        self._floor = float(config["concentration_floor"])
         self._uses_portrayal = agent_file.uses_portrayal(self.variant)
         self._uses_task_state = agent_file.uses_task_state(self.variant)
+        task_size = int(config["task_size"]) if self._uses_task_state else spaces.OBJECTIVE_SIZE
         if self._uses_portrayal:
-            self._portrayal = _MLP(w, "portrayal", layers)
+            self._portrayal = _mlp_arrays(w, "portrayal", layers)
         if self._uses_task_state:
-            self._task_rnn = _GRU(w, "task_rnn", "_l0")
-        self._cell = _GRU(w, "behaviour_cell")
-        self._prior = _MLP(w, "prior", layers)
-        self._posterior = _MLP(w, "posterior", layers)
-        self._animation = _MLP(w, "animation", layers)
-        E, Z, A = int(config["behaviour_size"]), self._stochastic_size, spaces.ACTION_SIZE
-        task = int(config["task_size"]) if self._uses_task_state else spaces.OBJECTIVE_SIZE
-        self._cell_task, self._cell_z, self._cell_a = np.split(self._cell.input_weight, [task, task + Z], axis=0)
-        self._posterior_e, self._posterior_d = self._posterior.first_blocks([E, spaces.DESCRIPTION_SIZE])
-        head = ([task] if self._uses_task_state else []) + [E, Z]
-        blocks = self._animation.first_blocks(head)
-        self._animation_task = blocks[0] if self._uses_task_state else None
-        self._animation_e, self._animation_z = blocks[-2:]
+            self._task_rnn = _gru_arrays(w, "task_rnn", "_l0")
+        cell_input, cell_hidden, self._cell_bias, self._cell_hidden_bias = _gru_arrays(w, "behaviour_cell")
+        cell_task, cell_z, cell_a = np.split(cell_input, [task_size, task_size + Z])
+        # z_t's belief: the posterior (on the self-description) or, in single_state, the prior.
+        self._belief = _mlp_arrays(w, "posterior" if self._uses_portrayal else "prior", layers)
+        belief_e = self._belief[0][0][:E]
+        self._animation = _mlp_arrays(w, "animation", layers)
+        animation_blocks = np.split(self._animation[0][0], np.cumsum(
+            ([task_size] if self._uses_task_state else []) + [E]))
+        animation_e, animation_z = animation_blocks[-2:]
+        self._cell_task = cell_task
+        self._animation_task = animation_blocks[0] if self._uses_task_state else None
+        self._from_e = np.hstack([cell_hidden, belief_e, animation_e])  # (E, 3E + 2 hidden)
+        self._from_z = np.hstack([cell_z, animation_z])  # (Z, 3E + hidden)
+        self._from_a = cell_a  # (A, 3E)
 
     def rollout(self, objectives, seed=None):
         """Objectives (N, 7) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""
         objectives = np.asarray(objectives, dtype=np.float64)
         rng = None if seed is None else np.random.default_rng(seed)
-        count, Z = len(objectives), self._stochastic_size
-        task = self._task_rnn.sequence(objectives) if self._uses_task_state else objectives  # (N, K)
-        cell_inputs = task @ self._cell_task + self._cell.input_bias  # (N, 3E)
+        E, Z = self._sizes
+        A = spaces.ACTION_SIZE
+        count = len(objectives)
+        task = _gru_sequence(objectives, self._task_rnn) if self._uses_task_state else objectives  # (N, K)
+        cell_inputs = task @ self._cell_task + self._cell_bias  # (N, 3E)
+        belief_inputs = np.broadcast_to(self._belief[0][1], (count, len(self._belief[0][1])))  # (N, hidden)
         if self._uses_portrayal:
-            described = self._portrayal(objectives)  # (N, 42)
-            posterior_inputs = described @ self._posterior_d + self._posterior.biases[0]  # (N, hidden)
-        animation_inputs = self._animation.biases[0] + (
-            task @ self._animation_task if self._uses_task_state else 0.0)  # (N, hidden) or (hidden,)
-        animation_inputs = np.broadcast_to(animation_inputs, (count, len(self._animation.biases[0])))
-        e = np.zeros(self._cell.size)
-        z = np.zeros(Z)
-        a = np.full(spaces.ACTION_SIZE, INITIAL_ACTION)
-        actions = np.empty((count, spaces.ACTION_SIZE))
+            described = _mlp_tail(self._portrayal, objectives @ self._portrayal[0][0] + self._portrayal[0][1])
+            belief_inputs = belief_inputs + described @ self._belief[0][0][E:]  # (N, hidden)
+        animation_inputs = np.broadcast_to(self._animation[0][1], (count, len(self._animation[0][1])))
+        if self._uses_task_state:
+            animation_inputs = animation_inputs + task @ self._animation_task  # (N, hidden)
+        gates, belief_end = 3 * E, 3 * E + len(self._belief[0][1])
+        e = np.zeros(E)
+        hidden_gates = self._cell_hidden_bias  # W_hh e_0 + b_hh with e_0 = 0
+        recurrent_gates = np.full(A, INITIAL_ACTION) @ self._from_a  # W_z z_0 + W_a a_0 with z_0 = 0
+        actions = np.empty((count, A))
         for t in range(count):
-            e = self._cell.step(cell_inputs[t] + z @ self._cell_z + a @ self._cell_a, e)
-            if self._uses_portrayal:
-                belief = self._posterior.rest(e @ self._posterior_e + posterior_inputs[t])
-            else:
-                belief = self._prior(e)
+            e = _gru_step(cell_inputs[t] + recurrent_gates, hidden_gates, e)
+            from_e = e @ self._from_e
+            hidden_gates = from_e[:gates] + self._cell_hidden_bias
+            belief = _mlp_tail(self._belief, from_e[gates:belief_end] + belief_inputs[t])
             z = belief[:Z]
             if rng is not None:
                 z = z + (_softplus(belief[Z:]) + self._min_std) * rng.standard_normal(Z)
-            out = self._animation.rest(animation_inputs[t] + e @ self._animation_e + z @ self._animation_z)
-            alpha = _softplus(out[:spaces.ACTION_SIZE]) + self._floor
-            beta = _softplus(out[spaces.ACTION_SIZE:]) + self._floor
-            a = actions[t] = alpha / (alpha + beta)
+            from_z = z @ self._from_z
+            out = _mlp_tail(self._animation, animation_inputs[t] + from_e[belief_end:] + from_z[gates:])
+            concentrations = _softplus(out) + self._floor  # (90,): alpha then beta
+            a = actions[t] = concentrations[:A] / (concentrations[:A] + concentrations[A:])
+            recurrent_gates = from_z[:gates] + a @ self._from_a
         return actions
