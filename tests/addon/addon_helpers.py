@@ -13,6 +13,7 @@ from rlanimate_addon.core import skeleton
 
 ROOT = Path(__file__).resolve().parents[2]
 SAMPLE_BLEND = ROOT / "sample_rigs" / "character.blend"
+SAMPLE_FBX = ROOT / "sample_rigs" / "character.fbx"
 SAMPLE_RIG = "RLAnimate_Character"
 ADDON = "rlanimate_addon"
 
@@ -42,7 +43,14 @@ def activate(obj):
 
 
 def load_sample_rig():
-    """The sample character (armature and skinned mesh) appended into the scene; returns the armature."""
+    """The sample character (armature and skinned mesh) brought into the scene; returns the armature.
+
+    From the .blend; Blender 4.2 cannot read a .blend saved by 5.0, so there from the sample FBX.
+    """
+    if bpy.app.version < (5, 0, 0):
+        before = set(bpy.data.objects)
+        bpy.ops.import_scene.fbx(filepath=str(SAMPLE_FBX), automatic_bone_orientation=False)
+        return activate(next(o for o in bpy.data.objects if o not in before and o.type == "ARMATURE"))
     with bpy.data.libraries.load(str(SAMPLE_BLEND), link=False) as (source, target):
         target.objects = list(source.objects)
     for obj in target.objects:

@@ -22,9 +22,12 @@ def test_fbx_round_trip_reproduces_every_joint_within_a_millimetre(settings, tmp
     assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=30,
                             frame_count=50) == {"FINISHED"}
     bpy.context.scene.frame_end = 20  # the export must still take in every baked frame
+    helpers.add_empty("Selected", (0, 0, 0)).select_set(True)
+    selected = {o.name for o in bpy.context.view_layer.objects if o.select_get()}
     path = tmp_path / "gesture.fbx"
     assert bpy.ops.rlanimate.export_fbx(filepath=str(path)) == {"FINISHED"}
-    assert bpy.context.scene.frame_end == 20 and rig.select_get() is False
+    assert bpy.context.scene.frame_end == 20, "the scene's frame range must be restored"
+    assert {o.name for o in bpy.context.view_layer.objects if o.select_get()} == selected
 
     imported = _imported(path)
     assert sorted(o.type for o in imported) == ["ARMATURE", "MESH"], "armature and mesh, nothing else"

@@ -109,7 +109,7 @@ def test_other_rigs_move_as_the_sample_rig_does(settings, rig_kind, behaviour, t
 
 def _reimport_sample_fbx(scale):
     before = set(bpy.data.objects)
-    bpy.ops.import_scene.fbx(filepath=str(helpers.ROOT / "sample_rigs" / "character.fbx"),
+    bpy.ops.import_scene.fbx(filepath=str(helpers.SAMPLE_FBX),
                              global_scale=scale, automatic_bone_orientation=True)
     return next(o for o in bpy.data.objects if o not in before and o.type == "ARMATURE")
 
