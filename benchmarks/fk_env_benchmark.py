@@ -49,7 +49,8 @@ def measure():
     for instances in INSTANCE_COUNTS:
         bpy_support.new_empty_scene()
         env = FKEnvironment(instances=instances)
-        rows.append(("bpy FKEnvironment.describe_actions", instances, best_seconds(lambda: env.describe_actions(actions))))
+        seconds = best_seconds(lambda: env.describe_actions(actions))
+        rows.append(("bpy FKEnvironment.describe_actions", instances, seconds))
     rotvecs = spaces.decode_action(actions)
     local = {joint: rotvecs[:, i] for i, joint in enumerate(skeleton.ACTION_JOINTS)}
     rows.append(("numpy core.kinematics (reference)", "-", best_seconds(lambda: kinematics.pose_matrices(local))))
@@ -64,8 +65,8 @@ def section(rows):
     lines = [
         HEADING, "",
         f"Poses per second of `trainer/fk_env.py` on the sample rig ({len(skeleton.BONES)} bones): {POSES} random",
-        f"actions decoded and evaluated per call (best of {REPEATS} after a warm-up), each batch of `instances` poses in",
-        "one depsgraph update. Pinned to one CPU core.", "",
+        f"actions decoded and evaluated per call (best of {REPEATS} after a warm-up), each batch of",
+        "`instances` poses in one depsgraph update. Pinned to one CPU core.", "",
         f"Regenerate: `{COMMAND}`", "",
         f"Machine: {platform.machine()}, 2 CPU cores shared with other jobs, Python {platform.python_version()}, "
         f"bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {date}.", "",

@@ -1,9 +1,10 @@
 """Build the sample character from the canonical skeleton: `sample_rigs/character.blend` and `.fbx`.
 
 Run as `python sample_rigs/build_character.py [OUT_DIR]` or `blender -b -P sample_rigs/build_character.py
--- [OUT_DIR]`. The armature "RLAnimate_Character" is `core.skeleton.BONES` exactly (names prefixed
-`mixamorig:`, heads, tails, rolls from the z hints, parents, connected where a child starts at its
-parent's tail); the mesh is a low-poly mannequin (a tapered prism per bone, ellipsoids for the skull,
+-- [OUT_DIR]`. Write the committed files with Blender 4.2 LTS (`.venv-bpy42/bin/python ...`): 4.2
+cannot read a .blend saved by 5.0. The armature "RLAnimate_Character" is `core.skeleton.BONES` exactly
+(names prefixed `mixamorig:`, heads, tails, rolls from the z hints, parents, connected where a child
+starts at its parent's tail); the mesh is a low-poly mannequin (a tapered prism per bone, ellipsoids for the skull,
 eyes and joints), rigidly skinned, so an animator sees a body. The content is deterministic: the same
 bones, vertices, faces and weights in the same order on every run (the bytes are not: Blender stores
 some memory addresses in the .blend, and the FBX exporter a creation time).
@@ -30,7 +31,8 @@ _SECTIONS = {
     "Spine2": (0.155, 0.100, 0.75), "Neck": (0.045, 0.045, 1.0),
     "Shoulder": (0.045, 0.050, 1.0), "Arm": (0.050, 0.050, 0.80), "ForeArm": (0.040, 0.040, 0.75),
     "Hand": (0.040, 0.016, 1.0),
-    "UpLeg": (0.080, 0.080, 0.70), "Leg": (0.055, 0.055, 0.65), "Foot": (0.040, 0.035, 1.1), "ToeBase": (0.045, 0.025, 0.8),
+    "UpLeg": (0.080, 0.080, 0.70), "Leg": (0.055, 0.055, 0.65), "Foot": (0.040, 0.035, 1.1),
+    "ToeBase": (0.045, 0.025, 0.8),
 }
 _FINGER_RADIUS = {"Thumb": 0.011, "Index": 0.009, "Middle": 0.0095, "Ring": 0.009, "Pinky": 0.008}
 # Ellipsoids (bone, centre offset from the bone's head in armature axes, radii along the bone's X, Y, Z):
@@ -45,7 +47,7 @@ SIDES = 8  # vertices per ring
 
 def _section(name):
     """(half-width along X, along Z, taper) of the bone's prism, or None for no prism."""
-    base = name[len("Left"):] if name.startswith("Left") else name[len("Right"):] if name.startswith("Right") else name
+    base = name.removeprefix("Left").removeprefix("Right")
     if base in _SECTIONS:
         return _SECTIONS[base]
     for finger, radius in _FINGER_RADIUS.items():

@@ -59,7 +59,8 @@ def test_body_mesh_is_skinned_to_the_rig(scene):
     assert [(m.type, m.object) for m in body.modifiers] == [("ARMATURE", rig)]
     group_names = {g.name for g in body.vertex_groups}
     assert group_names <= {b.name for b in rig.data.bones}
-    assert {skeleton.PREFIX + b for b in ("Head", "Hips", "LeftForeArm", "RightUpLeg", "LeftHandIndex2")} <= group_names
+    some_bones = ("Head", "Hips", "LeftForeArm", "RightUpLeg", "LeftHandIndex2")
+    assert {skeleton.PREFIX + b for b in some_bones} <= group_names
     weighted = [len(v.groups) for v in body.data.vertices]
     assert min(weighted) >= 1, "every vertex must follow a bone"
     # The body spans a standing adult: feet near the ground, top of the head near 1.8 m.
@@ -77,6 +78,17 @@ def test_fbx_reimports_every_bone_with_the_same_rest_pose(scene):
     position_error, frame_error = _rest_errors(rig)
     assert position_error < 1e-4 and frame_error < 1e-3
     assert any(o.type == "MESH" for o in imported)
+
+
+def test_committed_blend_is_readable_by_blender_4_2():
+    """Blender 5.0's .blend header cannot be read by 4.2 LTS, so the committed file is saved by 4.2."""
+    import zstandard  # a dependency of the bpy wheel; Blender compresses .blend files with zstd
+
+    with open(bpy_support.SAMPLE_RIG_BLEND, "rb") as handle:
+        header = zstandard.ZstdDecompressor().stream_reader(handle).read(12)
+    # The pre-5.0 header: "BLENDER", pointer size "-" or "_", endianness "v" or "V", 3-digit version.
+    assert header[:7] == b"BLENDER" and header[7:8] in b"-_" and header[8:9] in b"vV", header
+    assert int(header[9:12]) <= 402, f"saved by Blender {header[9:12].decode()}, newer than 4.2"
 
 
 def test_build_script_reproduces_the_committed_character(scene, tmp_path):

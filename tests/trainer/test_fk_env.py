@@ -76,7 +76,8 @@ def test_describe_actions_decodes_with_the_bounds(env):
     decoded = env.describe_actions(actions)
     assert np.allclose(decoded.descriptions, direct.descriptions)
     centred = env.describe_actions(np.full((1, spaces.ACTION_SIZE), 0.5))  # symmetric bounds: 0.5 is rest
-    assert np.allclose(centred.joint_positions[0], env.evaluate(np.zeros((1, JOINTS, 3))).joint_positions[0], atol=1e-6)
+    rest = env.evaluate(np.zeros((1, JOINTS, 3)))
+    assert np.allclose(centred.joint_positions[0], rest.joint_positions[0], atol=1e-6)
 
 
 def test_positions_are_in_metres_whatever_the_object_scale(tmp_path):
