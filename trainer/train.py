@@ -152,8 +152,8 @@ def run(args, session=None):
         saved = checkpoint.load(output / checkpoint.FILENAME)
         for name in RESUMED_SETTINGS:
             setattr(args, name, saved["arguments"][name])
-    session = session or Session(manifest_path(args.clips))
     agent_config, train_config = load_preset(args.preset)
+    session = session or Session(manifest_path(args.clips))
     epochs = args.epochs or default_epochs(train_config, args.behaviour)
 
     seed_everything(args.seed)
