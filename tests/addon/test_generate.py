@@ -119,11 +119,14 @@ def _pose_snapshot(rig, frames):
     return every, helpers.bone_heads(rig, every, frames)
 
 
-def _keys(action):
+def _fcurves(action):
     from rlanimate_addon.blender import action_adapter
 
-    target = action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None)
-    return {(f.data_path, f.array_index): [tuple(p.co) for p in f.keyframe_points] for f in target.fcurves()}
+    return action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None).fcurves()
+
+
+def _keys(action):
+    return {(f.data_path, f.array_index): [tuple(p.co) for p in f.keyframe_points] for f in _fcurves(action)}
 
 
 def _key_existing_animation(rig):
@@ -148,11 +151,11 @@ def test_existing_animation_other_frames_and_other_actions_are_preserved(setting
     leg = [helpers.rig_bone(rig, "LeftUpLeg"), helpers.rig_bone(rig, "LeftFoot")]
     leg_before = helpers.bone_heads(rig, leg, np.arange(40, 81))
 
-    result = helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=40, frame_count=41)
+    result = helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT", start_frame=40, frame_count=41)
     assert result == {"FINISHED"}
     assert _keys(existing) == existing_keys, "keys of the existing action changed"
     assert len(other_action.fcurves if hasattr(other_action, "fcurves") else other_action.layers) == 0
-    gesture = [a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Left")]
+    gesture = [a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Right")]
     assert len(gesture) == 1
     strips = [s for t in rig.animation_data.nla_tracks for s in t.strips]
     assert {s.action for s in strips} == {existing, gesture[0]}
@@ -160,13 +163,17 @@ def test_existing_animation_other_frames_and_other_actions_are_preserved(setting
     assert np.abs(after_outside - before_outside).max() < 1e-5, "frames outside the gesture changed"
     assert np.abs(helpers.bone_heads(rig, leg, np.arange(40, 81)) - leg_before).max() < 1e-5, \
         "bones the gesture does not drive changed"
-    hand = helpers.rig_bone(rig, "LeftHand")
-    moved = helpers.bone_heads(rig, [hand], np.arange(40, 81))[:, 0]
-    assert np.ptp(moved[:, 2]) > 0.05, "the gesture did not move the waving hand"
+    # Inside its frames the gesture drives the arm, over the existing keys of the same bone.
+    arm = helpers.rig_bone(rig, "RightArm")
+    curves = sorted((f for f in _fcurves(gesture[0]) if f'"{arm}"' in f.data_path), key=lambda f: f.array_index)
+    for frame in (40, 55, 70, 80):
+        bpy.context.scene.frame_set(frame)
+        keyed = [f.evaluate(frame) for f in curves]
+        assert np.allclose(tuple(rig.pose.bones[arm].rotation_quaternion), keyed, atol=1e-5)
 
     # A second gesture stacks on top and leaves the first one alone.
     first_keys = _keys(gesture[0])
-    assert helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT", start_frame=200) == {"FINISHED"}
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=200) == {"FINISHED"}
     assert _keys(gesture[0]) == first_keys and _keys(existing) == existing_keys
 
 
