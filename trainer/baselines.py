@@ -1,0 +1,225 @@
+"""The baselines an animator would try before RLAnimate, producing clips the evaluator scores.
+
+Both answer the agent's request (behaviour, arm, label attributes, frame count) with a clip of
+local rotations (F, 15, 3) of skeleton.ACTION_JOINTS, like MotionClip.rotvecs:
+
+NearestClip      retrieval, as motion matching does: the training clip of the same behaviour and arm
+                 whose label is closest (angle between pointing directions; |difference| of
+                 exaggerations), time-warped uniformly to the requested length (per-joint slerp).
+ProceduralIK     Blender's IK constraint on the sample rig. Point: the index finger's IK chain (Index1,
+                 Hand, ForeArm, Arm) reaches for a target 2.5 m along the requested direction, so the arm
+                 and finger line up with it; the constraint's influence is keyed 0 -> 1 -> 0 with
+                 minimum-jerk ease (stroke, hold, return), which is a per-joint slerp between the start
+                 pose and the solved pose. Wave: the hand's IK chain (Hand, ForeArm, Arm) follows a
+                 target that rises with minimum-jerk timing and swings side to side at 2.5 Hz; the
+                 raise (70 + 90 e degrees from hanging) and the swing (0.05 + 0.35 e arm lengths each
+                 way) scale with the exaggeration e, the same scale trainer/autolabel.py measures.
+                 Each frame is one depsgraph evaluation of the constrained rig, and the constraint's
+                 influence follows the raise, so the clip starts and ends in the neutral pose.
+
+Both start from and return to `neutral` (15, 3), the pose the training clips start in.
+"""
+import numpy as np
+
+from rlanimate_addon.core import metrics, rotations, skeleton, spaces
+from rlanimate_addon.core.errors import RLAnimateError
+from rlanimate_addon.core.gesture import slerp
+
+from . import autolabel, bpy_support
+
+FPS = 30.0
+#: Where the IK target sits along the requested pointing direction, metres from the rest shoulder.
+POINT_TARGET_DISTANCE = 2.5
+#: Pointing timing as fractions of the clip: stroke from..to, hold until, return until.
+POINT_TIMING = (0.12, 0.38, 0.72, 0.92)
+#: Waving timing: raise from..to, lower from..to, as fractions of the clip; swing frequency in Hz.
+WAVE_TIMING = (0.08, 0.3, 0.72, 0.94)
+WAVE_FREQUENCY = 2.5
+#: Wave shape: elevation of shoulder->hand from hanging (degrees) and side-to-side swing (arm lengths).
+WAVE_ELEVATION = (70.0, 90.0)  # at e = 0, added at e = 1
+WAVE_SWING = (0.05, 0.35)
+WAVE_REACH = 0.8  # shoulder->hand distance at the raise, in arm lengths (the elbow stays bent)
+
+
+def neutral_pose(clips):
+    """(15, 3) start pose: the mean first frame of `clips` (they all start standing neutrally)."""
+    if not clips:
+        raise RLAnimateError("No training clips: a baseline needs at least one clip to start from.")
+    quats = rotations.rotvec_to_quat(np.stack([np.asarray(c.rotvecs[0]) for c in clips]))  # (C, 15, 4)
+    quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
+    mean = quats.mean(axis=0)
+    return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
+
+
+def time_warp(rotvecs, frame_count):
+    """(M, 15, 3) -> (frame_count, 15, 3), uniform time scaling with per-joint slerp, ends kept."""
+    quats = rotations.rotvec_to_quat(np.asarray(rotvecs, dtype=np.float64))  # (M, 15, 4)
+    position = np.linspace(0.0, len(quats) - 1, int(frame_count))
+    low = np.floor(position).astype(int)
+    high = np.minimum(low + 1, len(quats) - 1)
+    weight = np.broadcast_to((position - low)[:, None], (len(position), quats.shape[1]))
+    return rotations.quat_to_rotvec(slerp(quats[low], quats[high], weight))
+
+
+def _blend(start, end, weights):
+    """Per-joint slerp from pose `start` (15, 3) to pose(s) `end` ((15, 3) or (F, 15, 3)) by (F,) weights."""
+    end = np.broadcast_to(end, (len(weights),) + np.shape(start))
+    q0 = np.broadcast_to(rotations.rotvec_to_quat(start), end.shape[:-1] + (4,))
+    w = np.broadcast_to(np.asarray(weights)[:, None], end.shape[:-1])
+    return rotations.quat_to_rotvec(slerp(q0, rotations.rotvec_to_quat(end), w))
+
+
+def minimum_jerk(s):
+    """Minimum-jerk progress 10s^3 - 15s^4 + 6s^5 of s clipped to [0, 1]: a bell-shaped speed."""
+    s = np.clip(s, 0.0, 1.0)
+    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
+
+
+def envelope(frame_count, rise_start, rise_end, fall_start, fall_end):
+    """(F,) 0 -> 1 -> 0 with minimum-jerk rise and fall; the arguments are fractions of the clip."""
+    s = np.linspace(0.0, 1.0, int(frame_count))
+    rise = minimum_jerk((s - rise_start) / (rise_end - rise_start))
+    fall = minimum_jerk((s - fall_start) / (fall_end - fall_start))
+    return rise * (1.0 - fall)
+
+
+def _check_request(behaviour, arm, frame_count):
+    if behaviour not in spaces.BEHAVIOURS:
+        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use POINT or WAVE.")
+    if arm not in skeleton.ARMS:
+        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
+    if int(frame_count) < 2:
+        raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}.")
+
+
+class NearestClip:
+    """Motion-matching retrieval over labelled training clips (MotionClip-like: behaviour, arm,
+    attributes, rotvecs)."""
+
+    def __init__(self, clips):
+        self.clips = list(clips)
+
+    def nearest(self, behaviour, arm, attributes):
+        """The training clip of `behaviour` and `arm` whose label is closest to `attributes`."""
+        candidates = [c for c in self.clips if c.behaviour.upper() == behaviour and c.arm.upper() == arm]
+        if not candidates:
+            raise RLAnimateError(f"No {behaviour.lower()} training clip uses the {arm.lower()} arm: "
+                                 "add one to the library to use the nearest-clip baseline.")
+        return min(candidates, key=lambda c: self.label_distance(behaviour, c.attributes, attributes))
+
+    @staticmethod
+    def label_distance(behaviour, a, b):
+        """Angle (rad) between pointing directions, or |difference| of exaggerations."""
+        if behaviour == "POINT":
+            a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+            cos = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
+            return float(np.arccos(np.clip(cos, -1.0, 1.0)))
+        return abs(float(np.ravel(a)[0]) - float(np.ravel(b)[0]))
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        _check_request(behaviour, arm, frame_count)
+        return time_warp(self.nearest(behaviour, arm, attributes).rotvecs, frame_count)
+
+
+class ProceduralIK:
+    """IK-constraint gestures on the sample rig, loaded into the current bpy session beside anything
+    already there (such as the FK environment's rigs)."""
+
+    def __init__(self, neutral, rig_path=bpy_support.SAMPLE_RIG_BLEND):
+        self.neutral = np.asarray(neutral, dtype=np.float64)  # (15, 3)
+        self._bpy = bpy_support.import_bpy()
+        self.rig = bpy_support.load_rig(rig_path)
+        self.rig.animation_data_clear()
+        self.rig.name = "RLAnimate_ProceduralIK"
+        self.target = self._bpy.data.objects.new("RLAnimate_ProceduralIK_target", None)
+        self._bpy.context.scene.collection.objects.link(self.target)
+        self._bpy.context.view_layer.update()
+        self.scale = float(np.mean(self.rig.matrix_world.to_scale()))  # object units -> metres
+        self._pose_bones = {skeleton.strip_prefix(b.name): b for b in self.rig.pose.bones}
+        bones = {skeleton.strip_prefix(b.name): b for b in self.rig.data.bones}
+        self._rest = {n: np.asarray(b.matrix_local, dtype=np.float64)[:3, :3] for n, b in bones.items()}
+        self._parent = {n: (skeleton.strip_prefix(b.parent.name) if b.parent else None) for n, b in bones.items()}
+        self._constraint = None
+
+    def _constrain(self, bone, chain_count):
+        if self._constraint is not None:
+            self._constraint[0].constraints.remove(self._constraint[1])
+        pose_bone = self._pose_bones[bone]
+        constraint = pose_bone.constraints.new("IK")
+        constraint.target = self.target
+        constraint.chain_count = chain_count
+        constraint.use_tail = True
+        constraint.use_stretch = False
+        self._constraint = (pose_bone, constraint)
+
+    def _set_pose(self, rotvecs):
+        for joint, rotvec in zip(skeleton.ACTION_JOINTS, rotvecs):
+            bone = self._pose_bones[joint]
+            bone.rotation_mode = "QUATERNION"
+            bone.rotation_quaternion = rotations.rotvec_to_quat(rotvec)
+
+    def _solve(self, target_position):
+        """(15, 3) local rotations of the constrained pose with the IK target at `target_position` (3,),
+        character frame in metres, starting from the neutral pose."""
+        world = np.asarray(self.rig.matrix_world, dtype=np.float64) @ np.append(np.asarray(target_position) / self.scale, 1.0)
+        self.target.location = world[:3]
+        self._bpy.context.view_layer.update()
+        pose = {n: np.asarray(b.matrix, dtype=np.float64)[:3, :3] for n, b in self._pose_bones.items()}
+        local = []
+        for joint in skeleton.ACTION_JOINTS:
+            parent = self._parent[joint]
+            bind = pose[parent] @ self._rest[parent].T @ self._rest[joint]
+            local.append(rotations.matrix_to_rotvec(bind.T @ pose[joint]))
+        return np.stack(local)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        _check_request(behaviour, arm, frame_count)
+        self._set_pose(self.neutral)
+        side = skeleton.ARM_PREFIX[arm]
+        if behaviour == "POINT":
+            direction = np.asarray(attributes, dtype=np.float64)
+            direction = direction / np.linalg.norm(direction)
+            self._constrain(side + "HandIndex1", 4)
+            solved = self._solve(skeleton.shoulder_rest_position(arm) + POINT_TARGET_DISTANCE * direction)
+            return _blend(self.neutral, solved, envelope(frame_count, *POINT_TIMING))
+        exaggeration = float(np.ravel(attributes)[0])
+        self._constrain(side + "Hand", 3)
+        solved = np.stack([self._solve(p) for p in self.wave_targets(arm, exaggeration, frame_count)])
+        return _blend(self.neutral, solved, envelope(frame_count, *WAVE_TIMING))
+
+    def wave_targets(self, arm, exaggeration, frame_count):
+        """(F, 3) hand targets of a wave, character frame in metres."""
+        side = skeleton.ARM_PREFIX[arm]
+        sign = 1.0 if arm == "LEFT" else -1.0
+        shoulder = skeleton.shoulder_rest_position(arm)
+        length = autolabel.arm_length(side)
+        raised = envelope(frame_count, *WAVE_TIMING)  # (F,)
+        hang = shoulder + np.array([0.05 * sign, -0.05, -0.9 * length])
+        elevation = np.radians(WAVE_ELEVATION[0] + WAVE_ELEVATION[1] * exaggeration)
+        up = shoulder + WAVE_REACH * length * np.array([sign * np.sin(elevation) * 0.7,
+                                                        -np.sin(elevation) * 0.7, -np.cos(elevation)])
+        t = np.arange(frame_count) / FPS
+        swing = (WAVE_SWING[0] + WAVE_SWING[1] * exaggeration) * length * np.sin(2 * np.pi * WAVE_FREQUENCY * t)
+        positions = hang + raised[:, None] * (up - hang)  # (F, 3)
+        positions[:, 0] += raised**2 * swing  # side to side, only once the arm is up
+        return positions
+
+
+def evaluate_motions(env, motions, clips, references):
+    """{'score', 'smoothness', 'clips': [{name, behaviour, score, smoothness}]} of generated
+    (F_i, 15, 3) `motions` against `clips` (references: algorithm.ClipReferences), as evaluate.evaluate_clips."""
+    ends = np.cumsum([len(m) for m in motions])[:-1]
+    positions = np.split(np.asarray(env.evaluate(np.concatenate(motions)).joint_positions), ends)
+    rows = []
+    for clip, generated in zip(clips, positions):
+        _, reference = references.get(clip)
+        rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
+                     "score": float(metrics.score(generated, reference)),
+                     "smoothness": float(metrics.smoothness(generated))})
+    return {"score": float(np.mean([r["score"] for r in rows])),
+            "smoothness": float(np.mean([r["smoothness"] for r in rows])), "clips": rows}
+
+
+def generate_for(baseline, clips):
+    """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
+    return [baseline.generate(c.behaviour.upper(), c.arm.upper(), c.attributes, len(c.rotvecs)) for c in clips]
