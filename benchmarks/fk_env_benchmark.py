@@ -31,29 +31,35 @@ HEADING = "## FK environment"
 BENCHMARKS_MD = bpy_support.REPO_ROOT / "docs" / "BENCHMARKS.md"
 
 
-def best_seconds(run):
-    """Fastest of REPEATS timed calls of `run()`, after one warm-up call."""
+LOAD_AT_START = os.getloadavg()[0]
+
+
+def timed(run):
+    """Seconds of one call of `run()`."""
+    start = time.perf_counter()
     run()
-    times = []
-    for _ in range(REPEATS):
-        start = time.perf_counter()
-        run()
-        times.append(time.perf_counter() - start)
-    return min(times)
+    return time.perf_counter() - start
 
 
 def measure():
-    """[(label, instances, seconds for POSES poses)] for every instance count, plus numpy FK."""
+    """[(label, instances, seconds for POSES poses)] for every instance count, plus numpy FK.
+
+    The counts are measured in turns, REPEATS rounds, each in a fresh scene after a warm-up call, and
+    the fastest round is kept: a burst of load from other jobs then hits every count alike.
+    """
     actions = np.random.default_rng(0).uniform(0.0, 1.0, (POSES, spaces.ACTION_SIZE))
-    rows = []
-    for instances in INSTANCE_COUNTS:
-        bpy_support.new_empty_scene()
-        env = FKEnvironment(instances=instances)
-        seconds = best_seconds(lambda: env.describe_actions(actions))
-        rows.append(("bpy FKEnvironment.describe_actions", instances, seconds))
+    best = {instances: float("inf") for instances in INSTANCE_COUNTS}
+    for _ in range(REPEATS):
+        for instances in INSTANCE_COUNTS:
+            bpy_support.new_empty_scene()
+            env = FKEnvironment(instances=instances)
+            env.describe_actions(actions[:instances])
+            best[instances] = min(best[instances], timed(lambda: env.describe_actions(actions)))
+    rows = [("bpy FKEnvironment.describe_actions", instances, best[instances]) for instances in INSTANCE_COUNTS]
     rotvecs = spaces.decode_action(actions)
     local = {joint: rotvecs[:, i] for i, joint in enumerate(skeleton.ACTION_JOINTS)}
-    rows.append(("numpy core.kinematics (reference)", "-", best_seconds(lambda: kinematics.pose_matrices(local))))
+    numpy_seconds = min(timed(lambda: kinematics.pose_matrices(local)) for _ in range(REPEATS))
+    rows.append(("numpy core.kinematics (reference)", "-", numpy_seconds))
     return rows
 
 
@@ -65,11 +71,12 @@ def section(rows):
     lines = [
         HEADING, "",
         f"Poses per second of `trainer/fk_env.py` on the sample rig ({len(skeleton.BONES)} bones): {POSES} random",
-        f"actions decoded and evaluated per call (best of {REPEATS} after a warm-up), each batch of",
+        f"actions decoded and evaluated per call (fastest of {REPEATS} interleaved rounds), each batch of",
         "`instances` poses in one depsgraph update. Pinned to one CPU core.", "",
         f"Regenerate: `{COMMAND}`", "",
         f"Machine: {platform.machine()}, 2 CPU cores shared with other jobs, Python {platform.python_version()}, "
-        f"bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {date}.", "",
+        f"bpy {bpy.app.version_string}, numpy {np.__version__}, load average {LOAD_AT_START:.1f} at start. "
+        f"Date: {date}.", "",
         "| method | instances | poses/s | ms per pose |",
         "|---|---:|---:|---:|",
     ]
@@ -80,7 +87,8 @@ def section(rows):
         "", f"Fastest in this run: {instances} instances, {POSES / seconds:,.0f} poses/s. On one core, batching",
         "saves little: the evaluation of each armature object dominates, and every depsgraph update also",
         "pays a per-object cost for all instances in the scene, so many instances are slower per pose.",
-        "`FKEnvironment` defaults to 8 instances. Timings vary by about 30% with the load of the shared machine.",
+        "`FKEnvironment` defaults to 8 instances. Absolute timings vary twofold with the load of the shared",
+        "machine (the load average is recorded above); compare instance counts within one run.",
     ]
     return "\n".join(lines) + "\n"
 
