@@ -78,7 +78,7 @@ def _world_point(target, scene):
 
 
 def _to_armature(obj, point):
-    return (np.linalg.inv(np.array(obj.matrix_world, dtype=np.float64)) @ np.append(point, 1.0))[:3]
+    return (np.array(obj.matrix_world.inverted(), dtype=np.float64) @ np.append(point, 1.0))[:3]
 
 
 def target_positions(scene, obj, target, frames):

@@ -130,12 +130,15 @@ def run_agent(agent, behaviour, objectives, seed=None):
     return spaces.decode_action(resample(actions, count), np.asarray(agent.action_bounds))
 
 
+_CANONICAL_FRAMES = {bone.name: skeleton.rest_frame(bone) for bone in skeleton.BONES}
+
+
 def retarget_matrices(canonical_bones, rig_rest_frames, to_character):
     """(B, 3, 3) C = F_can^-1 A F_rig for each named canonical bone.
 
     rig_rest_frames: (B, 3, 3) armature-space rest rotations of the rig's bones (columns: local axes).
     """
-    canonical = np.stack([skeleton.rest_frame(skeleton.BONE_BY_NAME[name]) for name in canonical_bones])
+    canonical = np.stack([_CANONICAL_FRAMES[name] for name in canonical_bones])
     return np.swapaxes(canonical, -1, -2) @ to_character @ np.asarray(rig_rest_frames, dtype=np.float64)
 
 
@@ -189,11 +192,10 @@ def continuous(quats):
     Keys are interpolated channel by channel; without this a sign flip between two frames would
     swing the bone the long way round.
     """
-    q = np.array(quats, dtype=np.float64)
-    for t in range(1, len(q)):
-        flip = np.sum(q[t] * q[t - 1], axis=-1) < 0.0
-        q[t, flip] *= -1.0
-    return q
+    q = np.asarray(quats, dtype=np.float64)
+    steps = np.where(np.sum(q[1:] * q[:-1], axis=-1) < 0.0, -1.0, 1.0)  # (N-1, B)
+    signs = np.concatenate([np.ones((1,) + q.shape[1:-1]), np.cumprod(steps, axis=0)])  # (N, B)
+    return q * signs[..., None]
 
 
 def pointing_hand_rotations(arm, count):

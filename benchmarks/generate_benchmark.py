@@ -1,0 +1,160 @@
+"""Generate Gesture speed: 120 frames on the sample rig, bake included, against Blender's own playback.
+
+Times `bpy.ops.rlanimate.generate_gesture()` (the whole operator: reading the rig and target, the
+numpy agent, retargeting, blending and the bulk F-curve writes), its numpy part alone, and
+`scene.frame_set` on each of the same 120 frames of the baked gesture (the sample rig with its
+skinned mesh), and writes the section "Generate Gesture" of docs/BENCHMARKS.md (replacing only that
+section, appending it when absent).
+
+Run: `nice -n 10 python benchmarks/generate_benchmark.py [--repeats N] [--no-write]`
+"""
+import argparse
+import os
+import platform
+import statistics
+import sys
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import bpy  # noqa: E402
+import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
+import numpy as np  # noqa: E402
+
+from rlanimate_addon.blender import armature_io, preferences  # noqa: E402
+from rlanimate_addon.core import gesture  # noqa: E402
+
+FRAMES = 120
+SECTION = "## Generate Gesture"
+REPORT = ROOT / "docs" / "BENCHMARKS.md"
+
+
+def fresh_scene():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    addon_utils.enable("rlanimate_addon", default_set=True)
+    with bpy.data.libraries.load(str(ROOT / "sample_rigs" / "character.blend"), link=False) as (source, target):
+        target.objects = list(source.objects)
+    for obj in target.objects:
+        bpy.context.scene.collection.objects.link(obj)
+    rig = bpy.data.objects["RLAnimate_Character"]
+    bpy.context.view_layer.objects.active = rig
+    target = bpy.data.objects.new("Target", None)
+    target.location = (-1.2, -2.5, 1.7)
+    bpy.context.scene.collection.objects.link(target)
+    settings = bpy.context.scene.rlanimate
+    settings.target, settings.frame_count, settings.start_frame, settings.arm = target, FRAMES, 1, "RIGHT"
+    return rig, settings
+
+
+def clear_animation(rig):
+    data = rig.animation_data
+    for action in {data.action} | {s.action for t in data.nla_tracks for s in t.strips}:
+        if action is not None:
+            bpy.data.actions.remove(action)
+    rig.animation_data_clear()
+
+
+def time_operator(rig, behaviour, repeats):
+    """Seconds per Generate Gesture call on an unanimated rig (each run starts from the same state)."""
+    bpy.context.scene.rlanimate.behaviour = behaviour
+    times = []
+    for _ in range(repeats + 1):  # the first run loads the agent file: a warm-up
+        start = time.perf_counter()
+        assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
+        times.append(time.perf_counter() - start)
+        clear_animation(rig)
+    return times[1:]
+
+
+def time_numpy_part(rig, repeats):
+    """Seconds for the bpy-free part alone: objectives, agent rollout, retarget and blend."""
+    agent = preferences.selected_agent(bpy.context)
+    names = armature_io.check_rig(rig)
+    rig_pose = armature_io.read_rig_pose(rig, names)
+    targets = np.tile([-1.2, -2.5, 1.7], (FRAMES, 1))
+    request = gesture.GestureRequest("POINT", "RIGHT", FRAMES, targets=targets)
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        gesture.gesture_rotations(agent, request, rig_pose)
+        times.append(time.perf_counter() - start)
+    return times
+
+
+def time_playback(rig, repeats):
+    """Seconds for scene.frame_set on each of the 120 baked frames (Blender's own evaluation)."""
+    bpy.context.scene.rlanimate.behaviour = "POINT"
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
+    scene = bpy.context.scene
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for frame in range(1, FRAMES + 1):
+            scene.frame_set(frame)
+        times.append(time.perf_counter() - start)
+    return times
+
+
+def ms(values):
+    return f"{1000 * statistics.median(values):.1f} (best {1000 * min(values):.1f})"
+
+
+def write_section(text):
+    report = REPORT.read_text() if REPORT.exists() else "# Benchmarks\n"
+    if SECTION in report:
+        head, rest = report.split(SECTION, 1)
+        tail = rest[rest.find("\n## "):] if "\n## " in rest else ""
+        report = head + text + tail
+    else:
+        report = report.rstrip("\n") + "\n\n" + text
+    REPORT.write_text(report.rstrip("\n") + "\n")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--no-write", action="store_true", help="print the section only")
+    args = parser.parse_args()
+    if hasattr(os, "sched_setaffinity"):
+        os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+
+    rig, _ = fresh_scene()
+    point = time_operator(rig, "POINT", args.repeats)
+    wave = time_operator(rig, "WAVE", args.repeats)
+    numpy_part = time_numpy_part(rig, args.repeats)
+    playback = time_playback(rig, args.repeats)
+    ratio = statistics.median(point) / statistics.median(playback)
+    agent = preferences.selected_agent(bpy.context)
+    trained = "untrained" if agent.metadata.get("training", {}).get("untrained") else "trained"
+
+    text = f"""{SECTION}
+
+Generate Gesture for {FRAMES} frames on the sample rig (armature and skinned mesh), bake included,
+against Blender's own playback evaluation of the same {FRAMES} frames (`scene.frame_set` per frame).
+Median of {args.repeats} runs after a warm-up, milliseconds, pinned to one CPU core; agent: the bundled
+default ({trained}).
+
+Regenerate: `nice -n 10 python benchmarks/generate_benchmark.py`
+
+Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python {platform.python_version()},
+bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
+
+| what | ms for {FRAMES} frames |
+|---|---:|
+| Generate Gesture, Point (operator, bake included) | {ms(point)} |
+| Generate Gesture, Wave (operator, bake included) | {ms(wave)} |
+| of which the numpy part (objectives, agent, retarget, blend) | {ms(numpy_part)} |
+| `scene.frame_set` x {FRAMES} (Blender's playback evaluation) | {ms(playback)} |
+
+Generate / playback ratio (Point): {ratio:.2f}. Budget: under 100 ms; aim: ratio below 1.
+"""
+    print(text)
+    if not args.no_write:
+        write_section(text)
+
+
+if __name__ == "__main__":
+    main()
