@@ -80,8 +80,11 @@ def load_rig(path=SAMPLE_RIG_BLEND, with_mesh=False):
                              "or choose another file.")
     before = set(bpy.data.objects)
     if path.suffix.lower() == ".blend":
-        with bpy.data.libraries.load(str(path), link=False) as (source, target):
-            target.objects = [name for name in source.objects]
+        try:
+            with bpy.data.libraries.load(str(path), link=False) as (source, target):
+                target.objects = list(source.objects)
+        except OSError as error:
+            raise RLAnimateError(f"Could not read {path}: {error}. Choose a .blend saved by Blender.") from error
         loaded = [o for o in target.objects if o is not None]
         if not with_mesh:
             for obj in [o for o in loaded if o.type != "ARMATURE"]:
