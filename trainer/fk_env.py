@@ -38,6 +38,7 @@ class FKEnvironment:
         self._bpy = bpy_support.import_bpy()
         self.rig = bpy_support.load_rig(rig_path)
         self.rig.animation_data_clear()  # an action would override the poses we write
+        _reset_pose(self.rig)
         self._bpy.context.view_layer.update()  # matrix_world is stale until the depsgraph runs
         self.scale = float(np.mean(self.rig.matrix_world.to_scale()))  # object units -> metres
         rig_names = [skeleton.strip_prefix(b.name) for b in self.rig.data.bones]
@@ -50,8 +51,9 @@ class FKEnvironment:
         self._pose_index = {name: k for k, name in enumerate(pose_names)}  # pose bones are in hierarchy order
         self._pose_to_bone = np.array([self._bone_index[name] for name in pose_names])
         self._action_slots = np.array([self._pose_index[j] for j in skeleton.ACTION_JOINTS])
+        self._collection = self._bpy.data.collections.new(_COLLECTION_NAME)
+        self._bpy.context.scene.collection.children.link(self._collection)
         self.objects = [self.rig] + [self._instance(k) for k in range(1, int(instances))]
-        self._quats = np.zeros((len(pose_names), 4), dtype=np.float32)  # (B, 4) pose-bone order
         self._matrices = np.zeros(len(pose_names) * 16, dtype=np.float32)
 
     @property
@@ -59,14 +61,9 @@ class FKEnvironment:
         return len(self.objects)
 
     def _instance(self, k):
-        bpy = self._bpy
-        collection = bpy.data.collections.get(_COLLECTION_NAME)
-        if collection is None:
-            collection = bpy.data.collections.new(_COLLECTION_NAME)
-            bpy.context.scene.collection.children.link(collection)
         obj = self.rig.copy()  # shares the armature data; the pose is per object
         obj.name = f"{self.rig.name}_fk{k:03d}"
-        collection.objects.link(obj)
+        self._collection.objects.link(obj)
         return obj
 
     def evaluate(self, action_rotvecs, extra_rotvecs=None):
@@ -129,3 +126,13 @@ class FKEnvironment:
                 raise RLAnimateError(f"Rotations of {name!r} contain NaN or infinity.")
             rotvecs[:, self._pose_index[bone]] = values
         return rotvecs
+
+
+def _reset_pose(rig):
+    """Quaternion rotation mode and rest location and scale on every pose bone, so that only the
+    quaternions evaluate() writes move the rig."""
+    bones = rig.pose.bones
+    for bone in bones:
+        bone.rotation_mode = "QUATERNION"
+    bones.foreach_set("location", np.zeros(3 * len(bones), dtype=np.float32))
+    bones.foreach_set("scale", np.ones(3 * len(bones), dtype=np.float32))

@@ -80,15 +80,36 @@ def test_describe_actions_decodes_with_the_bounds(env):
     assert np.allclose(centred.joint_positions[0], rest.joint_positions[0], atol=1e-6)
 
 
-def test_positions_are_in_metres_whatever_the_object_scale(tmp_path):
+def _modified_rig(tmp_path, change):
+    """Path of a copy of the sample rig saved after `change(rig)`."""
     bpy_support.new_empty_scene()
     rig = bpy_support.load_rig()
-    rig.scale = (0.5, 0.5, 0.5)
-    scaled_path = tmp_path / "half.blend"
-    bpy.data.libraries.write(str(scaled_path), {rig})
+    change(rig)
+    path = tmp_path / "modified.blend"
+    bpy.data.libraries.write(str(path), {rig})
     bpy_support.new_empty_scene()
-    result = FKEnvironment(scaled_path, instances=1).evaluate(np.zeros((1, JOINTS, 3)))
+    return path
+
+
+def test_positions_are_in_metres_whatever_the_object_scale(tmp_path):
+    def halve(rig):
+        rig.scale = (0.5, 0.5, 0.5)
+
+    result = FKEnvironment(_modified_rig(tmp_path, halve), instances=1).evaluate(np.zeros((1, JOINTS, 3)))
     assert np.allclose(result.joint_positions[0, 6], 0.5 * _head("LeftHand"), atol=1e-6)
+
+
+def test_euler_bones_and_a_posed_rig_are_driven_from_rest(tmp_path):
+    def pose_with_eulers(rig):
+        for bone in rig.pose.bones:
+            bone.rotation_mode = "XYZ"
+            bone.rotation_euler = (0.3, 0.2, 0.1)
+        rig.pose.bones[skeleton.PREFIX + "Hips"].location = (0.1, 0.2, 0.3)
+        rig.pose.bones[skeleton.PREFIX + "LeftArm"].scale = (2.0, 2.0, 2.0)
+
+    actions = np.random.default_rng(4).uniform(-1, 1, (3, JOINTS, 3))
+    result = FKEnvironment(_modified_rig(tmp_path, pose_with_eulers), instances=2).evaluate(actions)
+    assert np.abs(result.bone_heads - _numpy_heads(actions)).max() < 1e-5
 
 
 def test_fbx_rig_gives_the_same_results_as_the_blend():
