@@ -271,11 +271,21 @@ def _read_armature(bpy, obj, bone_map, path):
 def _retarget(canonical, frames, calibration_frames, calibration_heads, bone_map):
     """(rotvecs (F, 15, 3), fingers {bone: (F, 3)}) from the source's world motion (_read_armature)."""
     index = {name: i for i, name in enumerate(canonical)}
-    facing = retarget.character_frame(*(calibration_heads[index[name]] for name in
-                                        ("Hips" if "Hips" in index else "Spine", "Head", "LeftArm", "RightArm")))
+    source_calibration = {name: calibration_frames[i] for name, i in index.items()}
+    if (bone_map.calibration == "rest" and "Hips" in index
+            and retarget.carries_canonical_axes(source_calibration, {n: calibration_heads[i] for n, i in index.items()})):
+        # The bones carry the canonical axes (a rig built from core.skeleton, like the sample
+        # character): their world frames are canonical frames whatever the file's rest, and the hips
+        # give the facing. That matters because an FBX without a skinned mesh has no bind pose, and
+        # Blender's importer then takes the pose at export time as the rest, which need not be a T-pose.
+        facing = retarget.canonical_rest_frame("Hips") @ source_calibration["Hips"].T
+        calibration = {name: retarget.canonical_rest_frame(name) for name in index}
+    else:
+        facing = retarget.character_frame(*(calibration_heads[index[name]] for name in
+                                            ("Hips" if "Hips" in index else "Spine", "Head", "LeftArm", "RightArm")))
+        calibration = {name: facing @ frame for name, frame in source_calibration.items()}
     bases = retarget.local_rotations({name: facing @ frames[:, i] for name, i in index.items()},
-                                     {name: facing @ calibration_frames[i] for name, i in index.items()},
-                                     bone_map.shared_bend)
+                                     calibration, bone_map.shared_bend)
     fingers = {name: rotations.matrix_to_rotvec(bases[name]) for name in _FINGER_BONES if name in index}
     return retarget.action_rotvecs(bases), fingers
 

@@ -27,6 +27,11 @@ from rlanimate_addon.core import rotations, skeleton
 _REST = {bone.name: skeleton.rest_frame(bone) for bone in skeleton.BONES}
 
 
+def canonical_rest_frame(name):
+    """(3, 3) the canonical bone's rest frame in the character frame (columns X, Y, Z)."""
+    return _REST[name]
+
+
 def swing(from_dir, to_dir):
     """(3, 3) shortest rotation taking unit vector `from_dir` to unit vector `to_dir`."""
     a = np.asarray(from_dir, dtype=np.float64)
@@ -56,6 +61,30 @@ def character_frame(hips, head, left_shoulder, right_shoulder):
     across = stand @ (np.asarray(left_shoulder, dtype=np.float64) - np.asarray(right_shoulder, dtype=np.float64))
     yaw = np.arctan2(across[1], across[0])
     return rotations.rotvec_to_matrix(np.array([0.0, 0.0, -yaw])) @ stand
+
+
+def carries_canonical_axes(frames, heads, tolerance_degrees=3.0):
+    """True when a source's bones have the canonical local axes, whatever pose `frames` shows.
+
+    frames: {canonical bone: (3, 3)}, heads: {canonical bone: (3,)} of the source in one pose. Each
+    child's offset from its parent, seen in the parent's own axes, is fixed by the rig; a branch off
+    the bone's line (shoulders off the chest, eyes off the head, fingers off the hand) reveals the
+    bone's roll. Needs at least one such branch to say yes.
+    """
+    branches = 0
+    for bone in skeleton.BONES:
+        parent = bone.parent
+        if parent not in frames or bone.name not in frames:
+            continue
+        canonical = _REST[parent].T @ np.subtract(bone.head, skeleton.BONE_BY_NAME[parent].head)
+        source = frames[parent].T @ (np.asarray(heads[bone.name]) - np.asarray(heads[parent]))
+        if np.linalg.norm(canonical) < 1e-6 or np.linalg.norm(source) < 1e-9:
+            continue
+        canonical, source = canonical / np.linalg.norm(canonical), source / np.linalg.norm(source)
+        if np.degrees(np.arccos(np.clip(np.dot(canonical, source), -1.0, 1.0))) > tolerance_degrees:
+            return False
+        branches += abs(canonical[1]) < 0.99  # off the parent's Y axis
+    return branches > 0
 
 
 def twist_offsets(calibration_frames):

@@ -149,3 +149,14 @@ def test_retargeting_a_real_bandai_namco_wave_keeps_world_bone_directions():
     # The waving arm really moves: the test is not passing on a still pose.
     wrist = heads["Hand_R"] - heads["UpperArm_R"]
     assert np.ptp(wrist[:, 1]) > 20.0  # centimetres of vertical hand travel
+
+
+def test_canonical_axes_are_recognised_in_any_pose_and_other_rolls_are_not():
+    rng = np.random.default_rng(5)
+    local = random_local_rotations(rng, 1, scale=0.6)
+    frames = {name: f[0] for name, f in world_frames(local).items()}
+    pose = kinematics.pose_matrices(local)[0]
+    heads = {name: pose[kinematics.bone_index(name), :3, 3] for name in skeleton.BONE_NAMES}
+    assert retarget.carries_canonical_axes(frames, heads)
+    rolled = dict(frames, Spine2=frames["Spine2"] @ rotations.rotvec_to_matrix((0.0, 0.3, 0.0)))
+    assert not retarget.carries_canonical_axes(rolled, heads)
