@@ -5,8 +5,8 @@ units, another armature-space orientation and other bone rolls, as a Mixamo FBX 
 """
 from pathlib import Path
 
-import addon_utils  # Blender's own module, importable once bpy is
 import bpy
+import addon_utils  # noqa: I001  (Blender's own module, importable once bpy is)
 import numpy as np
 
 from rlanimate_addon.core import skeleton
@@ -118,3 +118,16 @@ def bone_heads(rig, bones, frames):
 def rig_bone(rig, canonical):
     """The rig's bone name for a canonical bone name."""
     return next(b.name for b in rig.data.bones if skeleton.strip_prefix(b.name) == canonical)
+
+
+def stand_neutral(rig, hang=1.3):
+    """Pose both arms hanging `hang` radians down from the T-pose, as the clips start: the start pose."""
+    from rlanimate_addon.core.rotations import matrix_to_quat, rotvec_to_matrix
+
+    for side, sign in (("Left", 1.0), ("Right", -1.0)):
+        bone = rig.data.bones[rig_bone(rig, side + "Arm")]
+        to_character = np.array(rig.matrix_world.to_3x3().normalized(), dtype=np.float64)
+        rest = to_character @ np.array(bone.matrix_local.to_3x3(), dtype=np.float64)  # world rest frame
+        down = rotvec_to_matrix(np.array([0.0, sign * hang, 0.0]))  # about the world's Y axis
+        local = rest.T @ down @ rest
+        rig.pose.bones[bone.name].rotation_quaternion = matrix_to_quat(local)

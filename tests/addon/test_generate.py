@@ -39,13 +39,14 @@ def finger_angles(rig, arm, target, frames):
 
 
 def apex(base_positions):
-    """Index of the frame where the finger base is farthest from where it started."""
+    """Index of the frame where the finger base is farthest from where it started (arms hanging)."""
     return int(np.argmax(np.linalg.norm(base_positions - base_positions[0], axis=1)))
 
 
 @pytest.mark.parametrize("arm", ["LEFT", "RIGHT"])
 def test_point_aims_the_index_finger_at_unseen_targets_and_returns(settings, arm):
     rig = helpers.load_sample_rig()
+    helpers.stand_neutral(rig)
     for k in range(2):
         location = random_target(arm)
         target = helpers.add_empty(f"Target{k}", location)
@@ -63,6 +64,7 @@ def test_point_aims_the_index_finger_at_unseen_targets_and_returns(settings, arm
 @pytest.mark.parametrize("arm", ["LEFT", "RIGHT"])
 def test_a_bigger_exaggeration_gives_a_wider_and_higher_wave(settings, arm):
     rig = helpers.load_sample_rig()
+    helpers.stand_neutral(rig)
     hand = helpers.rig_bone(rig, skeleton.ARM_PREFIX[arm] + "Hand")
     sizes = []
     for k, exaggeration in enumerate((0.1, 0.9)):
