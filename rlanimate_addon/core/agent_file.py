@@ -92,16 +92,20 @@ def load_agent_file(path):
 
 def _read_arrays(path):
     try:
-        with np.load(path, allow_pickle=False) as archive:
+        archive = np.load(path, allow_pickle=False)
+        if not hasattr(archive, "files"):  # a bare .npy array, not an archive
+            raise _not_an_agent(path)
+        with archive:
             return {name: archive[name] for name in archive.files}
     except ValueError as error:
-        if "allow_pickle" in str(error):
+        if "Object arrays cannot be loaded" in str(error):
             raise RLAnimateError(f"The agent file {path} carries a pickled Python object, which is refused "
                                  f"because loading it could run code: use an agent exported by "
                                  f"trainer/export.py.") from error
+        if "pickled data" in str(error):  # neither .npz nor .npy: numpy would have to unpickle it
+            raise RLAnimateError(f"{path} is not an RLAnimate agent file (not a numpy archive; pickled "
+                                 f"data is refused): choose a .npz written by trainer/export.py.") from error
         raise _damaged(path, error) from error
-    except AttributeError as error:  # np.load returned a bare array: a .npy, not an archive
-        raise _not_an_agent(path) from error
     except (OSError, EOFError, zipfile.BadZipFile, KeyError) as error:
         raise _damaged(path, error) from error
 

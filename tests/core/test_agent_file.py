@@ -1,0 +1,173 @@
+"""The agent-file loader: a real exported file loads; every kind of bad file gets its own clear error."""
+import json
+import pickle
+
+import numpy as np
+import pytest
+import torch
+
+from rlanimate_addon.core import agent_file
+from rlanimate_addon.core.agent_file import load_agent_file
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.config import load_preset
+from trainer.export import export_agent
+from trainer.models import RLAnimateAgent
+
+torch.set_num_threads(1)
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    path = tmp_path_factory.mktemp("agent") / "agent.npz"
+    torch.manual_seed(0)
+    export_agent(RLAnimateAgent(load_preset("debug")[0]), path)
+    return path
+
+
+def rewrite(path, weights, metadata, **extra):
+    np.savez(path, **weights, **{agent_file.METADATA_KEY: np.array(json.dumps(metadata))}, **extra)
+    return path
+
+
+def test_a_real_exported_file_loads(exported):
+    weights, metadata = load_agent_file(exported)
+    assert metadata["variant"] == "rlanimate"
+    assert set(weights) == set(agent_file.expected_weight_shapes(metadata["agent_config"], "rlanimate"))
+
+
+def test_missing_file(tmp_path):
+    with pytest.raises(RLAnimateError, match="No agent file"):
+        load_agent_file(tmp_path / "nowhere.npz")
+
+
+@pytest.mark.parametrize("fraction", [0.0, 0.1, 0.5, 0.99])
+def test_truncated_file(tmp_path, exported, fraction):
+    data = exported.read_bytes()
+    path = tmp_path / "truncated.npz"
+    path.write_bytes(data[:int(len(data) * fraction)])
+    with pytest.raises(RLAnimateError, match="truncated or damaged"):
+        load_agent_file(path)
+
+
+def test_flipped_bytes_inside_a_weight_array(tmp_path, exported):
+    data = bytearray(exported.read_bytes())
+    middle = len(data) // 2
+    data[middle:middle + 16] = bytes(255 - b for b in data[middle:middle + 16])
+    path = tmp_path / "flipped.npz"
+    path.write_bytes(bytes(data))
+    with pytest.raises(RLAnimateError, match="truncated or damaged"):
+        load_agent_file(path)
+
+
+def test_wrong_format_version(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    path = rewrite(tmp_path / "v99.npz", weights, {**metadata, "format_version": 99})
+    with pytest.raises(RLAnimateError, match="format version 99"):
+        load_agent_file(path)
+
+
+def test_wrong_array_shape(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    weights["animation.layers.0.weight"] = weights["animation.layers.0.weight"][:, :-1]
+    with pytest.raises(RLAnimateError, match=r"wrong shape animation\.layers\.0\.weight"):
+        load_agent_file(rewrite(tmp_path / "shape.npz", weights, metadata))
+
+
+def test_missing_array(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    del weights["behaviour_cell.weight_hh"]
+    with pytest.raises(RLAnimateError, match=r"missing behaviour_cell\.weight_hh"):
+        load_agent_file(rewrite(tmp_path / "missing.npz", weights, metadata))
+
+
+def test_config_that_does_not_match_the_arrays(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    metadata["agent_config"]["stochastic_size"] += 1
+    with pytest.raises(RLAnimateError, match="does not match its own config"):
+        load_agent_file(rewrite(tmp_path / "config.npz", weights, metadata))
+
+
+def test_pickled_object_array_is_refused(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    path = tmp_path / "pickled.npz"
+    rewrite(path, weights, metadata, payload=np.array([{"run": "code"}], dtype=object))
+    with pytest.raises(RLAnimateError, match="pickled"):
+        load_agent_file(path)
+
+
+def test_pickled_object_in_place_of_a_weight(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    weights["decoder.layers.0.bias"] = np.array([None] * len(weights["decoder.layers.0.bias"]), dtype=object)
+    with pytest.raises(RLAnimateError, match="pickled"):
+        load_agent_file(rewrite(tmp_path / "pickled_weight.npz", weights, metadata))
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_non_finite_weight(tmp_path, exported, bad):
+    weights, metadata = load_agent_file(exported)
+    weights["posterior.layers.1.weight"][0, 0] = bad
+    with pytest.raises(RLAnimateError, match=r"NaN or infinite values in posterior\.layers\.1\.weight"):
+        load_agent_file(rewrite(tmp_path / "nan.npz", weights, metadata))
+
+
+def test_integer_weights_are_refused(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    weights["prior.layers.0.bias"] = weights["prior.layers.0.bias"].astype(np.int64)
+    with pytest.raises(RLAnimateError, match="not floats"):
+        load_agent_file(rewrite(tmp_path / "int.npz", weights, metadata))
+
+
+def test_archive_without_metadata_is_not_an_agent(tmp_path):
+    path = tmp_path / "other.npz"
+    np.savez(path, x=np.zeros(3))
+    with pytest.raises(RLAnimateError, match="not an RLAnimate agent file"):
+        load_agent_file(path)
+
+
+def test_bare_npy_is_not_an_agent(tmp_path):
+    path = tmp_path / "array.npz"
+    with open(path, "wb") as handle:
+        np.save(handle, np.zeros(3))
+    with pytest.raises(RLAnimateError, match="not an RLAnimate agent file"):
+        load_agent_file(path)
+
+
+@pytest.mark.parametrize("content", [b"just some text, not an archive", pickle.dumps({"weights": [1, 2]})])
+def test_other_files_are_not_agents(tmp_path, content):
+    path = tmp_path / "other.npz"
+    path.write_bytes(content)
+    with pytest.raises(RLAnimateError, match="not an RLAnimate agent file"):
+        load_agent_file(path)
+
+
+def test_other_format_name_is_not_an_agent(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    with pytest.raises(RLAnimateError, match="not an RLAnimate agent file"):
+        load_agent_file(rewrite(tmp_path / "other.npz", weights, {**metadata, "format": "something-else"}))
+
+
+def test_damaged_metadata_text(tmp_path, exported):
+    weights, _ = load_agent_file(exported)
+    path = tmp_path / "text.npz"
+    np.savez(path, **weights, **{agent_file.METADATA_KEY: np.array('{"format": "rlanimate-agent", ')})
+    with pytest.raises(RLAnimateError, match="truncated or damaged"):
+        load_agent_file(path)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("action_bounds", [[0.0, 1.0]] * 44, "action_bounds"),
+    ("action_bounds", [[1.0, 0.0]] * 45, "action_bounds"),
+    ("average_frames", {"POINT": 90}, "average_frames"),
+    ("variant", "bigger", "Unknown agent variant"),
+])
+def test_invalid_metadata_values(tmp_path, exported, field, value, message):
+    weights, metadata = load_agent_file(exported)
+    with pytest.raises(RLAnimateError, match=message):
+        load_agent_file(rewrite(tmp_path / "meta.npz", weights, {**metadata, field: value}))
+
+
+def test_missing_metadata_field(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    del metadata["average_frames"]
+    with pytest.raises(RLAnimateError, match="lacks metadata average_frames"):
+        load_agent_file(rewrite(tmp_path / "meta.npz", weights, metadata))

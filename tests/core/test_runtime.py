@@ -1,0 +1,87 @@
+"""The numpy runtime reproduces the torch agent's deterministic rollout, for every variant."""
+import numpy as np
+import pytest
+import torch
+
+from rlanimate_addon.core import spaces
+from rlanimate_addon.core.runtime import GestureAgent, load_agent
+from trainer.config import load_preset
+from trainer.export import export_agent
+from trainer.models import VARIANTS, RLAnimateAgent
+
+torch.set_num_threads(1)
+
+
+def objectives_for_tests(frames=150):
+    point = spaces.make_objective("POINT", "LEFT", [0.4, -0.8, 0.3], frames)
+    wave = spaces.make_objective("WAVE", "RIGHT", 0.7, frames // 2)
+    return [point, wave]
+
+
+def exported_agent(tmp_path, preset, variant, weight_gain=2.0, seed=0):
+    """An agent with weights scaled up from their initialisation, so its dynamics are far from trivial."""
+    torch.manual_seed(seed)
+    agent = RLAnimateAgent(load_preset(preset)[0], variant)
+    with torch.no_grad():
+        for parameter in agent.parameters():
+            parameter.mul_(weight_gain)
+    path = tmp_path / f"{preset}_{variant}.npz"
+    export_agent(agent, path, {"average_frames": {"POINT": 80, "WAVE": 95}})
+    return agent, path
+
+
+def torch_rollout(agent, objectives):
+    return agent.rollout(torch.as_tensor(objectives, dtype=torch.float32)[None])[0].double().numpy()
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.parametrize("preset", ["debug", "default"])
+def test_deterministic_rollout_matches_torch(tmp_path, preset, variant):
+    agent, path = exported_agent(tmp_path, preset, variant)
+    runtime = load_agent(path)
+    for objectives in objectives_for_tests():
+        expected = torch_rollout(agent, objectives)
+        actions = runtime.rollout(objectives)
+        assert actions.shape == expected.shape
+        assert np.abs(actions - expected).max() < 1e-5
+        assert expected.std(axis=0).max() > 1e-3  # the actions do change over the gesture
+
+
+def test_rollout_is_a_pure_function_of_the_objectives(tmp_path):
+    _, path = exported_agent(tmp_path, "debug", "rlanimate")
+    runtime = load_agent(path)
+    objectives = objectives_for_tests()[0]
+    first = runtime.rollout(objectives)
+    runtime.rollout(objectives_for_tests()[1])
+    np.testing.assert_array_equal(runtime.rollout(objectives), first)
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_seeded_rollout_varies_reproducibly_within_the_action_range(tmp_path, variant):
+    _, path = exported_agent(tmp_path, "debug", variant)
+    runtime = load_agent(path)
+    objectives = objectives_for_tests()[0]
+    deterministic = runtime.rollout(objectives)
+    varied = runtime.rollout(objectives, seed=5)
+    np.testing.assert_array_equal(runtime.rollout(objectives, seed=5), varied)
+    assert np.all((varied >= 0.0) & (varied <= 1.0))
+    assert np.abs(varied - deterministic).max() > 1e-3
+    assert np.abs(runtime.rollout(objectives, seed=6) - varied).max() > 1e-3
+
+
+def test_metadata_accessors(tmp_path):
+    _, path = exported_agent(tmp_path, "debug", "rlanimate")
+    runtime = load_agent(path)
+    assert runtime.average_frames == {"POINT": 80.0, "WAVE": 95.0}
+    assert runtime.action_bounds.shape == (spaces.ACTION_SIZE, 2)
+    np.testing.assert_allclose(runtime.action_bounds, spaces.DEFAULT_ACTION_BOUNDS)
+    assert runtime.metadata["variant"] == "rlanimate"
+
+
+def test_shipped_default_agent_plays(tmp_path):
+    from pathlib import Path
+    runtime = load_agent(Path(__file__).resolve().parents[2] / "rlanimate_addon" / "agents" / "default.npz")
+    actions = runtime.rollout(spaces.make_objective("WAVE", "LEFT", 0.5, 40))
+    assert actions.shape == (40, spaces.ACTION_SIZE)
+    assert np.all(np.isfinite(actions)) and np.all((actions >= 0.0) & (actions <= 1.0))
+    assert isinstance(runtime, GestureAgent)
