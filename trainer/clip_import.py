@@ -234,25 +234,18 @@ def _frame_range(obj, path):
     return range(start, end + 1)
 
 
-def _read_armature(bpy, obj, bone_map, path):
-    """The mapped bones' world motion: (canonical names, frames (F, K, 3, 3), heads (F, K, 3),
+def _read_armature(bpy, obj, bone_map, frames):
+    """The mapped bones' world motion over `frames`: (canonical names, frames (F, K, 3, 3),
     calibration frames (K, 3, 3), calibration heads (K, 3)). A frame's Y axis is the bone's direction."""
     names = [b.name for b in obj.data.bones]
     matched = bone_maps.match_bones(names, bone_map)  # {canonical: source name}
     canonical = list(matched)
     order = [names.index(matched[c]) for c in canonical]
-    frames = _frame_range(obj, path)
     scene = bpy.context.scene
     pose = np.empty((len(frames), len(canonical), 4, 4))
     for k, frame in enumerate(frames):
         scene.frame_set(frame)
         pose[k] = _matrices(obj.pose.bones, "matrix")[order]
-    if not np.all(np.isfinite(pose)):
-        bad_frames, bad_bones = np.nonzero(~np.all(np.isfinite(pose), axis=(2, 3)))
-        bones = sorted({matched[canonical[b]] for b in bad_bones})
-        raise RLAnimateError(f"{path}: NaN values in the animation at frames "
-                             f"{sorted({int(frames[f]) for f in bad_frames})[:10]} (bones {', '.join(bones[:10])}). "
-                             "Fix or re-export the clip.")
     object_matrix = np.asarray(obj.matrix_world, dtype=np.float64)
     object_rotation = _orthonormal(object_matrix[:3, :3])
     rest = _matrices(obj.data.bones, "matrix_local")[order]  # (K, 4, 4) armature space
@@ -263,9 +256,8 @@ def _read_armature(bpy, obj, bone_map, path):
         heads = matrices[..., :3, 3] @ object_matrix[:3, :3].T + object_matrix[:3, 3]
         return object_rotation @ _orthonormal(matrices[..., :3, :3]) @ align, heads
 
-    frames_world, heads_world = world(pose)
     calibration_frames, calibration_heads = world(rest) if bone_map.calibration == "rest" else world(pose[0])
-    return canonical, frames_world, heads_world, calibration_frames, calibration_heads
+    return canonical, world(pose)[0], calibration_frames, calibration_heads
 
 
 def _retarget(canonical, frames, calibration_frames, calibration_heads, bone_map):
@@ -314,13 +306,13 @@ def _import_uncached(path, expected_fps, bone_map):
             raise RLAnimateError(f"{path}: the {chosen_map.name} armature {obj.name!r} lacks the bones "
                                  f"{', '.join(missing)}. Export a skeleton that has them, or add a bone "
                                  "map for this skeleton to rlanimate_addon/core/bone_maps.py.")
-        _frame_range(obj, path)  # no animation is the problem to report, whatever its frame rate
+        frames = _frame_range(obj, path)  # no animation is the problem to report, whatever the frame rate
         fps = _clip_fps(bpy.context.scene)
         if abs(fps - expected_fps) > 1e-3:
             raise RLAnimateError(f"{path}: the clip runs at {round(fps, 2):g} fps, but {expected_fps:g} fps is "
                                  f"expected. Re-export or resample it at {expected_fps:g} fps.")
-        canonical, frames, _, calibration_frames, calibration_heads = _read_armature(bpy, obj, chosen_map, path)
-    rotvecs, fingers = _retarget(canonical, frames, calibration_frames, calibration_heads, chosen_map)
+        motion = _read_armature(bpy, obj, chosen_map, frames)
+    rotvecs, fingers = _retarget(*motion, chosen_map)
     return MotionClip(name=path.stem, source=str(path), fps=float(fps), rotvecs=rotvecs, fingers=fingers)
 
 
