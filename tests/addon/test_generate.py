@@ -15,16 +15,19 @@ MAX_APEX_ANGLE_DEG = 5.0
 def random_target(arm, rng=RNG):
     """World position of an unseen target 1.5-4 m from the pointing shoulder, in the front hemisphere.
 
-    Azimuth runs from 70 degrees out to the arm's side to 30 degrees across the body; elevation from
-    -30 to +45 degrees.
+    Azimuth runs from 70 degrees out to the arm's side to 30 degrees across the body, elevation from
+    -25 to +45 degrees, and the target is at least 0.3 m above the floor.
     """
     side = 1.0 if arm == "LEFT" else -1.0
-    azimuth = math.radians(rng.uniform(-30.0, 70.0)) * side  # + is towards the arm's side
-    elevation = math.radians(rng.uniform(-30.0, 45.0))
-    distance = rng.uniform(1.5, 4.0)
-    direction = np.array([math.sin(azimuth) * math.cos(elevation), -math.cos(azimuth) * math.cos(elevation),
-                          math.sin(elevation)])
-    return skeleton.shoulder_rest_position(arm) + distance * direction
+    while True:
+        azimuth = math.radians(rng.uniform(-30.0, 70.0)) * side  # + is towards the arm's side
+        elevation = math.radians(rng.uniform(-25.0, 45.0))
+        distance = rng.uniform(1.5, 4.0)
+        direction = np.array([math.sin(azimuth) * math.cos(elevation), -math.cos(azimuth) * math.cos(elevation),
+                              math.sin(elevation)])
+        target = skeleton.shoulder_rest_position(arm) + distance * direction
+        if target[2] >= 0.3:
+            return target
 
 
 def finger_angles(rig, arm, target, frames):
