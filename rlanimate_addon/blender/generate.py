@@ -26,18 +26,15 @@ def generate(context, settings, progress=lambda step: None):
     scene = context.scene
     original_frame = scene.frame_current
     frames = start + np.arange(frame_count)
-    moved = False
     try:
         if action_adapter.is_animated(obj) and scene.frame_current != start:
-            scene.frame_set(start)
-            moved = True
+            scene.frame_set(start)  # the pose to blend from is the one at the start frame
         rig = armature_io.read_rig_pose(obj, names)
         targets = None
         if settings.behaviour == "POINT":
-            moved = True
             targets = armature_io.target_positions(scene, obj, settings.target, frames)
     finally:
-        if moved and scene.frame_current != original_frame:
+        if scene.frame_current != original_frame:
             scene.frame_set(original_frame)
     progress(2)
 
