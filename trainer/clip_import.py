@@ -362,7 +362,10 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
         except (OSError, KeyError, ValueError):
             pass  # a damaged cache entry: import again and overwrite it
     clip = _import_uncached(path, float(expected_fps), bone_map)
-    _save_cached(cache_file, clip)
+    try:
+        _save_cached(cache_file, clip)
+    except OSError as error:  # a read-only clip folder: import without caching
+        print(f"clip_import: not caching {path.name}: {error}", file=sys.stderr)
     return clip
 
 
@@ -412,8 +415,9 @@ def _labelled(clip, entry, manifest_path):
 def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None):
     """Import every clip of a directory (its manifest.json when it has one, else every .fbx/.bvh) or
     of a manifest file. Returns (clips, problems): the clips that imported, and one message per file
-    that did not. Clips listed in a manifest carry its labels. The cache defaults to `.import_cache/`
-    beside the clips; pass cache_dir=False to import afresh without caching."""
+    that did not. Clips listed in a manifest carry its labels. cache_dir: where imported clips are
+    cached (default: `.import_cache/` beside a manifest; no cache for a folder without one, so that
+    shared data folders stay untouched); False imports afresh without caching."""
     path = Path(path_or_manifest)
     manifest_path = path / "manifest.json" if path.is_dir() and (path / "manifest.json").is_file() else path
     if manifest_path.is_file() and manifest_path.suffix.lower() == ".json":
@@ -428,7 +432,9 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None):
     else:
         raise RLAnimateError(f"{path}: neither a clip directory nor a manifest .json. "
                              "Point to the folder of FBX/BVH clips or to its manifest.json.")
-    cache = None if cache_dir is False else Path(cache_dir) if cache_dir else folder / CACHE_DIR_NAME
+    if cache_dir is None:  # cache beside a manifest's clips; never write into a plain folder such as
+        cache_dir = folder / CACHE_DIR_NAME if manifest_path is not None else False  # ../shared/realmocap
+    cache = Path(cache_dir) if cache_dir else None
     clips, problems = [], []
     for entry in entries:
         file = folder / str(entry.get("file", ""))
