@@ -55,7 +55,7 @@ def read_rig_pose(obj, names):
 
 def may_move(obj):
     """True when the object's world transform can change over time (keys, drivers, constraints, parent)."""
-    if obj.constraints and len(obj.constraints):
+    if len(obj.constraints):
         return True
     if obj.parent is not None:
         if may_move(obj.parent) or (obj.parent_type == "BONE" and action_adapter.is_animated(obj.parent)):
