@@ -190,11 +190,23 @@ def keyed_progress(times, knots):
     return out
 
 
-def _blend(start, end, progress):
-    """Per-frame local rotations (T, 3, 3) along the geodesic start -> end (3, 3) at progress (T,),
-    which may leave [0, 1] for anticipation and overshoot."""
-    delta = matrix_to_rotvec(start.T @ end)
-    return start @ rotvec_to_matrix(np.asarray(progress)[:, None] * delta)
+def _blend(name, start, end, progress):
+    """Local rotations (T, 3, 3) of bone `name` from start (3, 3) to end ((T,) 3, 3) at progress (T,),
+    which may leave [0, 1] for anticipation and overshoot. The bone's direction moves along a great
+    circle (so a raised hand travels on a natural arc) while its roll turns evenly."""
+    rest = _REST_LOCAL[name]
+    first, last = rest @ start, rest @ end  # orientations in the parent's frame
+    y0, y1 = first[..., :, 1], last[..., :, 1]
+    axis = np.cross(y0, y1)
+    sine = np.linalg.norm(axis, axis=-1)
+    angle = np.arctan2(sine, np.sum(y0 * y1, axis=-1))
+    axis = axis / np.maximum(sine, 1e-12)[..., None]
+    swung = rotvec_to_matrix(axis * angle[..., None]) @ first  # direction of `last`, roll of `first`
+    twist = np.sum(matrix_to_rotvec(last @ np.swapaxes(swung, -1, -2)) * y1, axis=-1)
+    progress = np.asarray(progress)
+    swing = rotvec_to_matrix(axis * (progress * angle)[..., None])
+    direction = (swing @ y0[..., None])[..., 0]
+    return rest.T @ (rotvec_to_matrix(direction * (progress * twist)[..., None]) @ swing @ first)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -282,6 +294,57 @@ def _neutral():
 def neutral_pose():
     """{bone: (3,) local rotation vector} of the shared start and end pose, for ANIMATED_BONES."""
     return _neutral().rotvecs(ANIMATED_BONES)
+
+
+_CHEST = "Spine2"
+
+
+def _arc(start, end, progress):
+    """Unit vectors (T, 3) along the great circle from start to end ((T,) 3) at progress (T,)."""
+    frames = np.shape(progress)
+    d0 = np.broadcast_to(start, frames + (3,))
+    d1 = np.broadcast_to(end, frames + (3,))
+    axis = np.cross(d0, d1)
+    sine = np.linalg.norm(axis, axis=-1)
+    angle = np.arctan2(sine, np.sum(d0 * d1, axis=-1))
+    axis = axis / np.maximum(sine, 1e-12)[..., None]
+    return (rotvec_to_matrix(axis * (progress * angle)[..., None]) @ d0[..., None])[..., 0]
+
+
+def _arm_keys(pose, arm):
+    """Where `pose` puts the arm, in the chest's frame: the directions of the wrist and of the elbow
+    from the shoulder, the wrist's distance, and the hand's rotation."""
+    side = _side(arm)
+    to_chest = np.swapaxes(pose.world(_CHEST), -1, -2)
+    shoulder = pose.head(side + "Arm")
+    reach = (to_chest @ (pose.head(side + "Hand") - shoulder)[..., None])[..., 0]
+    elbow = (to_chest @ (pose.head(side + "ForeArm") - shoulder)[..., None])[..., 0]
+    distance = np.linalg.norm(reach, axis=-1)
+    return {"wrist": reach / distance[..., None], "distance": distance, "elbow": _unit(elbow),
+            "hand": to_chest @ pose.world(side + "Hand")}
+
+
+def _move_arm(pose, arm, start, end, progress, hand_progress, fold=0.0):
+    """Pose the arm on every frame between two `_arm_keys`. The wrist travels on a great-circle arc
+    about the shoulder with its distance eased (shortened by `fold` mid-way, so the elbow bends to
+    swing the arm and extends again), the elbow's direction swings on its own arc (the swivel), and
+    the hand turns by `hand_progress`. Progress (T,) may leave [0, 1] for anticipation and overshoot."""
+    side = _side(arm)
+    frames = progress.shape
+    upper, lower = _length(side + "ForeArm", side + "Arm"), _length(side + "Hand", side + "ForeArm")
+    distance = start["distance"] + progress * (end["distance"] - start["distance"])
+    distance = np.minimum(distance * (1.0 - fold * np.sin(np.pi * np.clip(progress, 0, 1)) ** 2),
+                          0.999 * (upper + lower))
+    hand_start = np.broadcast_to(start["hand"], frames + (3, 3))
+    hand_turn = matrix_to_rotvec(np.swapaxes(hand_start, -1, -2) @ end["hand"])
+    hand = hand_start @ rotvec_to_matrix(np.asarray(hand_progress)[..., None] * hand_turn)
+
+    chest = pose.world(_CHEST)
+    shoulder = pose.head(side + "Arm")
+    wrist = shoulder + (chest @ (distance[..., None] * _arc(start["wrist"], end["wrist"], progress))[..., None])[..., 0]
+    hint = (chest @ _arc(start["elbow"], end["elbow"], progress)[..., None])[..., 0]
+    elbow = _elbow_position(shoulder, wrist, hint, upper, lower)
+    _place_arm(pose, arm, elbow, wrist, chest @ hand)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -431,8 +494,8 @@ def _wave_pose(arm, exaggeration, style, phase, envelope):
 _GROUPS = {  # body part -> bones whose timing it sets (the other arm's bones stay neutral)
     "torso": ("Spine", "Spine1", "Spine2"),
     "gaze": ("Neck", "Head"),
-    "arm": ("Shoulder", "Arm", "ForeArm"),
-    "hand": ("Hand",) + tuple(f"Hand{finger}{k}" for finger in _FINGERS for k in (1, 2, 3)
+    "arm": ("Shoulder",),  # the arm, forearm and hand follow the wrist's path (_move_arm)
+    "hand": tuple(f"Hand{finger}{k}" for finger in _FINGERS for k in (1, 2, 3)
                               if not (finger == "Index" and k > 1)),
 }
 
@@ -466,20 +529,22 @@ def _frames_between(times, start, end):
     return int(inside[0]), int(inside[-1])
 
 
-def _assemble(spec, arm, end_local, progress, times, phases):
-    """Blend every animated bone from neutral towards its end pose by its group's progress."""
+def _assemble(spec, end, progress, times, phases, fold=0.0):
+    """The clip from neutral to the `end` pose (batch () or (T,)) and back: every bone blends by its
+    group's progress; the gesturing arm follows its wrist's path."""
     neutral = _neutral()
-    rotvecs = {}
+    pose = _Pose()
     for name in ANIMATED_BONES:
         start = neutral.local.get(name, np.eye(3))
-        group = next((g for g in _GROUPS if name in _group_bones(g, arm)), None)
+        group = next((g for g in _GROUPS if name in _group_bones(g, spec.arm)), None)
         if group is None:
-            local = np.broadcast_to(start, times.shape + (3, 3))
+            pose.local[name] = np.broadcast_to(start, times.shape + (3, 3))
         else:
-            end = np.broadcast_to(end_local.get(name, np.eye(3)), times.shape + (3, 3))
-            delta = matrix_to_rotvec(np.swapaxes(start, -1, -2) @ end)  # (T, 3)
-            local = start @ rotvec_to_matrix(progress[group][:, None] * delta)
-        rotvecs[name] = matrix_to_rotvec(local)
+            goal = np.broadcast_to(end.local.get(name, np.eye(3)), times.shape + (3, 3))
+            pose.local[name] = _blend(name, start, goal, progress[group])
+    _move_arm(pose, spec.arm, _arm_keys(neutral, spec.arm), _arm_keys(end, spec.arm),
+              progress["arm"], progress["hand"], fold)
+    rotvecs = {name: matrix_to_rotvec(pose.local[name]) for name in ANIMATED_BONES}
     phases = {k: _frames_between(times, *v) for k, v in phases.items()}
     return GestureClip(spec, rotvecs, phases)
 
@@ -502,19 +567,13 @@ def _synthesise_point(spec, style):
         "torso": [(0, 0), (lead + 0.5 * wind, 0), (t1 + 0.05, 1), (t2, 1), (t2 + back, 0)],
         "arm": [(0, 0), (lead, 0), (lead + wind, -style.anticipation), (t1, 1 + overshoot), (t1 + settle, 1),
                 (t2, 1), (t2 + back, -0.5 * overshoot), (t2 + back + back_settle, 0)],
-        "hand": [(0, 0), (lead + wind + 0.15 * stroke, 0), (t1 + settle, 1), (t2 + 0.05, 1),
+        "hand": [(0, 0), (lead + wind + 0.1 * stroke, 0), (t1 + 0.5 * settle, 1), (t2 + 0.05, 1),
                  (t2 + 0.05 + back, 0)],
     }
     progress = {g: keyed_progress(times, kn) for g, kn in knots.items()}
-    clip = _assemble(spec, spec.arm, hold.local, progress, times,
-                     {"stroke": (lead + wind, t1), "hold": (t1 + settle, t2), "return": (t2, t2 + back)})
-    # Extra elbow bend mid-stroke and mid-return (the forearm folds in to swing, then extends).
-    side, sign = _side(spec.arm), _SIDE_SIGN[spec.arm]
-    fold = 0.35 * (np.sin(np.pi * np.clip(progress["arm"], 0, 1)) ** 2)
-    forearm = rotvec_to_matrix(clip.rotvecs[side + "ForeArm"])
-    clip.rotvecs[side + "ForeArm"] = matrix_to_rotvec(
-        rotvec_to_matrix(fold[:, None] * np.array([0.0, 0.0, -sign])) @ forearm)
-    return clip
+    return _assemble(spec, hold, progress, times,
+                     {"stroke": (lead + wind, t1), "hold": (t1 + settle, t2), "return": (t2, t2 + back)},
+                     fold=0.05)
 
 
 def _synthesise_wave(spec, style):
@@ -540,9 +599,9 @@ def _synthesise_wave(spec, style):
                  (t_lower + 0.1 + lower, 0)],
     }
     progress = {g: keyed_progress(times, kn) for g, kn in knots.items()}
-    return _assemble(spec, spec.arm, raised.local, progress, times,
-                     {"raise": (lead + wind, lead + wind + rise), "wave": (t_start + 0.3, t_stop - 0.3),
-                      "lower": (t_lower, t_lower + lower)})
+    return _assemble(spec, raised, progress, times,
+                     {"raise": (lead + wind, t_start), "wave": (t_start, t_stop), "lower": (t_stop, t_lower + lower)},
+                     fold=0.08)
 
 
 def synthesise(spec):
