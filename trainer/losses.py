@@ -23,6 +23,8 @@ import torch
 import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
+from rlanimate_addon.core.agent_file import INITIAL_ACTION
+
 #: Clip poses are kept this far inside (0, 1) for the Beta's log-likelihood.
 POSE_MARGIN = 1e-3
 
@@ -32,7 +34,7 @@ def agent_losses(agent, batch, config):
     objective, motion = batch["objective"], batch["motion"]  # (C, L, 7), (C, L, 45)
     supervised = agent.variant == "supervised"
     played = motion if supervised else batch["action"]  # (C, L, 45)
-    previous = torch.cat([torch.full_like(played[:, :1], 0.5), played[:, :-1]], 1)  # a_{t-1}, a_0 = 0.5
+    previous = torch.cat([torch.full_like(played[:, :1], INITIAL_ACTION), played[:, :-1]], 1)  # a_{t-1}
     described = agent.self_description(objective)  # (C, L, 42) or None
     conditions = batch["description"] if described is None else described
     unrolled = agent.observe(objective, previous, conditions)

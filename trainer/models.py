@@ -15,7 +15,7 @@ Timing of one rollout (the environment plays a_t and returns the real descriptio
 Everything indexed t is computed at frame t from o_t and from the previous frame's z_{t-1} and
 a_{t-1}; a_t is the pose played at frame t and d'_t is the description of that pose. The
 behaviour state b_t of the paper is the pair (e_t, z_t), as in PlaNet's RSSM. A rollout or a
-training chunk starts from h_0 = e_0 = 0, z_0 = 0 and a_0 = INITIAL_ACTION.
+training chunk starts from h_0 = e_0 = 0, z_0 = 0 and a_0 = agent_file.INITIAL_ACTION.
 
 Variants (the paper's Table 4 ablations; docs/AGENT.md defines them):
     rlanimate        as above;
@@ -31,12 +31,11 @@ from torch import nn
 from torch.distributions import Beta, Independent, Normal
 
 from rlanimate_addon.core import agent_file, spaces
+from rlanimate_addon.core.errors import RLAnimateError
 
 from . import losses as loss_terms
 
 VARIANTS = agent_file.VARIANTS
-#: a_0, the "previous action" of a sequence's first frame: the middle of every channel's range.
-INITIAL_ACTION = 0.5
 
 
 class MLP(nn.Module):
@@ -58,7 +57,7 @@ class RLAnimateAgent(nn.Module):
     def __init__(self, agent_config, variant="rlanimate"):
         super().__init__()
         if variant not in VARIANTS:
-            raise ValueError(f"Unknown variant {variant!r}: use one of {', '.join(VARIANTS)}")
+            raise RLAnimateError(f"Unknown agent variant {variant!r}: use one of {', '.join(VARIANTS)}.")
         c = self.config = agent_config
         self.variant = variant
         O, D, A = spaces.OBJECTIVE_SIZE, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
@@ -126,7 +125,7 @@ class RLAnimateAgent(nn.Module):
         """(e_0, z_0, a_0) for `batch_size` sequences, with `like`'s dtype."""
         c = self.config
         return (like.new_zeros(batch_size, c.behaviour_size), like.new_zeros(batch_size, c.stochastic_size),
-                like.new_full((batch_size, spaces.ACTION_SIZE), INITIAL_ACTION))
+                like.new_full((batch_size, spaces.ACTION_SIZE), agent_file.INITIAL_ACTION))
 
     def rollout(self, objectives, deterministic=True, generator=None):
         """Play the agent on objectives (B, T, 7) -> actions (B, T, 45) in [0, 1], without gradients.

@@ -24,6 +24,9 @@ FORMAT_NAME = "rlanimate-agent"
 FORMAT_VERSION = 1
 METADATA_KEY = "__metadata__"
 VARIANTS = ("rlanimate", "single_state", "single_dynamics", "supervised")
+#: a_0, the previous action of a sequence's first frame (the middle of every channel's range): part
+#: of the agent's definition, shared by the torch model and the numpy runtime.
+INITIAL_ACTION = 0.5
 #: Metadata fields every agent file has.
 REQUIRED_METADATA = ("format", "format_version", "variant", "agent_config", "action_bounds", "average_frames")
 _AGENT_SIZES = ("task_size", "behaviour_size", "stochastic_size", "hidden_size", "portrayal_hidden_size",

@@ -15,9 +15,7 @@ their contributions to each layer) is done for all frames at once before the per
 import numpy as np
 
 from . import agent_file, spaces
-
-#: a_0, the previous action of the first frame (trainer/models.py INITIAL_ACTION).
-INITIAL_ACTION = 0.5
+from .errors import RLAnimateError
 
 
 def load_agent(path):
@@ -117,6 +115,10 @@ class GestureAgent:
     def rollout(self, objectives, seed=None):
         """Objectives (N, 7) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""
         objectives = np.asarray(objectives, dtype=np.float64)
+        if objectives.ndim != 2 or objectives.shape[1] != spaces.OBJECTIVE_SIZE or len(objectives) == 0 \
+                or not np.all(np.isfinite(objectives)):
+            raise RLAnimateError(f"The agent needs finite objectives of shape (frames, {spaces.OBJECTIVE_SIZE}), "
+                                 f"got {objectives.shape}: give the gesture at least one frame and a valid target.")
         rng = None if seed is None else np.random.default_rng(seed)
         E, Z = self._sizes
         A = spaces.ACTION_SIZE
@@ -133,7 +135,7 @@ class GestureAgent:
         gates, belief_end = 3 * E, 3 * E + len(self._belief[0][1])
         e = np.zeros(E)
         hidden_gates = self._cell_hidden_bias  # W_hh e_0 + b_hh with e_0 = 0
-        recurrent_gates = np.full(A, INITIAL_ACTION) @ self._from_a  # W_z z_0 + W_a a_0 with z_0 = 0
+        recurrent_gates = np.full(A, agent_file.INITIAL_ACTION) @ self._from_a  # W_z z_0 + W_a a_0 with z_0 = 0
         actions = np.empty((count, A))
         for t in range(count):
             e = _gru_step(cell_inputs[t] + recurrent_gates, hidden_gates, e)

@@ -85,3 +85,12 @@ def test_shipped_default_agent_plays(tmp_path):
     assert actions.shape == (40, spaces.ACTION_SIZE)
     assert np.all(np.isfinite(actions)) and np.all((actions >= 0.0) & (actions <= 1.0))
     assert isinstance(runtime, GestureAgent)
+
+
+@pytest.mark.parametrize("objectives", [np.zeros((0, 7)), np.zeros((5, 6)), np.zeros(7),
+                                        np.full((4, 7), np.nan)])
+def test_bad_objectives_get_a_clear_error(tmp_path, objectives):
+    from rlanimate_addon.core.errors import RLAnimateError
+    _, path = exported_agent(tmp_path, "debug", "rlanimate")
+    with pytest.raises(RLAnimateError, match="objectives of shape"):
+        load_agent(path).rollout(objectives)
