@@ -83,10 +83,10 @@ def test_losses_fall_on_a_tiny_batch(variant):
     config, train = load_preset("debug")
     torch.manual_seed(0)
     agent = RLAnimateAgent(config, variant)
-    batch = synthetic_batch(8, 12)
-    optimiser = torch.optim.Adam(agent.parameters(), lr=1e-2)
+    batch = synthetic_batch(6, 10)
+    optimiser = torch.optim.Adam(agent.parameters(), lr=2e-2)
     history = []
-    for _ in range(100):
+    for _ in range(50):
         losses = agent.losses(batch, train)
         optimiser.zero_grad()
         losses["total"].backward()
@@ -149,4 +149,4 @@ def test_unknown_preset_names_the_choices():
 def test_default_agent_fits_in_two_megabytes_of_float32():
     agent = RLAnimateAgent(load_preset("default")[0])
     assert 4 * sum(p.numel() for p in agent.parameters()) < 2e6
-    assert np.isfinite(sum(float(p.sum()) for p in agent.parameters()))
+    assert all(torch.isfinite(p.detach()).all() for p in agent.parameters())
