@@ -300,7 +300,8 @@ _CHEST = "Spine2"
 
 
 def _arc(start, end, progress):
-    """Unit vectors (T, 3) along the great circle from start to end ((T,) 3) at progress (T,)."""
+    """Rotations (T, 3, 3) that carry the unit vector `start` along its great circle towards `end`
+    ((T,) 3), by the fraction `progress` (T,) of the way."""
     frames = np.shape(progress)
     d0 = np.broadcast_to(start, frames + (3,))
     d1 = np.broadcast_to(end, frames + (3,))
@@ -308,7 +309,11 @@ def _arc(start, end, progress):
     sine = np.linalg.norm(axis, axis=-1)
     angle = np.arctan2(sine, np.sum(d0 * d1, axis=-1))
     axis = axis / np.maximum(sine, 1e-12)[..., None]
-    return (rotvec_to_matrix(axis * (progress * angle)[..., None]) @ d0[..., None])[..., 0]
+    return rotvec_to_matrix(axis * (np.asarray(progress) * angle)[..., None])
+
+
+def _apply(rotation, vector):
+    return (rotation @ vector[..., None])[..., 0]
 
 
 def _arm_keys(pose, arm):
@@ -339,11 +344,20 @@ def _move_arm(pose, arm, start, end, progress, hand_progress, fold=0.0):
     hand_turn = matrix_to_rotvec(np.swapaxes(hand_start, -1, -2) @ end["hand"])
     hand = hand_start @ rotvec_to_matrix(np.asarray(hand_progress)[..., None] * hand_turn)
 
+    # The elbow's offset from the shoulder-wrist line rides along with the wrist's arc (parallel
+    # transport), turning evenly about that line to its end swivel: no fixed reference, no flips.
+    carry = _arc(start["wrist"], end["wrist"], progress)
+    direction = _apply(carry, np.broadcast_to(start["wrist"], frames + (3,)))
+    offset = np.broadcast_to(_perpendicular(start["elbow"], start["wrist"]), frames + (3,))
+    carried = _apply(_arc(start["wrist"], end["wrist"], np.ones(frames)), offset)
+    target = _perpendicular(end["elbow"], end["wrist"])
+    swivel = np.arctan2(np.sum(np.cross(carried, target) * end["wrist"], axis=-1), np.sum(carried * target, axis=-1))
+    hint = _apply(rotvec_to_matrix(direction * (progress * swivel)[..., None]), _apply(carry, offset))
+
     chest = pose.world(_CHEST)
     shoulder = pose.head(side + "Arm")
-    wrist = shoulder + (chest @ (distance[..., None] * _arc(start["wrist"], end["wrist"], progress))[..., None])[..., 0]
-    hint = (chest @ _arc(start["elbow"], end["elbow"], progress)[..., None])[..., 0]
-    elbow = _elbow_position(shoulder, wrist, hint, upper, lower)
+    wrist = shoulder + _apply(chest, distance[..., None] * direction)
+    elbow = _elbow_position(shoulder, wrist, _apply(chest, hint), upper, lower)
     _place_arm(pose, arm, elbow, wrist, chest @ hand)
 
 
@@ -567,7 +581,7 @@ def _synthesise_point(spec, style):
         "torso": [(0, 0), (lead + 0.5 * wind, 0), (t1 + 0.05, 1), (t2, 1), (t2 + back, 0)],
         "arm": [(0, 0), (lead, 0), (lead + wind, -style.anticipation), (t1, 1 + overshoot), (t1 + settle, 1),
                 (t2, 1), (t2 + back, -0.5 * overshoot), (t2 + back + back_settle, 0)],
-        "hand": [(0, 0), (lead + wind + 0.1 * stroke, 0), (t1 + 0.5 * settle, 1), (t2 + 0.05, 1),
+        "hand": [(0, 0), (lead + wind, 0), (t1 + 0.15, 1), (t2 + 0.05, 1),
                  (t2 + 0.05 + back, 0)],
     }
     progress = {g: keyed_progress(times, kn) for g, kn in knots.items()}
@@ -595,7 +609,7 @@ def _synthesise_wave(spec, style):
         "torso": [(0, 0), (lead + 0.1, 0), (lead + wind + rise, 1), (t_lower, 1), (t_lower + lower, 0)],
         "arm": [(0, 0), (lead, 0), (lead + wind, -0.04), (lead + wind + rise, 1), (t_lower, 1),
                 (t_lower + lower, -0.02), (t_lower + lower + settle, 0)],
-        "hand": [(0, 0), (lead + wind + 0.2 * rise, 0), (lead + wind + rise + 0.1, 1), (t_lower + 0.1, 1),
+        "hand": [(0, 0), (lead + wind, 0), (lead + wind + 0.85 * rise, 1), (t_lower + 0.1, 1),
                  (t_lower + 0.1 + lower, 0)],
     }
     progress = {g: keyed_progress(times, kn) for g, kn in knots.items()}
