@@ -11,6 +11,7 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
 that they explore and stay reproducible; evaluation rolls out deterministically.
 """
+import math
 import time
 
 import numpy as np
@@ -69,7 +70,7 @@ class Trainer:
     """Algorithm 1's state (agent, optimiser, buffer, RNGs, epoch, history) and one iteration of it."""
 
     def __init__(self, agent, env, clips, train_config, behaviour="both", seed=0,
-                 bounds=spaces.DEFAULT_ACTION_BOUNDS, references=None):
+                 bounds=spaces.DEFAULT_ACTION_BOUNDS, references=None, epochs=None):
         if behaviour not in BEHAVIOUR_CHOICES:
             raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use point, wave or both.")
         self.agent = agent
@@ -83,6 +84,7 @@ class Trainer:
         self.buffer = EpisodeBuffer()
         self.rng = np.random.default_rng(seed)
         self.rollout_generator = torch.Generator().manual_seed(seed)
+        self.epochs = epochs  # the planned length of the run, for the learning-rate schedule
         self.epoch = 0
         self.history = []  # one metrics dict per epoch
 
@@ -108,9 +110,21 @@ class Trainer:
             })
         return drawn
 
+    def learning_rate(self):
+        """This epoch's Adam step size: cosine from learning_rate down to learning_rate_final over the
+        planned epochs, or constant when the config or the trainer gives no final rate or no length."""
+        config = self.train_config
+        final = getattr(config, "learning_rate_final", None)
+        if final is None or not self.epochs:
+            return config.learning_rate
+        progress = min(self.epoch / self.epochs, 1.0)
+        return final + (config.learning_rate - final) * 0.5 * (1.0 + math.cos(math.pi * progress))
+
     def update(self):
         """Step 3: T gradient steps on C chunks of L frames; returns each loss's mean over the steps."""
         config = self.train_config
+        for group in self.optimizer.param_groups:
+            group["lr"] = self.learning_rate()
         self.agent.train()
         totals = {}
         for _ in range(config.update_steps):
@@ -133,7 +147,7 @@ class Trainer:
         losses = self.update()
         self.epoch += 1
         metrics = {"epoch": self.epoch, "episodes": len(self.buffer), "frames": self.buffer.frames,
-                   "collect_seconds": collected - start, "update_seconds": time.perf_counter() - collected,
+                   "learning_rate": self.optimizer.param_groups[0]["lr"], "collect_seconds": collected - start, "update_seconds": time.perf_counter() - collected,
                    **{f"loss/{name}": value for name, value in losses.items()}}
         self.history.append(metrics)
         return metrics

@@ -1,10 +1,11 @@
 """Regenerate the paper's Section 4 results: Table 4, Figure 3 and length flexibility.
 
-    nice -n 10 python -m trainer.experiments [--preset default] [--epoch-scale 1.0]
+    nice -n 10 python -m trainer.experiments [--preset default] [--epoch-scale 1.0] [--jobs 2]
 
 Trains the four methods (RLAnimate and its three ablations) on each column (wave, point, both)
-for the paper's 50 / 100 epochs times --epoch-scale, each run in runs/experiments/<method>_<column>/
-(an interrupted experiment resumes from those checkpoints), then writes to docs/results/:
+for the paper's 50 / 100 epochs times --epoch-scale, each run by `trainer/train.py` in its own
+process, --jobs at a time, into runs/experiments/<method>_<column>/. Runs that already finished are
+kept and interrupted ones resume from their checkpoints. Then it writes to docs/results/:
     table4.json   {method: {column: {score, smoothness, episodes, train_seconds}}} (held-out clips)
     table4.md     the same as a table, with the training-clip scores and the run settings
     figure3_seen.png, figure3_unseen.png   score over epochs on seen and unseen clips
@@ -20,12 +21,14 @@ if str(REPO_ROOT) not in sys.path:
 
 import argparse  # noqa: E402
 import json  # noqa: E402
+import subprocess  # noqa: E402
+import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
 from rlanimate_addon.core import metrics  # noqa: E402
-from trainer import evaluate, plots, train  # noqa: E402
+from trainer import checkpoint, evaluate, plots, train  # noqa: E402
 from trainer.bpy_support import script_args  # noqa: E402
 
 COLUMNS = ("wave", "point", "both")
@@ -44,23 +47,64 @@ def build_parser():
     parser.add_argument("--results", default=str(train.RESULTS_DIR))
     parser.add_argument("--eval-every", type=int, default=5)
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--jobs", type=int, default=1, help="training runs at a time, one process each")
     return parser
 
 
-def run_arguments(options, method, column):
-    output = Path(options.runs) / f"{method}_{column}"
-    epochs = max(1, int(round(train.PAPER_EPOCHS[column] * options.epoch_scale)))
-    argv = ["--behaviour", column, "--variant", method, "--preset", options.preset, "--clips", options.clips,
-            "--epochs", str(epochs), "--seed", str(options.seed), "--output", str(output),
-            "--eval-every", str(options.eval_every), "--quiet"]
-    if (output / "checkpoint.pt").is_file():
-        argv.append("--resume")
-    return train.build_parser().parse_args(argv)
+def run_folder(options, method, column):
+    return Path(options.runs) / f"{method}_{column}"
+
+
+def planned_epochs(options, column):
+    return max(1, int(round(train.PAPER_EPOCHS[column] * options.epoch_scale)))
+
+
+def is_finished(folder, epochs):
+    report = folder / "report.json"
+    return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
+
+
+def train_command(options, method, column):
+    folder = run_folder(options, method, column)
+    command = [sys.executable, str(REPO_ROOT / "trainer" / "train.py"), "--behaviour", column,
+               "--variant", method, "--preset", options.preset, "--clips", options.clips,
+               "--epochs", str(planned_epochs(options, column)), "--seed", str(options.seed),
+               "--output", str(folder), "--eval-every", str(options.eval_every), "--quiet"]
+    return command + (["--resume"] if (folder / checkpoint.FILENAME).is_file() else [])
+
+
+def train_all(options):
+    """Run every unfinished (method, column), --jobs processes at a time; raise if one fails."""
+    pending = [(m, c) for m in options.methods for c in options.columns
+               if not is_finished(run_folder(options, m, c), planned_epochs(options, c))]
+    running = []
+    while pending or running:
+        while pending and len(running) < options.jobs:
+            method, column = pending.pop(0)
+            folder = run_folder(options, method, column)
+            folder.mkdir(parents=True, exist_ok=True)
+            log = open(folder / "train.log", "w")
+            running.append((method, column, log, subprocess.Popen(
+                train_command(options, method, column), stdout=log, stderr=subprocess.STDOUT)))
+        time.sleep(1.0)
+        for entry in list(running):
+            method, column, log, process = entry
+            if process.poll() is not None:
+                log.close()
+                running.remove(entry)
+                if process.returncode != 0:
+                    raise RuntimeError(f"{method} {column} failed: see {run_folder(options, method, column)}/train.log")
+                print(f"finished {method} {column}", flush=True)
+
+
+def load_run(folder):
+    report = json.loads((folder / "report.json").read_text())
+    history = [json.loads(line) for line in (folder / "metrics.jsonl").read_text().splitlines()]
+    return report, history
 
 
 def table4_markdown(table, seen, settings):
-    lines = ["# Table 4: final score and smoothness imitating held-out clips", "",
-             settings, "",
+    lines = ["# Table 4: final score and smoothness imitating held-out clips", "", settings, "",
              "| method | wave score | wave smooth. | point score | point smooth. | both score | both smooth. |",
              "|---|---|---|---|---|---|---|"]
     for method, columns in table.items():
@@ -79,39 +123,70 @@ def table4_markdown(table, seen, settings):
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None):
-    options = build_parser().parse_args(script_args(argv))
-    torch.set_num_threads(1)
-    results = Path(options.results)
-    results.mkdir(parents=True, exist_ok=True)
-    session = train.Session(train.manifest_path(options.clips))
-    table, seen, histories, flexibility = {}, {}, {}, None
+def write_table_and_figures(options, results):
+    """table4.json/.md and Figure 3 from every finished run of the requested methods and columns."""
+    table, seen, histories = {}, {}, {}
     for method in options.methods:
         for column in options.columns:
-            report, trainer = train.run(run_arguments(options, method, column), session)
-            print(f"{method:16s} {column:5s} held-out score {report['held_out']['score']:6.2f} "
-                  f"smoothness {report['held_out']['smoothness']:6.2f} "
-                  f"episodes {report['episodes']} {report['train_seconds']:.0f}s", flush=True)
+            folder = run_folder(options, method, column)
+            if not is_finished(folder, planned_epochs(options, column)):
+                continue
+            report, history = load_run(folder)
             table.setdefault(method, {})[column] = {
                 "score": report["held_out"]["score"], "smoothness": report["held_out"]["smoothness"],
                 "episodes": report["episodes"], "train_seconds": report["train_seconds"]}
             seen.setdefault(method, {})[column] = report["training"]
-            histories.setdefault(method, {})[column] = trainer.history
-            if method == "rlanimate" and column == "both":
-                test = evaluate.select_clips(session.test_clips, "both")
-                flexibility = evaluate.length_flexibility(trainer.agent, session.env, test,
-                                                          session.train_clips, LENGTH_SCALES, trainer.bounds)
+            histories.setdefault(method, {})[column] = history
     settings = (f"Preset `{options.preset}`, seed {options.seed}, epochs = {options.epoch_scale:g} x the paper's "
-                f"(50 one behaviour, 100 both; an epoch is one iteration of Algorithm 1). "
+                f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1). "
                 f"Regenerate: `nice -n 10 python -m trainer.experiments --preset {options.preset} "
                 f"--epoch-scale {options.epoch_scale:g}`.")
     (results / "table4.json").write_text(json.dumps(table, indent=2) + "\n")
     (results / "table4.md").write_text(table4_markdown(table, seen, settings))
     for split in ("seen", "unseen"):
         plots.figure3(histories, results / f"figure3_{split}.png", split)
-    if flexibility is not None:
-        (results / "length_flexibility.json").write_text(json.dumps(flexibility, indent=2) + "\n")
-        plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)
+    return table
+
+
+def load_trained_agent(folder, preset):
+    """The torch agent of a finished run, from its checkpoint."""
+    from trainer.config import load_preset
+    from trainer.models import RLAnimateAgent
+
+    saved = checkpoint.load(folder / checkpoint.FILENAME)
+    agent = RLAnimateAgent(load_preset(preset)[0], saved["arguments"]["variant"])
+    agent.load_state_dict(saved["trainer"]["agent"])
+    return agent
+
+
+def write_length_flexibility(options, results):
+    """Section 4.4 for the RLAnimate both-behaviour agent on the held-out clips."""
+    folder = run_folder(options, "rlanimate", "both")
+    if not is_finished(folder, planned_epochs(options, "both")):
+        return None
+    session = train.Session(train.manifest_path(options.clips))
+    agent = load_trained_agent(folder, options.preset)
+    test = evaluate.select_clips(session.test_clips, "both")
+    flexibility = evaluate.length_flexibility(agent, session.env, test, session.train_clips, LENGTH_SCALES)
+    (results / "length_flexibility.json").write_text(json.dumps(flexibility, indent=2) + "\n")
+    plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)
+    return flexibility
+
+
+def main(argv=None):
+    options = build_parser().parse_args(script_args(argv))
+    torch.set_num_threads(1)
+    results = Path(options.results)
+    results.mkdir(parents=True, exist_ok=True)
+    train_all(options)
+    table = write_table_and_figures(options, results)
+    for method, columns in table.items():
+        for column, entry in columns.items():
+            print(f"{method:16s} {column:5s} held-out score {entry['score']:6.2f} smoothness "
+                  f"{entry['smoothness']:6.2f} episodes {entry['episodes']} {entry['train_seconds']:.0f}s")
+    flexibility = write_length_flexibility(options, results)
+    if flexibility:
+        print("length flexibility:", json.dumps(flexibility))
     return 0
 
 

@@ -51,7 +51,8 @@ def figure3(histories, path, split):
         axis.set_xlabel("epoch")
         axis.set_ylabel("score")
         axis.set_ylim(bottom=max(axis.get_ylim()[0], 0))
-        axis.legend(fontsize=8)
+        if axis.lines:
+            axis.legend(fontsize=8)
     which = "clips from the training set" if split == "seen" else "clips excluded from the training set"
     figure.suptitle(f"Imitating {which}")
     figure.tight_layout()

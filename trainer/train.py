@@ -159,7 +159,7 @@ def run(args, session=None):
     seed_everything(args.seed)
     agent = RLAnimateAgent(agent_config, args.variant)
     trainer = Trainer(agent, session.env, session.train_clips, train_config, args.behaviour, args.seed,
-                      references=session.references)
+                      references=session.references, epochs=epochs)
     if saved is not None:
         trainer.load_state_dict(saved["trainer"])
     arguments = {name: getattr(args, name) for name in RESUMED_SETTINGS}
