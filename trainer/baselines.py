@@ -223,3 +223,39 @@ def evaluate_motions(env, motions, clips, references):
 def generate_for(baseline, clips):
     """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
     return [baseline.generate(c.behaviour.upper(), c.arm.upper(), c.attributes, len(c.rotvecs)) for c in clips]
+
+
+METHOD_LABELS = {"rlanimate": "RLAnimate", "nearest_clip": "Nearest clip", "procedural_ik": "Procedural IK"}
+METRIC_LABELS = {"score": "score", "smoothness": "smoothness", "forearm_angle_deg": "forearm angle at hold (deg)"}
+
+
+def write_results(results_dir, section, description, sets):
+    """Merge one section into results_dir/baselines.json and rewrite baselines.md from the whole file.
+
+    sets: {set name: {method: {metric: value, ...}}}; the other sections are kept as they are, so
+    the sample-library and the real-data runs each update their own.
+    """
+    import json
+    from pathlib import Path
+    results_dir = Path(results_dir)
+    results_dir.mkdir(parents=True, exist_ok=True)
+    path = results_dir / "baselines.json"
+    table = json.loads(path.read_text()) if path.is_file() else {}
+    table[section] = {"description": description, "sets": sets}
+    path.write_text(json.dumps(table, indent=2) + "\n")
+    lines = ["# RLAnimate against the baselines an animator would try first", "",
+             "Nearest clip: the training clip with the closest label, time-warped to the requested length. "
+             "Procedural IK: Blender's IK constraint with minimum-jerk timing (trainer/baselines.py). "
+             "Each method answers the held-out clip's own request (label and length); score and smoothness "
+             "as in docs/METRICS.md. Discussion: docs/REALMOCAP.md.", ""]
+    for name, entry in table.items():
+        lines += [f"## {name}", "", entry["description"], ""]
+        for set_name, methods in entry["sets"].items():
+            metric_names = [m for m in METRIC_LABELS if any(m in row for row in methods.values())]
+            lines += [f"**{set_name}**", "", "| method | " + " | ".join(METRIC_LABELS[m] for m in metric_names) + " |",
+                      "|---|" + "---|" * len(metric_names)]
+            for method, row in methods.items():
+                lines.append(f"| {METHOD_LABELS.get(method, method)} | "
+                             + " | ".join(f"{row[m]:.2f}" for m in metric_names) + " |")
+            lines.append("")
+    (results_dir / "baselines.md").write_text("\n".join(lines))
