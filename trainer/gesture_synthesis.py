@@ -28,6 +28,7 @@ from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import matrix_to_rotvec, rotvec_to_matrix
 
 FPS = 30
+MAX_WAVING = 1.7  # s of oscillation at most, so no clip runs past 4.5 s
 
 _FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")
 #: Finger bones each clip animates besides the action joints (Index2/3 stay at rest: the agent
@@ -142,7 +143,7 @@ class Style:
     """Moderate per-clip variation: the agent sees only t/N and the label, so timing stays close."""
     tempo: float          # scales every duration
     lead_in: float        # s in the neutral pose before anything moves
-    hold: float           # s of pointing hold / number of wave cycles is separate
+    hold: float           # s of pointing hold
     anticipation: float   # wind-up, as a fraction of the stroke
     overshoot: float      # past the key pose before settling, as a fraction of the stroke
     swivel: float         # rad added to the natural elbow swivel
@@ -157,9 +158,9 @@ def draw_style(seed):
     """The style of clip `seed`, deterministic."""
     rng = np.random.default_rng(np.random.SeedSequence([0x5EED, int(seed)]))
     return Style(
-        tempo=float(np.clip(rng.normal(1.0, 0.05), 0.9, 1.1)),
+        tempo=float(np.clip(rng.normal(1.0, 0.04), 0.92, 1.08)),
         lead_in=float(rng.uniform(0.25, 0.4)),
-        hold=float(rng.uniform(0.8, 1.1)),
+        hold=float(rng.uniform(0.75, 1.0)),
         anticipation=float(rng.uniform(0.04, 0.07)),
         overshoot=float(rng.uniform(0.025, 0.045)),
         swivel=float(rng.uniform(-0.12, 0.12)),
@@ -597,7 +598,7 @@ def _synthesise_wave(spec, style):
     lower, settle, rest = (0.8 + 0.1 * e) * k, 0.3 * k, 0.25
     frequency = style.wave_frequency - 0.2 * e  # bigger waves swing a little slower
     t_start = lead + wind + rise - 0.15
-    t_stop = t_start + style.wave_cycles / frequency
+    t_stop = t_start + min(style.wave_cycles / frequency, MAX_WAVING)
     t_lower = t_stop - 0.1
     total = t_lower + lower + settle + rest
     times = np.arange(int(round(total * FPS)) + 1) / FPS
