@@ -23,6 +23,7 @@ class AgentConfig:
     hidden_layers: int = 2  # hidden layers of every MLP
     min_std: float = 0.1  # floor of the prior's and posterior's standard deviations
     concentration_floor: float = 1.0  # floor of the Beta's alpha and beta (>= 1: unimodal)
+    concentration_scale: float = 100.0  # alpha, beta = floor + scale * softplus(output)
 
     def to_dict(self):
         return asdict(self)

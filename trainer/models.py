@@ -107,9 +107,10 @@ class RLAnimateAgent(nn.Module):
 
     def policy(self, features):
         """Animation model: features (..., F) -> Beta over the action (..., 45)."""
-        alpha, beta = self.animation(features).chunk(2, -1)
-        floor = self.config.concentration_floor
-        return Independent(Beta(F.softplus(alpha) + floor, F.softplus(beta) + floor), 1)
+        concentrations = self.config.concentration_floor + \
+            self.config.concentration_scale * F.softplus(self.animation(features))  # (..., 90)
+        alpha, beta = concentrations.chunk(2, -1)
+        return Independent(Beta(alpha, beta), 1)
 
     def decode(self, features):
         """Description decoder: features (..., F) -> predicted real description (..., 42)."""

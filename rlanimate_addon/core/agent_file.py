@@ -31,6 +31,7 @@ INITIAL_ACTION = 0.5
 REQUIRED_METADATA = ("format", "format_version", "variant", "agent_config", "action_bounds", "average_frames")
 _AGENT_SIZES = ("task_size", "behaviour_size", "stochastic_size", "hidden_size", "portrayal_hidden_size",
                 "hidden_layers")
+_AGENT_SCALARS = ("min_std", "concentration_floor", "concentration_scale")
 
 
 def uses_portrayal(variant):
@@ -145,7 +146,8 @@ def _parse_metadata(path, entry):
 def _check_weights(path, arrays, metadata):
     config = metadata["agent_config"]
     if not isinstance(config, dict) or any(not isinstance(config.get(k), int) or config[k] <= 0
-                                           for k in _AGENT_SIZES):
+                                           for k in _AGENT_SIZES) \
+            or any(not isinstance(config.get(k), (int, float)) or not config[k] > 0 for k in _AGENT_SCALARS):
         raise RLAnimateError(f"The agent file {path} has an invalid agent_config: re-export it with "
                              f"trainer/export.py.")
     expected = expected_weight_shapes(config, metadata["variant"])

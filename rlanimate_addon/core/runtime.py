@@ -90,6 +90,7 @@ class GestureAgent:
         self._sizes = (E, Z)
         self._min_std = float(config["min_std"])
         self._floor = float(config["concentration_floor"])
+        self._concentration_scale = float(config["concentration_scale"])
         self._uses_portrayal = agent_file.uses_portrayal(self.variant)
         self._uses_task_state = agent_file.uses_task_state(self.variant)
         task_size = int(config["task_size"]) if self._uses_task_state else spaces.OBJECTIVE_SIZE
@@ -147,7 +148,7 @@ class GestureAgent:
                 z = z + (_softplus(belief[Z:]) + self._min_std) * rng.standard_normal(Z)
             from_z = z @ self._from_z
             out = _mlp_tail(self._animation, animation_inputs[t] + from_e[belief_end:] + from_z[gates:])
-            concentrations = _softplus(out) + self._floor  # (90,): alpha then beta
+            concentrations = self._floor + self._concentration_scale * _softplus(out)  # (90,): alpha, beta
             a = actions[t] = concentrations[:A] / (concentrations[:A] + concentrations[A:])
             recurrent_gates = from_z[:gates] + a @ self._from_a
         return actions
