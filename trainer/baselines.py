@@ -18,7 +18,11 @@ ProceduralIK     Blender's IK constraint on the sample rig. Point: the index fin
                  influence follows the raise, so the clip starts and ends in the neutral pose.
 
 Both start from and return to `neutral` (15, 3), the pose the training clips start in.
+AgentMethod (an exported .npz, numpy runtime) and TrainedAgentMethod (a trainer's torch agent) put
+RLAnimate behind the same generate() interface, so all three are scored by one code path.
 """
+from pathlib import Path
+
 import numpy as np
 
 from rlanimate_addon.core import metrics, rotations, skeleton, spaces
@@ -205,6 +209,34 @@ class ProceduralIK:
         return positions
 
 
+class TrainedAgentMethod:
+    """A torch RLAnimate agent behind the baselines' generate() interface: the deterministic rollout
+    that trainer.evaluate scores, decoded to rotations with the trainer's bounds."""
+
+    def __init__(self, trainer, path):
+        self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        from .algorithm import rollout_actions
+        self.agent.eval()
+        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count))
+        return spaces.decode_action(actions, self.bounds)
+
+
+class AgentMethod:
+    """An exported RLAnimate agent (.npz) behind the baselines' generate() interface: the deterministic
+    numpy rollout on the request's objectives, decoded to rotations."""
+
+    def __init__(self, path):
+        from rlanimate_addon.core import runtime
+        self.path = Path(path)
+        self.agent = runtime.load_agent(self.path)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        objectives = spaces.make_objective(behaviour, arm, attributes, frame_count)
+        return spaces.decode_action(self.agent.rollout(objectives), np.asarray(self.agent.action_bounds))
+
+
 def evaluate_motions(env, motions, clips, references):
     """{'score', 'smoothness', 'clips': [{name, behaviour, score, smoothness}]} of generated
     (F_i, 15, 3) `motions` against `clips` (references: algorithm.ClipReferences), as evaluate.evaluate_clips."""
@@ -236,7 +268,6 @@ def write_results(results_dir, section, description, sets):
     the sample-library and the real-data runs each update their own.
     """
     import json
-    from pathlib import Path
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
     path = results_dir / "baselines.json"
@@ -259,3 +290,59 @@ def write_results(results_dir, section, description, sets):
                              + " | ".join(f"{row[m]:.2f}" for m in metric_names) + " |")
             lines.append("")
     (results_dir / "baselines.md").write_text("\n".join(lines))
+
+
+def sample_library_comparison(agent_path, manifest):
+    """{set: {method: {score, smoothness, clips}}} on the sample library's held-out clips, per behaviour."""
+    from .algorithm import ClipReferences
+    from .evaluate import select_clips
+    from .train import Session
+    session = Session(manifest)
+    train_clips = session.train_clips
+    methods = {"rlanimate": AgentMethod(agent_path), "nearest_clip": NearestClip(train_clips),
+               "procedural_ik": ProceduralIK(neutral_pose(train_clips))}
+    references = ClipReferences(session.env)
+    sets = {}
+    for behaviour in ("point", "wave"):
+        clips = select_clips(session.test_clips, behaviour)
+        sets[f"{behaviour}, held-out clips ({len(clips)})"] = {
+            name: {key: result[key] for key in ("score", "smoothness")}
+            for name, result in ((name, evaluate_motions(session.env, generate_for(method, clips), clips, references))
+                                 for name, method in methods.items())}
+    return sets, methods["rlanimate"].agent.metadata.get("training", {})
+
+
+def main(argv=None):
+    """python -m trainer.baselines [--agent PATH] [--clips MANIFEST] [--results DIR]: the sample-library
+    section of docs/results/baselines.json and .md."""
+    import argparse
+    import sys
+
+    import torch
+
+    from .bpy_support import new_empty_scene, script_args
+    from .train import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR
+    parser = argparse.ArgumentParser(prog="python -m trainer.baselines", description=main.__doc__.split(":")[0])
+    parser.add_argument("--agent", default=str(INSTALLED_AGENT), help="exported RLAnimate agent (.npz)")
+    parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
+    parser.add_argument("--results", default=str(RESULTS_DIR))
+    options = parser.parse_args(script_args(argv))
+    torch.set_num_threads(1)
+    new_empty_scene()
+    try:
+        sets, training = sample_library_comparison(options.agent, options.clips)
+    except RLAnimateError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 2
+    provenance = ", ".join(f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes")
+                           if k in training) or "untrained"
+    write_results(options.results, "sample library",
+                  f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
+                  f"RLAnimate: `{Path(options.agent).name}` ({provenance}). "
+                  "Regenerate: `nice -n 10 python -m trainer.baselines`.", sets)
+    print(open(Path(options.results) / "baselines.md").read())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

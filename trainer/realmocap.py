@@ -32,7 +32,7 @@ from dataclasses import replace  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from rlanimate_addon.core import skeleton, spaces  # noqa: E402
+from rlanimate_addon.core import skeleton  # noqa: E402
 from rlanimate_addon.core.errors import RLAnimateError  # noqa: E402
 from trainer import autolabel, baselines  # noqa: E402
 
@@ -152,34 +152,6 @@ def angle_degrees(a, b):
     return float(np.degrees(np.arccos(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0))))
 
 
-class TrainedAgentMethod:
-    """A torch RLAnimate agent behind the baselines' generate() interface: the deterministic rollout
-    that trainer.evaluate scores, decoded to rotations with the trainer's bounds."""
-
-    def __init__(self, trainer, path):
-        self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)
-
-    def generate(self, behaviour, arm, attributes, frame_count):
-        from trainer.algorithm import rollout_actions
-        self.agent.eval()
-        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count))
-        return spaces.decode_action(actions, self.bounds)
-
-
-class AgentMethod:
-    """An exported RLAnimate agent (.npz) behind the baselines' generate() interface: the deterministic
-    numpy rollout on the request's objectives, decoded to rotations."""
-
-    def __init__(self, path):
-        from rlanimate_addon.core import runtime
-        self.path = Path(path)
-        self.agent = runtime.load_agent(self.path)
-
-    def generate(self, behaviour, arm, attributes, frame_count):
-        objectives = spaces.make_objective(behaviour, arm, attributes, frame_count)
-        return spaces.decode_action(self.agent.rollout(objectives), np.asarray(self.agent.action_bounds))
-
-
 def guide_angles(method, clips, env):
     """Per guide clip: the angle (deg) between generated and real forearm directions at their holds."""
     rows = []
@@ -206,7 +178,7 @@ def train_agent(session, name, behaviour, epochs, preset, seed, runs=RUNS_DIR):
     if (output / checkpoint.FILENAME).is_file():
         argv.append("--resume")
     report, trainer = train.run(train.build_parser().parse_args(argv), session)
-    return report, TrainedAgentMethod(trainer, output / "agent.npz")
+    return report, baselines.TrainedAgentMethod(trainer, output / "agent.npz")
 
 
 def compare(methods, clips, env, references):
@@ -239,12 +211,15 @@ def point_agent_and_library(point_agent, runs, epochs, seed):
     library = train.Session(train.DEFAULT_MANIFEST)
     clips = [c for c in library.train_clips if c.behaviour == "POINT"]
     if point_agent is None:
-        installed = AgentMethod(train.INSTALLED_AGENT)
-        training = installed.agent.metadata.get("training", {})
-        if not training.get("untrained") and training.get("behaviour") in ("point", "both"):
-            return installed, clips
+        try:
+            installed = baselines.AgentMethod(train.INSTALLED_AGENT)
+            training = installed.agent.metadata.get("training", {})
+            if not training.get("untrained") and training.get("behaviour") in ("point", "both"):
+                return installed, clips
+        except RLAnimateError as error:
+            print(f"realmocap: not using the installed agent: {error}", file=sys.stderr)
         return train_agent(library, "sample_point", "point", epochs, "default", seed, runs)[1], clips
-    return AgentMethod(point_agent), clips
+    return baselines.AgentMethod(point_agent), clips
 
 
 def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
