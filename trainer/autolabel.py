@@ -136,3 +136,20 @@ def label_point(rotvecs, arm=None):
     hold = int(np.flatnonzero(raised)[np.argmin(speed[raised])])
     direction = spaces.pointing_direction(arm, heads[side + "HandIndex1"][hold])
     return PointLabel(arm, direction, hold)
+
+
+def label_clip(clip, behaviour):
+    """Label an unlabelled MotionClip in place from its motion and return it: `behaviour` 'POINT' or
+    'WAVE' (the user says which; the arm and the attributes come from the motion). This is what an
+    `--autolabel` import or training path calls for a user's own clips."""
+    behaviour = behaviour.upper()
+    if behaviour == "WAVE":
+        label = label_wave(clip.rotvecs, clip.fps)
+        clip.behaviour, clip.arm, clip.exaggeration, clip.attributes = "WAVE", label.arm, label.exaggeration, label.exaggeration
+    elif behaviour == "POINT":
+        label = label_point(clip.rotvecs)
+        clip.behaviour, clip.arm, clip.attributes = "POINT", label.arm, label.direction
+    else:
+        raise RLAnimateError(f"Unknown behaviour {behaviour!r} to label clips with: use POINT or WAVE.")
+    clip.label = label
+    return clip

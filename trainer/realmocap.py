@@ -99,15 +99,7 @@ def import_real_clip(path, cache_dir=RUNS_DIR / "import_cache"):
     from trainer import clip_import
     info = parse_name(path)
     clip = relaxed_hand(clip_import.import_clip(path, cache_dir=cache_dir))
-    if info["content"] == "guide":
-        label = autolabel.label_point(clip.rotvecs)
-        clip = replace(clip, behaviour="POINT", arm=label.arm, attributes=label.direction)
-        clip.hold_frame = label.hold_frame
-    else:
-        label = autolabel.label_wave(clip.rotvecs, clip.fps)
-        clip = replace(clip, behaviour="WAVE", arm=label.arm, attributes=label.exaggeration,
-                       exaggeration=label.exaggeration)
-        clip.elevation, clip.stroke = label.elevation, label.stroke
+    autolabel.label_clip(clip, "POINT" if info["content"] == "guide" else "WAVE")
     clip.content, clip.style, clip.take, clip.named_arm = info["content"], info["style"], info["take"], info["arm"]
     return clip
 
@@ -160,7 +152,7 @@ def guide_angles(method, clips, env):
         real = env.evaluate(clip.rotvecs)
         generated = env.evaluate(motion)
         hold = autolabel.label_point(motion, clip.arm).hold_frame
-        real_forearm = forearm_direction(real.bone_heads, env.bone_names, clip.arm)[clip.hold_frame]
+        real_forearm = forearm_direction(real.bone_heads, env.bone_names, clip.arm)[clip.label.hold_frame]
         generated_forearm = forearm_direction(generated.bone_heads, env.bone_names, clip.arm)[hold]
         rows.append({"name": clip.name, "style": clip.style, "arm": clip.arm,
                      "direction": [round(float(v), 4) for v in clip.attributes],
@@ -193,8 +185,8 @@ def label_table(clips):
     for clip in clips:
         entry = table.setdefault(clip.style, {"exaggeration": [], "elevation": [], "stroke": [], "arm_correct": []})
         entry["exaggeration"].append(clip.exaggeration)
-        entry["elevation"].append(clip.elevation)
-        entry["stroke"].append(clip.stroke)
+        entry["elevation"].append(clip.label.elevation)
+        entry["stroke"].append(clip.label.stroke)
         entry["arm_correct"].append(clip.named_arm is None or clip.named_arm == clip.arm)
     return {style: {"clips": len(v["exaggeration"]), "exaggeration": float(np.mean(v["exaggeration"])),
                     "exaggeration_sd": float(np.std(v["exaggeration"])), "elevation_deg": float(np.mean(v["elevation"])),

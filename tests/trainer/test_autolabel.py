@@ -99,3 +99,13 @@ def test_feminine_waves_label_below_active_waves(tmp_path):
                 assert label.arm == side.upper(), path.name
                 labels.setdefault(style, []).append(label.exaggeration)
     assert max(labels["feminine"]) + 0.3 < min(labels["active"]), labels
+
+
+def test_label_clip_fills_an_unlabelled_clip():
+    from trainer.clip_import import MotionClip
+    clip = autolabel.label_clip(MotionClip("mine", "", FPS, _wave("LEFT", 150.0, 0.2)), "wave")
+    assert (clip.behaviour, clip.arm) == ("WAVE", "LEFT")
+    assert clip.attributes == clip.exaggeration == clip.label.exaggeration
+    from rlanimate_addon.core.errors import RLAnimateError
+    with pytest.raises(RLAnimateError, match="POINT or WAVE"):
+        autolabel.label_clip(clip, "dance")

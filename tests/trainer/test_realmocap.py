@@ -66,7 +66,7 @@ def test_imported_clips_are_labelled_from_their_motion(tmp_path):
     guide = realmocap.import_real_clip(realmocap.REALMOCAP_DIR / "guide" / "dataset-1_guide_normal_001.bvh", tmp_path)
     assert guide.behaviour == "POINT" and guide.arm == "RIGHT"
     assert abs(np.linalg.norm(guide.attributes) - 1.0) < 1e-9
-    assert 0 < guide.hold_frame < guide.frames - 1
+    assert 0 < guide.label.hold_frame < guide.frames - 1
 
 
 @needs_data
@@ -106,5 +106,5 @@ def _as_point(clip):
     from trainer import autolabel
     label = autolabel.label_point(clip.rotvecs, clip.arm)
     point = copy.copy(clip)
-    point.behaviour, point.attributes, point.hold_frame = "POINT", label.direction, label.hold_frame
+    point.behaviour, point.attributes, point.label = "POINT", label.direction, label
     return point
