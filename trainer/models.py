@@ -1,16 +1,17 @@
 """The RLAnimate agent (paper Section 3.1): portrayal, behaviour and animation models, and a decoder.
 
-Timing of one rollout (the environment plays a_t and returns the real description d'_t):
+Timing of one rollout step (the environment plays a_t and returns the real description d'_t):
 
-    t:            1                     2                     3
-    o_t           o_1                   o_2                   o_3          objective (task module)
-    d_t        d_1 = g(o_1)          d_2 = g(o_2)          d_3 = g(o_3)    portrayal: self-description
-    h_t   h_0 --> h_1 --------------> h_2 --------------> h_3              h_t = f1(h_{t-1}, o_t)
-    e_t   e_0 --> e_1 --------------> e_2 --------------> e_3              e_t = f2(e_{t-1}; h_t, z_{t-1}, a_{t-1})
-                   |  ^               ^|  ^
-    z_t          z_1 ~ q(.|e_1,d_1) --'|  |                                posterior; prior p(z_t | e_t)
-    a_t          a_1 ~ Beta(h_1,e_1,z_1)--'                                animation model, a_t in [0, 1]^45
-    d'_t         d'_1 = FK(a_1)        d'_2                  d'_3          environment; decoder(h_t, e_t, z_t) ~ d'_t
+                  frame t-1                  frame t
+    objective     o_{t-1}                    o_t
+    portrayal     d_{t-1}                    d_t = g(o_t)                               self-description
+    task state    h_{t-1} -----------------> h_t = f1(h_{t-1}, o_t)
+    behaviour     e_{t-1} -----------------> e_t = f2(e_{t-1}; h_t, z_{t-1}, a_{t-1})
+                  z_{t-1} ------------------------------------^   |
+                  a_{t-1} ------------------------------------^   v
+                                             z_t ~ q(z_t | e_t, d_t)                    prior p(z_t | e_t)
+    animation                                a_t ~ Beta(h_t, e_t, z_t)                  played at frame t
+    environment   d'_{t-1} = FK(a_{t-1})     d'_t = FK(a_t)           decoder(h_t, e_t, z_t) predicts d'_t
 
 Everything indexed t is computed at frame t from o_t and from the previous frame's z_{t-1} and
 a_{t-1}; a_t is the pose played at frame t and d'_t is the description of that pose. The

@@ -63,7 +63,8 @@ def gru_shapes(name, inputs, size, suffix=""):
 def expected_weight_shapes(agent_config, variant):
     """{array name: shape} of an agent with `agent_config` (a dict of AgentConfig fields) and `variant`."""
     if variant not in VARIANTS:
-        raise RLAnimateError(f"Unknown agent variant {variant!r}: the file must name one of {', '.join(VARIANTS)}.")
+        raise RLAnimateError(f"Unknown agent variant {variant!r}: the file must name one of "
+                             f"{', '.join(VARIANTS)}.")
     c = agent_config
     O, D, A = spaces.OBJECTIVE_SIZE, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
     E, Z, hid, n = c["behaviour_size"], c["stochastic_size"], c["hidden_size"], c["hidden_layers"]

@@ -118,8 +118,8 @@ class GestureAgent:
         objectives = np.asarray(objectives, dtype=np.float64)
         if objectives.ndim != 2 or objectives.shape[1] != spaces.OBJECTIVE_SIZE or len(objectives) == 0 \
                 or not np.all(np.isfinite(objectives)):
-            raise RLAnimateError(f"The agent needs finite objectives of shape (frames, {spaces.OBJECTIVE_SIZE}), "
-                                 f"got {objectives.shape}: give the gesture at least one frame and a valid target.")
+            raise RLAnimateError(f"The agent needs finite objectives of shape (frames, {spaces.OBJECTIVE_SIZE}), got "
+                                 f"{objectives.shape}: give the gesture at least one frame and a valid target.")
         rng = None if seed is None else np.random.default_rng(seed)
         E, Z = self._sizes
         A = spaces.ACTION_SIZE

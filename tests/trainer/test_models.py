@@ -111,7 +111,8 @@ def test_portrayal_direct_loss_can_be_switched_off():
     agent = RLAnimateAgent(config)
     batch = synthetic_batch(4, 8)
     assert float(agent.losses(batch, train)["portrayal"].detach()) > 0.0
-    assert float(agent.losses(batch, dataclasses.replace(train, portrayal_direct_loss=False))["portrayal"].detach()) == 0.0
+    switched_off = dataclasses.replace(train, portrayal_direct_loss=False)
+    assert float(agent.losses(batch, switched_off)["portrayal"].detach()) == 0.0
 
 
 def test_supervised_variant_clones_the_clip_without_kl():
@@ -122,7 +123,8 @@ def test_supervised_variant_clones_the_clip_without_kl():
     losses = agent.losses(batch, train)
     assert float(losses["l2"]) == 0.0
     torch.manual_seed(1)
-    changed = dict(batch, action=torch.rand_like(batch["action"]), description=torch.rand_like(batch["description"]))
+    changed = dict(batch, action=torch.rand_like(batch["action"]),
+                   description=torch.rand_like(batch["description"]))
     torch.manual_seed(1)
     same = agent.losses(batch, train)
     torch.manual_seed(1)
