@@ -334,8 +334,8 @@ def main(argv=None):
     except RLAnimateError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
-    provenance = ", ".join(f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes")
-                           if k in training) or "untrained"
+    provenance = "untrained" if training.get("untrained") else ", ".join(
+        f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
     write_results(options.results, "sample library",
                   f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
                   f"RLAnimate: `{Path(options.agent).name}` ({provenance}). "
