@@ -141,13 +141,14 @@ class Trainer:
 
     def run_epoch(self):
         """One iteration of Algorithm 1; appends and returns its metrics."""
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), time.process_time()
         self.collect()
         collected = time.perf_counter()
         losses = self.update()
         self.epoch += 1
         metrics = {"epoch": self.epoch, "episodes": len(self.buffer), "frames": self.buffer.frames,
-                   "learning_rate": self.optimizer.param_groups[0]["lr"], "collect_seconds": collected - start, "update_seconds": time.perf_counter() - collected,
+                   "learning_rate": self.optimizer.param_groups[0]["lr"], "collect_seconds": collected - start,
+                   "update_seconds": time.perf_counter() - collected, "cpu_seconds": time.process_time() - cpu_start,
                    **{f"loss/{name}": value for name, value in losses.items()}}
         self.history.append(metrics)
         return metrics

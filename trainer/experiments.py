@@ -113,13 +113,14 @@ def table4_markdown(table, seen, settings):
             entry = columns.get(column)
             cells += [f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}"] if entry else ["-", "-"]
         lines.append(f"| {plots.METHOD_LABELS[method]} | " + " | ".join(cells) + " |")
-    lines += ["", "Sample episodes and training time (s) per run; score on 10 training (seen) clips:", "",
-              "| method | column | episodes | train seconds | seen score | seen smooth. |", "|---|---|---|---|---|---|"]
+    lines += ["", "Sample episodes, training time (wall clock and CPU seconds, on a machine shared with other "
+              "jobs) and score on 10 training (seen) clips per run:", "",
+              "| method | column | episodes | wall s | CPU s | seen score | seen smooth. |", "|---|---|---|---|---|---|---|"]
     for method, columns in table.items():
         for column, entry in columns.items():
             lines.append(f"| {plots.METHOD_LABELS[method]} | {column} | {entry['episodes']} | "
-                         f"{entry['train_seconds']:.0f} | {seen[method][column]['score']:.2f} | "
-                         f"{seen[method][column]['smoothness']:.2f} |")
+                         f"{entry['train_seconds']:.0f} | {seen[method][column]['cpu_seconds']:.0f} | "
+                         f"{seen[method][column]['score']:.2f} | {seen[method][column]['smoothness']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
@@ -135,7 +136,7 @@ def write_table_and_figures(options, results):
             table.setdefault(method, {})[column] = {
                 "score": report["held_out"]["score"], "smoothness": report["held_out"]["smoothness"],
                 "episodes": report["episodes"], "train_seconds": report["train_seconds"]}
-            seen.setdefault(method, {})[column] = report["training"]
+            seen.setdefault(method, {})[column] = {**report["training"], "cpu_seconds": report["train_cpu_seconds"]}
             histories.setdefault(method, {})[column] = history
     settings = (f"Preset `{options.preset}`, seed {options.seed}, epochs = {options.epoch_scale:g} x the paper's "
                 f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1). "

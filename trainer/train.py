@@ -209,10 +209,12 @@ def _flatten(evaluation):
 
 def _report(args, trainer, final, epochs):
     seconds = sum(e["collect_seconds"] + e["update_seconds"] for e in trainer.history)
+    cpu_seconds = sum(e["cpu_seconds"] for e in trainer.history)
     return {
         "behaviour": args.behaviour, "variant": args.variant, "preset": args.preset, "seed": args.seed,
         "clips": str(manifest_path(args.clips)), "epochs": epochs, "episodes": len(trainer.buffer),
-        "frames": trainer.buffer.frames, "train_seconds": seconds, "torch_threads": torch.get_num_threads(),
+        "frames": trainer.buffer.frames, "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
+        "torch_threads": torch.get_num_threads(),
         "held_out": final["unseen"], "training": final["seen"],
         "final_losses": {k[5:]: v for k, v in trainer.history[-1].items() if k.startswith("loss/")},
     }
@@ -238,7 +240,8 @@ def _write_report(report, output):
     lines = [f"# RLAnimate agent: {report['variant']}, {report['behaviour']}", "",
              f"Preset `{report['preset']}`, seed {report['seed']}, {report['epochs']} epochs (iterations of "
              f"Algorithm 1), {report['episodes']} sample episodes ({report['frames']} frames), "
-             f"{report['train_seconds'] / 60:.1f} min of training on {report['torch_threads']} torch thread(s). "
+             f"{report['train_seconds'] / 60:.1f} min of training (wall clock; {report['train_cpu_seconds'] / 60:.1f} "
+             f"min of CPU time) with {report['torch_threads']} torch thread(s) on a machine shared with other jobs. "
              f"Clips: `{Path(report['clips']).relative_to(REPO_ROOT) if Path(report['clips']).is_relative_to(REPO_ROOT) else report['clips']}`.",
              "", "| clip set | clips | score | smoothness |", "|---|---|---|---|"]
     for label, key in (("held-out (unseen)", "held_out"), ("training (seen)", "training")):
