@@ -118,11 +118,12 @@ def _continuous_quaternions(rotvecs):
 
 
 def bake_clip(rig, clip, name):
-    """A new action on `rig` with quaternion keys for every bone the clip animates, frames 1..F."""
+    """A new action on `rig` with quaternion keys for every bone the clip animates, frames 0..F-1
+    (FBX time 0 onwards, as Mixamo files start; Blender's importer shows them as frames 1..F)."""
     from rlanimate_addon.blender import action_adapter
 
     target = action_adapter.new_action(name, rig)
-    frames = np.arange(1, clip.frames + 1)
+    frames = np.arange(clip.frames)
     for bone, rotvecs in clip.rotvecs.items():
         path = f'pose.bones["{skeleton.PREFIX}{bone}"].rotation_quaternion'
         quats = _continuous_quaternions(rotvecs)
@@ -136,7 +137,7 @@ def export_fbx(bpy, rig, path, frames):
     """Export the rig's active action as a Mixamo-style FBX (armature only, baked, 30 fps)."""
     scene = bpy.context.scene
     scene.render.fps, scene.render.fps_base = FPS, 1.0
-    scene.frame_start, scene.frame_end = 1, frames
+    scene.frame_start, scene.frame_end = 0, frames - 1
     bpy.context.view_layer.update()
     for obj in bpy.context.view_layer.objects:
         obj.select_set(obj == rig)
