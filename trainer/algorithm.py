@@ -114,7 +114,7 @@ class Trainer:
         """This epoch's Adam step size: cosine from learning_rate down to learning_rate_final over the
         planned epochs, or constant when the config or the trainer gives no final rate or no length."""
         config = self.train_config
-        final = getattr(config, "learning_rate_final", None)
+        final = config.learning_rate_final
         if final is None or not self.epochs:
             return config.learning_rate
         progress = min(self.epoch / self.epochs, 1.0)

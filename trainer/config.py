@@ -41,6 +41,7 @@ class TrainConfig:
     chunk_count: int = 16  # C: chunks per update
     chunk_length: int = 32  # L: frames per chunk
     learning_rate: float = 1e-3  # Adam
+    learning_rate_final: float = None  # cosine decay to this over the run's epochs (None: constant)
     grad_clip: float = 100.0  # global gradient-norm clip
     free_nats: float = 1.0  # L2: KL below this (nats per frame) is not penalised
     kl_balance: float = 0.8  # L2: weight of the KL's gradient into the prior (1 - it into the posterior)
@@ -71,7 +72,8 @@ PRESETS = {
                     portrayal_hidden_size=8, hidden_layers=1),
         TrainConfig(epochs_single=2, epochs_both=2, update_steps=3, chunk_count=4, chunk_length=8),
     ),
-    "default": (AgentConfig(), TrainConfig()),
+    "default": (AgentConfig(), TrainConfig(update_steps=30, chunk_count=32, learning_rate=3e-3,
+                                           learning_rate_final=1e-4)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),
