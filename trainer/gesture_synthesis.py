@@ -49,7 +49,6 @@ _REST = {b.name: skeleton.rest_frame(b) for b in skeleton.BONES}
 _HEAD = {b.name: np.asarray(b.head, dtype=np.float64) for b in skeleton.BONES}
 _REST_LOCAL = {n: _REST[n] if p is None else _REST[p].T @ _REST[n] for n, p in _PARENT.items()}
 _OFFSET = {n: None if p is None else _REST[p].T @ (_HEAD[n] - _HEAD[p]) for n, p in _PARENT.items()}
-_EYE_MIDPOINT = 0.5 * (_HEAD["LeftEye"] + _HEAD["RightEye"])
 
 
 def _length(child, parent):
@@ -194,7 +193,7 @@ def keyed_progress(times, knots):
 def _blend(name, start, end, progress):
     """Local rotations (T, 3, 3) of bone `name` from start (3, 3) to end ((T,) 3, 3) at progress (T,),
     which may leave [0, 1] for anticipation and overshoot. The bone's direction moves along a great
-    circle (so a raised hand travels on a natural arc) while its roll turns evenly."""
+    circle while its roll turns evenly (swing-twist), so no bone wobbles off its path."""
     rest = _REST_LOCAL[name]
     first, last = rest @ start, rest @ end  # orientations in the parent's frame
     y0, y1 = first[..., :, 1], last[..., :, 1]
@@ -264,10 +263,11 @@ _POINTING_HAND = {"Thumb": (0.35, 0.55, 0.6), "Index": (0.0,), "Middle": (1.35, 
 _SPREAD = {"Thumb": 0.0, "Index": 0.0, "Middle": 0.0, "Ring": -0.04, "Pinky": -0.1}
 
 
-def _shape_hand(pose, arm, shape, spread=0.0):
+def _shape_hand(pose, arm, shape, spread=False):
+    """Give the arm's fingers a hand shape (curl angles per finger), fanned out when `spread`."""
     side, sign = _side(arm), _SIDE_SIGN[arm]
     for finger, angles in shape.items():
-        _curl(pose, side, finger, angles, sign * spread * _SPREAD[finger] / 0.1 if spread else 0.0)
+        _curl(pose, side, finger, angles, sign * _SPREAD[finger] if spread else 0.0)
 
 
 def _pose_neutral_arm(pose, arm):
@@ -282,7 +282,7 @@ def _pose_neutral_arm(pose, arm):
     # Palm faces the thigh and a little back; the hand's local Z is minus the palm normal.
     hand = _frame_from([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], hand_y, [sign * 1.0, -0.25, 0.0])
     _place_arm(pose, arm, elbow, wrist, hand)
-    _shape_hand(pose, arm, _RELAXED_HAND, spread=0.1)
+    _shape_hand(pose, arm, _RELAXED_HAND, spread=True)
 
 
 def _neutral():
@@ -499,7 +499,7 @@ def _wave_pose(arm, exaggeration, style, phase, envelope):
     hand_y = in_plane(fore_angle + flap + 0.06)
     hand = _frame_from([0.0, 1.0, 0.0], [0.0, 0.0, 1.0], hand_y, np.broadcast_to(-palm_forward, hand_y.shape))
     _place_arm(pose, arm, elbow, wrist, hand)
-    _shape_hand(pose, arm, _OPEN_HAND, spread=0.1)
+    _shape_hand(pose, arm, _OPEN_HAND, spread=True)
     return pose
 
 
