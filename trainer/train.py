@@ -51,7 +51,8 @@ def build_parser():
     parser.add_argument("--clips", default=str(DEFAULT_MANIFEST),
                         help="clip library: a manifest.json or the folder that holds one")
     parser.add_argument("--epochs", type=int, default=None,
-                        help="iterations of Algorithm 1 (default: the preset's, else 50 for one behaviour, 100 for both)")
+                        help="iterations of Algorithm 1 (default: the preset's, the paper's 50 for one behaviour "
+                             "and 100 for both; on --resume, the run's own)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--output", default=str(DEFAULT_OUTPUT))
     parser.add_argument("--preset", default="default", help="config preset: debug, default or paper")
@@ -72,8 +73,7 @@ def manifest_path(clips):
 
 
 def default_epochs(train_config, behaviour):
-    configured = getattr(train_config, "epochs_both" if behaviour == "both" else "epochs_single", None)
-    return int(configured) if configured else PAPER_EPOCHS[behaviour]
+    return train_config.epochs_both if behaviour == "both" else train_config.epochs_single
 
 
 def seed_everything(seed):
@@ -152,6 +152,7 @@ def run(args, session=None):
         saved = checkpoint.load(output / checkpoint.FILENAME)
         for name in RESUMED_SETTINGS:
             setattr(args, name, saved["arguments"][name])
+        args.epochs = args.epochs or saved["arguments"]["epochs"]
     agent_config, train_config = load_preset(args.preset)
     session = session or Session(manifest_path(args.clips))
     epochs = args.epochs or default_epochs(train_config, args.behaviour)
@@ -162,7 +163,7 @@ def run(args, session=None):
                       references=session.references, epochs=epochs)
     if saved is not None:
         trainer.load_state_dict(saved["trainer"])
-    arguments = {name: getattr(args, name) for name in RESUMED_SETTINGS}
+    arguments = {**{name: getattr(args, name) for name in RESUMED_SETTINGS}, "epochs": epochs}
     log = MetricsLog(output, trainer.history)
     bar = tqdm(range(trainer.epoch, epochs), initial=trainer.epoch, total=epochs, disable=args.quiet,
                desc=f"{args.variant} {args.behaviour}", unit="epoch", dynamic_ncols=True)

@@ -1,4 +1,5 @@
 """Checkpoints: atomic, plain data, clear errors; and a resumed run equals the uninterrupted one bit for bit."""
+import dataclasses
 import random
 from types import SimpleNamespace
 
@@ -9,8 +10,10 @@ import torch
 from rlanimate_addon.core.errors import RLAnimateError
 from tests.trainer.synthetic_library import make_library
 from trainer import checkpoint, train
-from trainer.algorithm import ClipReferences
+from trainer.algorithm import ClipReferences, Trainer
+from trainer.config import load_preset
 from trainer.fk_env import FKEnvironment
+from trainer.models import RLAnimateAgent
 
 torch.set_num_threads(1)
 
@@ -80,3 +83,31 @@ def test_resumed_run_equals_the_uninterrupted_run(session, tmp_path):
     assert [e["loss/total"] for e in a["history"]] == [e["loss/total"] for e in b["history"]]
     lines = (tmp_path / "resumed" / "metrics.jsonl").read_text().splitlines()
     assert len(lines) == 4  # the metrics log is rebuilt from the checkpoint, not duplicated
+
+
+def test_a_run_killed_mid_schedule_resumes_exactly(session, tmp_path):
+    """Kill after 2 of 4 planned epochs (learning rate mid-decay), rebuild from the file, continue."""
+    agent_config, train_config = load_preset("debug")
+    train_config = dataclasses.replace(train_config, learning_rate=3e-3, learning_rate_final=1e-4)
+
+    def fresh_trainer():
+        torch.manual_seed(0)
+        return Trainer(RLAnimateAgent(agent_config), session.env, session.train_clips, train_config, "both",
+                       seed=8, references=session.references, epochs=4)
+
+    straight = fresh_trainer()
+    for _ in range(4):
+        straight.run_epoch()
+    killed = fresh_trainer()
+    for _ in range(2):
+        killed.run_epoch()
+    checkpoint.save(tmp_path / checkpoint.FILENAME, killed.state_dict(), {})
+    torch.manual_seed(123)  # the new process's RNGs are whatever they are
+    resumed = fresh_trainer()
+    resumed.load_state_dict(checkpoint.load(tmp_path / checkpoint.FILENAME)["trainer"])
+    for _ in range(2):
+        resumed.run_epoch()
+    assert [e["learning_rate"] for e in resumed.history] == [e["learning_rate"] for e in straight.history]
+    assert resumed.history[1]["learning_rate"] < train_config.learning_rate  # the schedule was decaying
+    a, b = straight.agent.state_dict(), resumed.agent.state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
