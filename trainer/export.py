@@ -54,7 +54,7 @@ def export_agent(agent, path, metadata=None):
     }
     arrays = {name: tensor.detach().cpu().numpy().astype(np.float32)
               for name, tensor in agent.state_dict().items()}
-    arrays[agent_file.METADATA_KEY] = np.array(json.dumps(full, indent=1, sort_keys=True))
+    arrays[agent_file.METADATA_KEY] = np.array(json.dumps(full, indent=1, sort_keys=True, default=_json_value))
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     temporary = path.with_name(f".{path.name}.{os.getpid()}.tmp")
@@ -67,6 +67,13 @@ def export_agent(agent, path, metadata=None):
     finally:
         temporary.unlink(missing_ok=True)
     return full
+
+
+def _json_value(value):
+    """numpy scalars and arrays in the metadata, as JSON numbers and lists."""
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    raise TypeError(f"Agent metadata must be JSON data; got {type(value).__name__}")
 
 
 def _spaces():

@@ -27,7 +27,7 @@ def test_round_trip_keeps_every_weight_and_the_metadata(tmp_path, variant):
     path = tmp_path / "agent.npz"
     export_agent(agent, path, {"train_config": train_config, "average_frames": {"POINT": 84, "WAVE": 101.5},
                                "action_bounds": bounds, "training": {"seed": 3, "epochs": 7, "clips": "x"},
-                               "evaluation": {"held_out_score": 99.1}})
+                               "evaluation": {"held_out_score": 99.1, "episodes": np.int64(200)}})
     weights, metadata = load_agent_file(path)
     state = agent.state_dict()
     assert set(weights) == set(state)
@@ -43,7 +43,7 @@ def test_round_trip_keeps_every_weight_and_the_metadata(tmp_path, variant):
     np.testing.assert_allclose(metadata["action_bounds"], bounds)
     assert metadata["training"]["seed"] == 3 and metadata["training"]["epochs"] == 7
     assert metadata["training"]["date"] and "git_commit" in metadata["training"]
-    assert metadata["evaluation"] == {"held_out_score": 99.1}
+    assert metadata["evaluation"] == {"held_out_score": 99.1, "episodes": 200}
     assert metadata["spaces"]["action_joints"] == list(skeleton.ACTION_JOINTS)
     assert metadata["spaces"]["action_size"] == spaces.ACTION_SIZE
     assert metadata["rig"]["required_bones"] == list(skeleton.REQUIRED_BONES)

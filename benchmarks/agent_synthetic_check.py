@@ -1,0 +1,76 @@
+"""A quick learning check of the agent without Blender: Algorithm 1 on a synthetic clip library.
+
+Run: `nice -n 10 python benchmarks/agent_synthetic_check.py [VARIANT] [EPOCHS] [--no-portrayal-loss]`
+
+It trains the both-behaviour agent of the `default` preset with trainer/algorithm.py, but plays
+actions through the numpy forward kinematics of the canonical skeleton (rlanimate_addon/core/
+kinematics.py) instead of the bpy FK environment, on the synthetic library of the trainer tests
+(20 training clips per behaviour, one held-out clip per behaviour and arm). It prints held-out
+and seen score / smoothness and the losses every 10 epochs. It is a check of the models and losses
+in minutes, not the paper's experiment (that is trainer/train.py on the sample clip library).
+"""
+import argparse
+import dataclasses
+import sys
+import time
+from pathlib import Path
+from types import SimpleNamespace
+
+REPO_ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO_ROOT))
+sys.path.insert(0, str(REPO_ROOT / "tests" / "trainer"))
+
+import numpy as np  # noqa: E402
+import torch  # noqa: E402
+
+import synthetic_library  # noqa: E402
+from rlanimate_addon.core import kinematics, skeleton, spaces  # noqa: E402
+from trainer import evaluate  # noqa: E402
+from trainer.algorithm import ClipReferences, Trainer  # noqa: E402
+from trainer.config import load_preset  # noqa: E402
+from trainer.models import VARIANTS, RLAnimateAgent  # noqa: E402
+
+
+class NumpyFKEnvironment:
+    """The FK environment's `evaluate` on the canonical skeleton, in numpy."""
+
+    def evaluate(self, rotvecs):
+        rotvecs = np.asarray(rotvecs)  # (P, 15, 3)
+        pose = kinematics.pose_matrices({j: rotvecs[:, k] for k, j in enumerate(skeleton.ACTION_JOINTS)})
+        heads = kinematics.head_positions(pose)  # (P, B, 3)
+        positions = {bone: heads[:, kinematics.bone_index(bone)] for bone in skeleton.BONE_NAMES}
+        eyes = {eye: pose[:, kinematics.bone_index(eye), :3, 1] for eye in ("LeftEye", "RightEye")}
+        descriptions = spaces.describe(positions, eyes)  # (P, 42)
+        return SimpleNamespace(descriptions=descriptions,
+                               joint_positions=spaces.description_joint_positions(descriptions))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("variant", nargs="?", default="rlanimate", choices=VARIANTS)
+    parser.add_argument("epochs", nargs="?", type=int, default=40)
+    parser.add_argument("--no-portrayal-loss", action="store_true")
+    args = parser.parse_args()
+    torch.set_num_threads(1)
+    torch.manual_seed(0)
+    library = synthetic_library.make_library(seed=0, per_behaviour=20)
+    agent_config, train_config = load_preset("default")
+    train_config = dataclasses.replace(train_config, portrayal_direct_loss=not args.no_portrayal_loss)
+    env = NumpyFKEnvironment()
+    references = ClipReferences(env)
+    agent = RLAnimateAgent(agent_config, args.variant)
+    trainer = Trainer(agent, env, library.train, train_config, "both", 0, references=references)
+    start = time.perf_counter()
+    for epoch in range(1, args.epochs + 1):
+        metrics = trainer.run_epoch()
+        if epoch % 10 == 0 or epoch == args.epochs:
+            unseen = evaluate.evaluate_clips(agent, env, library.test, references)
+            seen = evaluate.evaluate_clips(agent, env, library.train[:10], references)
+            losses = " ".join(f"{k[5:]} {v:.3g}" for k, v in metrics.items() if k.startswith("loss/"))
+            print(f"epoch {epoch} ({time.perf_counter() - start:.0f} s): held-out {unseen['score']:.2f} / "
+                  f"{unseen['smoothness']:.2f}, seen {seen['score']:.2f} / {seen['smoothness']:.2f}; {losses}",
+                  flush=True)
+
+
+if __name__ == "__main__":
+    main()
