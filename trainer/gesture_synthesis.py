@@ -40,6 +40,7 @@ ANIMATED_BONES = tuple(skeleton.ACTION_JOINTS) + tuple(b for b in FINGER_BONES i
 _UP = np.array([0.0, 0.0, 1.0])
 _FORWARD = np.array([0.0, -1.0, 0.0])
 _SIDE_SIGN = {"LEFT": 1.0, "RIGHT": -1.0}  # +X is the character's left
+_OTHER_ARM = {"LEFT": "RIGHT", "RIGHT": "LEFT"}
 
 # ---------------------------------------------------------------------------------------------
 # Rest geometry and a small batched pose evaluator (same convention as core.kinematics).
@@ -270,12 +271,13 @@ def _shape_hand(pose, arm, shape, spread=False):
         _curl(pose, side, finger, angles, sign * _SPREAD[finger] if spread else 0.0)
 
 
-def _pose_neutral_arm(pose, arm):
-    """Arm hanging relaxed: slightly away from the hip, elbow bent ~16 deg, palm towards the thigh."""
+def _pose_neutral_arm(pose, arm, elbow_bend=0.28):
+    """Arm hanging relaxed under gravity from wherever the shoulder is: slightly away from the hip,
+    elbow bent `elbow_bend` rad (~16 deg), palm towards the thigh."""
     side, sign = _side(arm), _SIDE_SIGN[arm]
     shoulder = pose.head(side + "Arm")
     upper_dir = _unit([sign * 0.16, -0.03, -1.0])
-    fore_dir = _unit(upper_dir * np.cos(0.28) + _perpendicular(_FORWARD, upper_dir) * np.sin(0.28))
+    fore_dir = _unit(upper_dir * np.cos(elbow_bend) + _perpendicular(_FORWARD, upper_dir) * np.sin(elbow_bend))
     elbow = shoulder + _length(side + "ForeArm", side + "Arm") * upper_dir
     wrist = elbow + _length(side + "Hand", side + "ForeArm") * fore_dir
     hand_y = _unit(fore_dir * np.cos(0.12) + _perpendicular(_FORWARD, fore_dir) * np.sin(0.12))
@@ -417,6 +419,8 @@ def _pointing_hold(arm, target, style):
 
     # Gaze leads to the target; the eyes follow the head.
     _aim_head(pose, np.asarray(target, dtype=np.float64), tilt=0.3 * style.head_tilt * -sign)
+    # The free arm keeps hanging under gravity however the torso turns and leans, elbow a bit softer.
+    _pose_neutral_arm(pose, _OTHER_ARM[arm], elbow_bend=0.36)
 
     # Clavicle: rises once the arm is above the shoulder, comes forward for targets ahead/across.
     rise = 0.32 * max(elevation + 0.1, 0.0)
@@ -475,6 +479,7 @@ def _wave_pose(arm, exaggeration, style, phase, envelope):
     _turn_torso(pose, lean[:, None] * np.array([0.0, 1.0, 0.0]))
     _aim_head(pose, _ADDRESSEE + np.array([0.0, 0.0, 0.25 * e]),
               tilt=np.full(phase.shape, -sign * style.head_tilt * (0.7 + 0.6 * e)))
+    _pose_neutral_arm(pose, _OTHER_ARM[arm], elbow_bend=0.32)
 
     amplitude = (0.22 + 0.38 * e) * envelope                       # forearm sway, rad
     upper_amplitude = (0.08 + 0.42 * e) * amplitude                # whole-arm involvement
@@ -516,7 +521,9 @@ _GROUPS = {  # body part -> bones whose timing it sets (the other arm's bones st
 
 
 def _group_bones(group, arm):
-    if group in ("torso", "gaze"):
+    if group == "torso":  # the free arm re-hangs as the torso moves
+        return _GROUPS[group] + tuple(_side(_OTHER_ARM[arm]) + b for b in ("Arm", "ForeArm", "Hand"))
+    if group == "gaze":
         return _GROUPS[group]
     return tuple(_side(arm) + b for b in _GROUPS[group])
 
