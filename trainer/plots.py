@@ -19,14 +19,16 @@ def training_curves(history, path, title=""):
     figure, (losses, scores) = plt.subplots(1, 2, figsize=(11, 4))
     for key in sorted({k for entry in history for k in entry if k.startswith("loss/")}):
         epochs, values = _series(history, key)
-        losses.plot(epochs, [max(v, 1e-8) for v in values], label=key[5:])
-    losses.set_yscale("log")
+        losses.plot(epochs, values, label=key[5:])
+    losses.set_yscale("symlog", linthresh=1e-3)  # some terms (the Beta NLL) go negative
     losses.set_xlabel("epoch")
     losses.set_title("losses (mean over the epoch's update steps)")
     losses.legend(fontsize=8)
     for split, style in (("seen", "-o"), ("unseen", "-s")):
         epochs, values = _series(history, f"{split}/score")
         scores.plot(epochs, values, style, markersize=3, label=f"{split} clips")
+    if scores.lines:
+        scores.set_ylim(0, 100.5)
     scores.set_xlabel("epoch")
     scores.set_ylabel("score")
     scores.set_title("score (deterministic rollouts)")
@@ -50,8 +52,8 @@ def figure3(histories, path, split):
         axis.set_title(COLUMN_LABELS[column])
         axis.set_xlabel("epoch")
         axis.set_ylabel("score")
-        axis.set_ylim(bottom=max(axis.get_ylim()[0], 0))
         if axis.lines:
+            axis.set_ylim(0, 100.5)  # early scores can be far below 0 (the log penalty); 0-100 shows the race
             axis.legend(fontsize=8)
     which = "clips from the training set" if split == "seen" else "clips excluded from the training set"
     figure.suptitle(f"Imitating {which}")
