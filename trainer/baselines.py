@@ -258,7 +258,8 @@ def generate_for(baseline, clips):
 
 
 METHOD_LABELS = {"rlanimate": "RLAnimate", "nearest_clip": "Nearest clip", "procedural_ik": "Procedural IK"}
-METRIC_LABELS = {"score": "score", "smoothness": "smoothness", "forearm_angle_deg": "forearm angle at hold (deg)"}
+METRIC_LABELS = {"score": "score", "smoothness": "smoothness", "label_error": "label error (autolabel)",
+                 "forearm_angle_deg": "forearm angle at hold (deg)"}
 
 
 def write_results(results_dir, section, description, sets):
@@ -287,13 +288,16 @@ def write_results(results_dir, section, description, sets):
                       "|---|" + "---|" * len(metric_names)]
             for method, row in methods.items():
                 lines.append(f"| {METHOD_LABELS.get(method, method)} | "
-                             + " | ".join(f"{row[m]:.2f}" for m in metric_names) + " |")
+                             + " | ".join(f"{row[m]:.3g}" if m == "label_error" else f"{row[m]:.2f}"
+                                          for m in metric_names) + " |")
             lines.append("")
     (results_dir / "baselines.md").write_text("\n".join(lines))
 
 
 def sample_library_comparison(agent_path, manifest):
-    """{set: {method: {score, smoothness, clips}}} on the sample library's held-out clips, per behaviour."""
+    """{set: {method: {score, smoothness[, label_error]}}} on the sample library's held-out clips, per
+    behaviour; for waves the label error compares the auto-labels of the generated and the real clip
+    (the library's own exaggeration scale is the generator's, not autolabel's)."""
     from .algorithm import ClipReferences
     from .evaluate import select_clips
     from .train import Session
@@ -305,10 +309,16 @@ def sample_library_comparison(agent_path, manifest):
     sets = {}
     for behaviour in ("point", "wave"):
         clips = select_clips(session.test_clips, behaviour)
-        sets[f"{behaviour}, held-out clips ({len(clips)})"] = {
-            name: {key: result[key] for key in ("score", "smoothness")}
-            for name, result in ((name, evaluate_motions(session.env, generate_for(method, clips), clips, references))
-                                 for name, method in methods.items())}
+        rows = {}
+        for name, method in methods.items():
+            motions = generate_for(method, clips)
+            result = evaluate_motions(session.env, motions, clips, references)
+            rows[name] = {key: result[key] for key in ("score", "smoothness")}
+            if behaviour == "wave":
+                rows[name]["label_error"] = float(np.mean([
+                    abs(autolabel.label_wave(m).exaggeration - autolabel.label_wave(c.rotvecs).exaggeration)
+                    for m, c in zip(motions, clips)]))
+        sets[f"{behaviour}, held-out clips ({len(clips)})"] = rows
     return sets, methods["rlanimate"].agent.metadata.get("training", {})
 
 

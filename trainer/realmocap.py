@@ -174,9 +174,17 @@ def train_agent(session, name, behaviour, epochs, preset, seed, runs=RUNS_DIR):
 
 
 def compare(methods, clips, env, references):
-    """{method: evaluate_motions result} on `clips`."""
-    return {name: baselines.evaluate_motions(env, baselines.generate_for(method, clips), clips, references)
-            for name, method in methods.items()}
+    """{method: evaluate_motions result} on `clips`; for waves also `label_error`, the mean
+    |autolabel exaggeration of the generated wave - requested exaggeration| (does it portray the label?)."""
+    results = {}
+    for name, method in methods.items():
+        motions = baselines.generate_for(method, clips)
+        result = baselines.evaluate_motions(env, motions, clips, references)
+        if all(c.behaviour == "WAVE" for c in clips):
+            result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
+                                                   for m, c in zip(motions, clips)]))
+        results[name] = result
+    return results
 
 
 def label_table(clips):
@@ -252,7 +260,8 @@ def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
 
 
 def _summary(result):
-    return {"score": result["score"], "smoothness": result["smoothness"], "clips": len(result["clips"])}
+    return {"clips": len(result["clips"]),
+            **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result}}
 
 
 def run_experiments(options):
@@ -339,16 +348,18 @@ def realmocap_markdown(results):
         lines.append(f"| {style} | {row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f} | {row['elevation_deg']:.0f} | "
                      f"{row['stroke_arm_lengths']:.2f} | {row['arm_correct']}/{row['clips']} |")
     lines += ["", "Goodbye waves: " + ", ".join(f"{s} {r['exaggeration']:.2f}" for s, r in results["labels"]["bye"].items()), ""]
-    lines += ["## Score and smoothness", "", "| experiment | test set | method | score | smoothness |", "|---|---|---|---|---|"]
+    lines += ["## Score and smoothness", "",
+              "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
+              "| experiment | test set | method | score | smoothness | label error |", "|---|---|---|---|---|---|"]
     for name, label in (("wave", "wave agent, takes 001-008 (112 clips)"),
                         ("holdout", f"wave agent, 5 styles (100 clips; unseen: {', '.join(HOLDOUT_STYLES)})")):
         entry = results[name]
         for set_name in ("test", "bye"):
             for method, result in entry.get(set_name, {}).items():
                 lines.append(f"| {label} | {set_name} ({len(result['clips'])}) | {baselines.METHOD_LABELS[method]} | "
-                             f"{result['score']:.2f} | {result['smoothness']:.2f} |")
+                             f"{result['score']:.2f} | {result['smoothness']:.2f} | {result['label_error']:.3f} |")
         lines.append(f"| {label} | seen (10 training clips) | RLAnimate | {entry['seen']['score']:.2f} | "
-                     f"{entry['seen']['smoothness']:.2f} |")
+                     f"{entry['seen']['smoothness']:.2f} | |")
     lines += ["", f"Training: wave agent {results['wave']['episodes']} episodes, {results['wave']['train_seconds']:.0f} s; "
               f"hold-out agent {results['holdout']['episodes']} episodes, {results['holdout']['train_seconds']:.0f} s "
               "(1 torch thread).", "",
