@@ -9,7 +9,7 @@ Arm: the one whose wrist travels further relative to its shoulder ("which hand m
 Wave exaggeration in [0, 1], from how high the arm goes and how wide the hand strokes:
     elevation_t  = angle between shoulder->wrist and straight down (0 hanging, 90 level, 180 overhead)
     elevation    = ELEVATION_PERCENTILE-th percentile of elevation_t over the clip (the raised arm)
-    raised       = frames with elevation_t >= rest + RAISED_SHARE * (elevation - rest)
+    raised       = frames with elevation_t >= low + RAISED_SHARE * (elevation - low), low = min elevation_t
     stroke       = 2 sqrt(2) RMS over `raised` of (wrist - shoulder) minus its centred moving average
                    over STROKE_WINDOW_S seconds, divided by L (peak-to-peak of a sinusoidal wave)
     exaggeration = clip(ELEVATION_WEIGHT * e + STROKE_WEIGHT * s, 0, 1), with
@@ -88,8 +88,8 @@ def _elevation(vectors):
 
 
 def _raised(elevation_t, elevation):
-    rest = float(np.min(elevation_t))
-    return elevation_t >= rest + RAISED_SHARE * (elevation - rest)
+    low = float(np.min(elevation_t))
+    return elevation_t >= low + RAISED_SHARE * (elevation - low)
 
 
 def _moving_average(values, window):
