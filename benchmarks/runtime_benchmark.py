@@ -4,7 +4,7 @@ Run: `nice -n 10 python benchmarks/runtime_benchmark.py`. It pins itself to one 
 `GestureAgent.rollout` (deterministic, and with a variation seed) on the shipped default agent and on
 default-size agents of the other variants, for gestures of 0.4x, 1x and 1.5x the default length,
 and the torch agent's rollout for reference. A frame's cost is the whole rollout's CPU time (precompute
-included) over its frames, the least of REPEATS rounds. It prints a markdown section
+included) over its frames, the least of REPEATS interleaved rounds. It prints a markdown section
 and replaces the "Numpy runtime" section of docs/BENCHMARKS.md with it (other sections are kept).
 """
 import os
@@ -33,7 +33,7 @@ from trainer.models import VARIANTS, RLAnimateAgent  # noqa: E402
 
 DEFAULT_AGENT = REPO_ROOT / "rlanimate_addon" / "agents" / "default.npz"
 LENGTH_SCALES = (0.4, 1.0, 1.5)
-REPEATS = 25
+REPEATS = 30
 BUDGET_US = 100.0
 COMMAND = "nice -n 10 python benchmarks/runtime_benchmark.py"
 HEADING = "## Numpy runtime"
@@ -41,15 +41,17 @@ BENCHMARKS_MD = REPO_ROOT / "docs" / "BENCHMARKS.md"
 LOAD_AT_START = os.getloadavg()[0]
 
 
-def best_seconds(run):
-    """Least CPU time of REPEATS calls of `run()`, in seconds (CPU time, not wall time: on the
-    shared machine a wall clock also counts the time other jobs hold the core)."""
-    times = []
+def least_cpu_seconds(runs):
+    """Least CPU time of each of `runs` (callables) over REPEATS rounds, interleaved so that a burst
+    of other jobs' load hits one round of every run rather than every round of one. CPU time, not
+    wall time: on the shared machine a wall clock also counts the time other jobs hold the core."""
+    best = [float("inf")] * len(runs)
     for _ in range(REPEATS):
-        start = time.process_time()
-        run()
-        times.append(time.process_time() - start)
-    return min(times)
+        for k, run in enumerate(runs):
+            start = time.process_time()
+            run()
+            best[k] = min(best[k], time.process_time() - start)
+    return best
 
 
 def agents(folder):
@@ -67,20 +69,25 @@ def agents(folder):
 def measure():
     """Rows of (label, frames, numpy us/frame, seeded numpy us/frame, torch us/frame or None)."""
     torch.set_num_threads(1)
-    rows = []
+    cases, runs = [], []
     with tempfile.TemporaryDirectory() as folder:
         for label, runtime, torch_agent in agents(folder):
             average = int(round(runtime.average_frames["POINT"]))
             for scale in LENGTH_SCALES:
                 frames = max(2, int(round(scale * average)))
                 objectives = spaces.make_objective("POINT", "RIGHT", [-0.3, -0.9, 0.2], frames)
-                numpy_us = best_seconds(lambda: runtime.rollout(objectives)) / frames * 1e6
-                seeded_us = best_seconds(lambda: runtime.rollout(objectives, seed=1)) / frames * 1e6
-                torch_us = None
+                cases.append((label, frames, torch_agent is not None))
+                runs.append(lambda r=runtime, o=objectives: r.rollout(o))
+                runs.append(lambda r=runtime, o=objectives: r.rollout(o, seed=1))
                 if torch_agent is not None:
                     batch = torch.as_tensor(objectives, dtype=torch.float32)[None]
-                    torch_us = best_seconds(lambda: torch_agent.rollout(batch)) / frames * 1e6
-                rows.append((label, frames, numpy_us, seeded_us, torch_us))
+                    runs.append(lambda a=torch_agent, b=batch: a.rollout(b))
+        seconds = iter(least_cpu_seconds(runs))
+    rows = []
+    for label, frames, has_torch in cases:
+        numpy_us, seeded_us = (next(seconds) / frames * 1e6 for _ in range(2))
+        torch_us = next(seconds) / frames * 1e6 if has_torch else None
+        rows.append((label, frames, numpy_us, seeded_us, torch_us))
     return rows
 
 
@@ -91,7 +98,7 @@ def section(rows):
         HEADING, "",
         "Cost per frame of the extension's numpy agent runtime (`GestureAgent.rollout`): a whole rollout",
         "(portrayal, task state and per-frame behaviour loop) divided by its frames, least CPU time of "
-        f"{REPEATS} rounds, one sequence per call, pinned to one CPU core; the torch agent's own",
+        f"{REPEATS} interleaved rounds, one sequence per call, pinned to one CPU core; the torch agent's own",
         "rollout for reference.", "",
         f"Regenerate: `{COMMAND}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average "
