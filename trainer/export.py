@@ -31,8 +31,8 @@ def export_agent(agent, path, metadata=None):
     """Atomically write `agent` (an RLAnimateAgent) to `path` (.npz); returns the full metadata written.
 
     `metadata` may hold: "training" (provenance: clips, seed, epochs, ...; the git commit and date
-    are added), "train_config" (a TrainConfig or dict), "average_frames" ({"POINT": n, "WAVE": n},
-    the mean length of each behaviour's training clips), "action_bounds" ((45, 2), default the
+    are added), "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each
+    behaviour trained, the mean length of its training clips), "action_bounds" ((45, 2), default the
     spaces' bounds), and any other JSON-serialisable entries (kept as given).
     """
     extra = dict(metadata or {})

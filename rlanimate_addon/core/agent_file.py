@@ -177,7 +177,8 @@ def _check_metadata_values(path, metadata):
         raise RLAnimateError(f"The agent file {path} has invalid action_bounds (need ({spaces.ACTION_SIZE}, 2) "
                              f"finite [low, high] pairs): re-export it with trainer/export.py.")
     frames = metadata["average_frames"]
-    if not isinstance(frames, dict) or any(not isinstance(frames.get(b), (int, float)) or frames[b] < 2
-                                           for b in spaces.BEHAVIOURS):
+    if not isinstance(frames, dict) or not frames or any(
+            b not in spaces.BEHAVIOURS or not isinstance(n, (int, float)) or not n >= 2 for b, n in frames.items()):
         raise RLAnimateError(f"The agent file {path} has invalid average_frames (need a length of at least 2 "
-                             f"frames for each of {', '.join(spaces.BEHAVIOURS)}): re-export it.")
+                             f"frames for each behaviour it was trained for, among "
+                             f"{', '.join(spaces.BEHAVIOURS)}): re-export it.")

@@ -82,7 +82,12 @@ class GestureAgent:
         self.metadata = metadata
         self.variant = metadata["variant"]
         self.action_bounds = np.asarray(metadata["action_bounds"], dtype=np.float64)  # (45, 2)
-        self.average_frames = {b: float(metadata["average_frames"][b]) for b in spaces.BEHAVIOURS}
+        trained = {b: float(n) for b, n in metadata["average_frames"].items()}
+        #: The behaviours the agent was trained for, in spaces.BEHAVIOURS order.
+        self.behaviours = tuple(b for b in spaces.BEHAVIOURS if b in trained)
+        #: Average gesture length in frames per behaviour (the UI's default length); a behaviour the
+        #: agent was not trained for gets the mean of the others, so the UI always has a default.
+        self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values())))) for b in spaces.BEHAVIOURS}
         config = metadata["agent_config"]
         w = {name: np.asarray(array, dtype=np.float64) for name, array in weights.items()}
         layers = int(config["hidden_layers"])
@@ -120,6 +125,11 @@ class GestureAgent:
                 or not np.all(np.isfinite(objectives)):
             raise RLAnimateError(f"The agent needs finite objectives of shape (frames, {spaces.OBJECTIVE_SIZE}), got "
                                  f"{objectives.shape}: give the gesture at least one frame and a valid target.")
+        untrained = set(objectives[:, spaces.OBJECTIVE_TYPE]) - {spaces.BEHAVIOUR_TYPE[b] for b in self.behaviours}
+        if untrained:
+            raise RLAnimateError(f"This agent was trained for {' and '.join(b.lower() for b in self.behaviours)} "
+                                 f"only: choose an agent trained for the requested behaviour in the add-on "
+                                 f"preferences.")
         rng = None if seed is None else np.random.default_rng(seed)
         E, Z = self._sizes
         A = spaces.ACTION_SIZE

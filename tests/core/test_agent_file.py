@@ -157,7 +157,9 @@ def test_damaged_metadata_text(tmp_path, exported):
 @pytest.mark.parametrize("field, value, message", [
     ("action_bounds", [[0.0, 1.0]] * 44, "action_bounds"),
     ("action_bounds", [[1.0, 0.0]] * 45, "action_bounds"),
-    ("average_frames", {"POINT": 90}, "average_frames"),
+    ("average_frames", {}, "average_frames"),
+    ("average_frames", {"POINT": 90, "JUMP": 50}, "average_frames"),
+    ("average_frames", {"POINT": 1}, "average_frames"),
     ("variant", "bigger", "Unknown agent variant"),
 ])
 def test_invalid_metadata_values(tmp_path, exported, field, value, message):

@@ -73,6 +73,7 @@ def test_metadata_accessors(tmp_path):
     _, path = exported_agent(tmp_path, "debug", "rlanimate")
     runtime = load_agent(path)
     assert runtime.average_frames == {"POINT": 80.0, "WAVE": 95.0}
+    assert runtime.behaviours == ("POINT", "WAVE")
     assert runtime.action_bounds.shape == (spaces.ACTION_SIZE, 2)
     np.testing.assert_allclose(runtime.action_bounds, spaces.DEFAULT_ACTION_BOUNDS)
     assert runtime.metadata["variant"] == "rlanimate"
@@ -94,3 +95,17 @@ def test_bad_objectives_get_a_clear_error(tmp_path, objectives):
     _, path = exported_agent(tmp_path, "debug", "rlanimate")
     with pytest.raises(RLAnimateError, match="objectives of shape"):
         load_agent(path).rollout(objectives)
+
+
+def test_single_behaviour_agent_plays_only_its_behaviour(tmp_path):
+    from rlanimate_addon.core.errors import RLAnimateError
+    torch.manual_seed(0)
+    path = tmp_path / "point.npz"
+    export_agent(RLAnimateAgent(load_preset("debug")[0]), path, {"average_frames": {"POINT": 116.0}})
+    runtime = load_agent(path)
+    assert runtime.behaviours == ("POINT",)
+    assert runtime.average_frames == {"POINT": 116.0, "WAVE": 116.0}
+    point, wave = objectives_for_tests()
+    assert runtime.rollout(point).shape == (len(point), spaces.ACTION_SIZE)
+    with pytest.raises(RLAnimateError, match="trained for point only"):
+        runtime.rollout(wave)
