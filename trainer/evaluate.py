@@ -38,7 +38,8 @@ def generate_positions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUN
 
 
 def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-    """{'score', 'smoothness', 'clips': [{name, behaviour, score, smoothness}]} over `clips`."""
+    """{'score', 'smoothness', 'by_behaviour': {behaviour: {score, smoothness}},
+    'clips': [{name, behaviour, score, smoothness}]}: means over `clips`, per behaviour, and per clip."""
     agent.eval()
     generated = generate_positions(agent, env, [clip_objective(clip) for clip in clips], bounds)
     rows = []
@@ -47,9 +48,14 @@ def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_B
         rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
                      "score": float(metrics.score(positions, reference)),
                      "smoothness": float(metrics.smoothness(positions))})
+    by_behaviour = {}
+    for behaviour in sorted({r["behaviour"] for r in rows}):
+        group = [r for r in rows if r["behaviour"] == behaviour]
+        by_behaviour[behaviour] = {"score": float(np.mean([r["score"] for r in group])),
+                                   "smoothness": float(np.mean([r["smoothness"] for r in group]))}
     return {"score": float(np.mean([r["score"] for r in rows])),
             "smoothness": float(np.mean([r["smoothness"] for r in rows])),
-            "clips": rows}
+            "by_behaviour": by_behaviour, "clips": rows}
 
 
 def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.DEFAULT_ACTION_BOUNDS):

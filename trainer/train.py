@@ -248,6 +248,9 @@ def _write_report(report, output):
     for label, key in (("held-out (unseen)", "held_out"), ("training (seen)", "training")):
         lines.append(f"| {label} | {len(report[key]['clips'])} | {report[key]['score']:.2f} | "
                      f"{report[key]['smoothness']:.2f} |")
+        for behaviour, entry in report[key]["by_behaviour"].items():
+            count = sum(c["behaviour"] == behaviour for c in report[key]["clips"])
+            lines.append(f"| {label}, {behaviour} | {count} | {entry['score']:.2f} | {entry['smoothness']:.2f} |")
     lines += ["", "Per held-out clip:", "", "| clip | behaviour | score | smoothness |", "|---|---|---|---|"]
     lines += [f"| {c['name']} | {c['behaviour']} | {c['score']:.2f} | {c['smoothness']:.2f} |"
               for c in report["held_out"]["clips"]]

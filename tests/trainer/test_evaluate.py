@@ -56,6 +56,8 @@ def test_a_replayed_clip_scores_100_and_noise_lowers_score_and_smoothness(env, l
     reference_smoothness = np.mean([metrics.smoothness(references.get(c)[1]) for c in clips])
     assert perfect["smoothness"] == pytest.approx(reference_smoothness, abs=1e-3)
     assert [row["name"] for row in perfect["clips"]] == [c.name for c in clips]
+    waves = [row["score"] for row in perfect["clips"] if row["behaviour"] == "wave"]
+    assert perfect["by_behaviour"]["wave"]["score"] == pytest.approx(np.mean(waves))
     noisy = evaluate.evaluate_clips(ReplayAgent(clips, noise=0.03), env, clips, references)
     assert noisy["score"] < perfect["score"] - 0.5
     assert noisy["smoothness"] < perfect["smoothness"] - 0.5
