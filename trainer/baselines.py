@@ -348,8 +348,8 @@ def main(argv=None):
         f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
     write_results(options.results, "sample library",
                   f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
-                  f"RLAnimate: `{Path(options.agent).name}` ({provenance}). "
-                  "Regenerate: `nice -n 10 python -m trainer.baselines`.", sets)
+                  f"RLAnimate: `{options.agent}` ({provenance}). "
+                  f"Regenerate: `nice -n 10 python -m trainer.baselines --agent {options.agent}`.", sets)
     print(open(Path(options.results) / "baselines.md").read())
     return 0
 

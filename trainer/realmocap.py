@@ -279,7 +279,11 @@ def run_experiments(options):
     waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
     env = FKEnvironment()
     references = ClipReferences(env)
+    command = f"nice -n 15 python -m trainer.realmocap --epochs {options.epochs} --preset {options.preset} --seed {options.seed}"
+    if options.point_agent:
+        command += f" --point-agent {options.point_agent}"
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
+               "command": command,
                "epochs": options.epochs, "preset": options.preset, "seed": options.seed,
                "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
 
@@ -340,7 +344,7 @@ def realmocap_markdown(results):
              f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), retargeted onto the "
              f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
              f"Preset `{results['preset']}`, {results['epochs']} epochs, seed {results['seed']}. "
-             "Regenerate: `nice -n 15 python -m trainer.realmocap`.", "",
+             f"Regenerate: `{results['command']}`.", "",
              "## Auto-labels per style (one-arm waves, 20 clips each)", "",
              "| style | exaggeration (mean ± sd) | elevation (deg) | stroke (arm lengths) | arm detected |",
              "|---|---|---|---|---|"]
@@ -406,7 +410,7 @@ def main(argv=None):
     (out / "realmocap.md").write_text(realmocap_markdown(results))
     baselines.write_results(out, "real motion capture",
                             "Agents trained on the real waves (takes 001-008, or 5 styles); pointing agent from "
-                            "the sample library for the guide clips. Regenerate: `nice -n 15 python -m trainer.realmocap`.",
+                            f"the sample library for the guide clips. Regenerate: `{results['command']}`.",
                             baseline_sets(results))
     print(realmocap_markdown(results))
     return 0
