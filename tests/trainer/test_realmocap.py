@@ -86,6 +86,8 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     session = realmocap.RealSession(env, references, train, test)
     report, agent = realmocap.train_agent(session, "tiny", "wave", 1, "debug", 0, runs=tmp_path)
     assert agent.path.is_file() and report["episodes"] == 1
+    exported = baselines.AgentMethod(agent.path).generate("WAVE", "LEFT", 0.4, 40)
+    np.testing.assert_allclose(exported, agent.generate("WAVE", "LEFT", 0.4, 40), atol=1e-4)
     methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train),
                "procedural_ik": baselines.ProceduralIK(baselines.neutral_pose(train))}
     comparison = realmocap.compare(methods, test, env, references)
