@@ -5,7 +5,7 @@ target, writing keys):
 
     targets (N, 3) in the rig's armature space --pointing_directions--> objectives (N, 7)
     --agent.rollout--> actions (M, 45) --decode, time_scale--> canonical rotations (N, 15, 3)
-    --retarget--> rig quaternions (N, 15, 4) --blend_from_pose--> keys
+    --aim.aim_at (POINT)--> --retarget--> rig quaternions (N, 15, 4) --blend_from_pose--> keys
 
 A rig may differ from the canonical skeleton in three ways, all handled here:
   * scale and units (a Mixamo FBX in centimetres): only directions and rotations are used;
@@ -19,7 +19,7 @@ A rig may differ from the canonical skeleton in three ways, all handled here:
 """
 import numpy as np
 
-from . import skeleton, spaces
+from . import aim, skeleton, spaces
 from .errors import RLAnimateError
 from .rotations import matrix_to_quat, rotvec_to_matrix
 
@@ -27,6 +27,9 @@ from .rotations import matrix_to_quat, rotvec_to_matrix
 SUPPORTED_LENGTH = (0.4, 1.5)
 #: Fraction of the gesture spent blending in from, and back out to, the rig's pose at the start frame.
 BLEND_FRACTION = 0.2
+#: Whether Point turns the agent's arm so the index finger passes through the target (core/aim.py);
+#: False keys the agent's raw aim.
+AIM_CORRECTION = True
 
 #: Bones of the pointing hand shape, with their canonical local rotation vectors (radians): the
 #: thumb tucked and the three other fingers curled towards the palm (negative about the local X
@@ -77,6 +80,20 @@ def pointing_directions(arm, targets, rest_heads):
     if not np.all(np.isfinite(norms)) or np.any(norms < 1e-3 * scale):
         raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
     return (offsets / norms[:, None]) @ character_frame(rest_heads).T
+
+
+def canonical_targets(arm, targets, rest_heads):
+    """(N, 3) targets placed on the canonical skeleton as they sit relative to the rig.
+
+    The direction from the rig's rest shoulder is kept (`pointing_directions`), and the distance is
+    scaled by the canonical over the rig's Hips-to-Head length, so units and proportions drop out.
+    """
+    shoulder = np.asarray(rest_heads[skeleton.ARM_PREFIX[arm] + "Arm"], dtype=np.float64)
+    distances = np.linalg.norm(np.atleast_2d(np.asarray(targets, dtype=np.float64)) - shoulder, axis=1)
+    head, hips = skeleton.BONE_BY_NAME["Head"].head, skeleton.BONE_BY_NAME["Hips"].head
+    scale = np.linalg.norm(np.subtract(head, hips)) / np.linalg.norm(np.subtract(rest_heads["Head"], rest_heads["Hips"]))
+    directions = pointing_directions(arm, targets, rest_heads)  # (N, 3)
+    return skeleton.shoulder_rest_position(arm) + directions * (distances * scale)[:, None]
 
 
 def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5):
@@ -219,6 +236,9 @@ def gesture_rotations(agent, request, rig):
                                   rest_heads=rig.rest_heads, exaggeration=request.exaggeration)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
     names = list(skeleton.ACTION_JOINTS)
+    if request.behaviour == "POINT" and AIM_CORRECTION:
+        targets = canonical_targets(request.arm, request.targets, rig.rest_heads)
+        canonical = aim.aim_at(canonical, request.arm, np.broadcast_to(targets, (len(canonical), 3)))
     if request.behaviour == "POINT":
         hand_names, hand = pointing_hand_rotations(request.arm, request.frame_count)
         present = [i for i, name in enumerate(hand_names) if name in rig.rest_frames]

@@ -1,0 +1,85 @@
+"""Aim correction: the finger line passes through the target, fades with the phase weight, stays smooth."""
+import math
+
+import numpy as np
+import pytest
+
+from rlanimate_addon.core import aim, gesture, kinematics, metrics, runtime, skeleton
+
+FRAMES = 120  # about the agent's average Point length
+
+
+@pytest.fixture(scope="module")
+def agent():
+    return runtime.load_agent("rlanimate_addon/agents/default.npz")
+
+
+def random_target(arm, rng):
+    """A target 1.5-4 m from the rest shoulder, in the front hemisphere of the arm's side."""
+    side = 1.0 if arm == "LEFT" else -1.0
+    azimuth = math.radians(rng.uniform(-30.0, 70.0)) * side
+    elevation = math.radians(rng.uniform(-25.0, 45.0))
+    direction = np.array([math.sin(azimuth) * math.cos(elevation), -math.cos(azimuth) * math.cos(elevation),
+                          math.sin(elevation)])
+    return skeleton.shoulder_rest_position(arm) + rng.uniform(1.5, 4.0) * direction
+
+
+def agent_gesture(agent, arm, target):
+    objectives = gesture.build_objectives("POINT", arm, FRAMES, targets=np.tile(target, (FRAMES, 1)),
+                                          rest_heads=gesture.canonical_rig_pose().rest_heads)
+    return gesture.run_agent(agent, "POINT", objectives)  # (N, 15, 3)
+
+
+def finger_angles(rotvecs, arm, target):
+    """(N,) degrees between the finger line and the line from the finger base to the target."""
+    _, base, finger, _ = aim.finger_lines(rotvecs, arm)
+    to_target = target - base
+    cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(to_target, axis=1)
+    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+
+
+def description_positions(rotvecs):
+    pose = kinematics.pose_matrices({j: rotvecs[:, i] for i, j in enumerate(skeleton.ACTION_JOINTS)})
+    heads = kinematics.head_positions(pose)
+    return heads[:, [kinematics.bone_index(bone) for _, bone in skeleton.DESCRIPTION_JOINTS]]  # (N, 10, 3)
+
+
+@pytest.mark.parametrize("arm", skeleton.ARMS)
+def test_full_weight_puts_the_target_on_the_finger_line(agent, arm):
+    rng = np.random.default_rng()
+    for _ in range(3):
+        target = random_target(arm, rng)
+        raw = agent_gesture(agent, arm, target)
+        aimed = aim.aim_at(raw, arm, target, weights=np.ones(FRAMES))
+        assert finger_angles(aimed, arm, target).max() < 0.5
+        others = [i for i, j in enumerate(skeleton.ACTION_JOINTS) if j != skeleton.ARM_PREFIX[arm] + "Arm"]
+        np.testing.assert_array_equal(aimed[:, others], raw[:, others])
+
+
+def test_zero_weight_changes_nothing(agent):
+    target = random_target("RIGHT", np.random.default_rng())
+    raw = agent_gesture(agent, "RIGHT", target)
+    np.testing.assert_allclose(aim.aim_at(raw, "RIGHT", target, weights=np.zeros(FRAMES)), raw, atol=1e-9)
+
+
+@pytest.mark.parametrize("arm", skeleton.ARMS)
+def test_phase_weight_keeps_the_ends_and_smoothness_and_aims_the_apex(agent, arm):
+    target = random_target(arm, np.random.default_rng())
+    raw = agent_gesture(agent, arm, target)
+    aimed = aim.aim_at(raw, arm, target)
+    np.testing.assert_allclose(aimed[[0, -1]], raw[[0, -1]], atol=1e-9)
+    _, base, _, _ = aim.finger_lines(aimed, arm)
+    apex = int(np.argmax(np.linalg.norm(base - base[0], axis=1)))
+    assert finger_angles(aimed, arm, target)[apex] < 0.5
+    before, after = metrics.smoothness(description_positions(raw)), metrics.smoothness(description_positions(aimed))
+    assert after >= metrics.ARTEFACT_THRESHOLD
+    assert after > before - 0.5, f"smoothness fell from {before:.2f} to {after:.2f}"
+
+
+def test_pointing_phase_rises_to_one_at_the_apex_and_is_zero_at_the_start():
+    t = np.linspace(0.0, 1.0, 50)
+    base = np.stack([np.sin(np.pi * t) ** 2, np.zeros_like(t), np.zeros_like(t)], axis=1)  # out and back
+    weights = aim.pointing_phase(base)
+    assert weights[0] == 0.0 and weights[-1] == 0.0
+    assert weights[np.argmax(base[:, 0])] == 1.0
+    assert np.all((weights >= 0.0) & (weights <= 1.0))
