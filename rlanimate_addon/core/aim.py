@@ -19,7 +19,7 @@ MAX_ITERATIONS = 30
 TOLERANCE = 1e-5
 #: The correction fades in between these fractions of the finger base's largest excursion from its
 #: start (and out again on the return): 0 below the first, 1 above the second.
-PHASE_RAMP = (0.1, 0.8)
+PHASE_RAMP = (0.05, 0.9)
 
 
 def finger_lines(rotvecs, arm):
