@@ -145,7 +145,8 @@ def label_clip(clip, behaviour):
     behaviour = behaviour.upper()
     if behaviour == "WAVE":
         label = label_wave(clip.rotvecs, clip.fps)
-        clip.behaviour, clip.arm, clip.exaggeration, clip.attributes = "WAVE", label.arm, label.exaggeration, label.exaggeration
+        clip.behaviour, clip.arm = "WAVE", label.arm
+        clip.exaggeration = clip.attributes = label.exaggeration
     elif behaviour == "POINT":
         label = label_point(clip.rotvecs)
         clip.behaviour, clip.arm, clip.attributes = "POINT", label.arm, label.direction

@@ -165,7 +165,8 @@ class ProceduralIK:
     def _solve(self, target_position):
         """(15, 3) local rotations of the constrained pose with the IK target at `target_position` (3,),
         character frame in metres, starting from the neutral pose."""
-        world = np.asarray(self.rig.matrix_world, dtype=np.float64) @ np.append(np.asarray(target_position) / self.scale, 1.0)
+        local = np.append(np.asarray(target_position) / self.scale, 1.0)  # object space, homogeneous
+        world = np.asarray(self.rig.matrix_world, dtype=np.float64) @ local
         self.target.location = world[:3]
         self._bpy.context.view_layer.update()
         pose = {n: np.asarray(b.matrix, dtype=np.float64)[:3, :3] for n, b in self._pose_bones.items()}

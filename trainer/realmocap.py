@@ -52,7 +52,8 @@ HOLDOUT_STYLES = ("elderly", "exhausted")
 RELAXED_HAND = {"Index": -0.12, "Middle": -0.18, "Ring": -0.24, "Pinky": -0.3}
 RELAXED_THUMB = (0.0, 0.0, 0.15)
 
-_NAME = re.compile(r"dataset-(?P<dataset>\d)_(?P<content>[a-z]+)(?:-(?P<side>left|right)-hand)?_(?P<style>[a-z-]+)_(?P<take>\d{3})$")
+_NAME = re.compile(r"dataset-(?P<dataset>\d)_(?P<content>[a-z]+)(?:-(?P<side>left|right)-hand)?"
+                   r"_(?P<style>[a-z-]+)_(?P<take>\d{3})$")
 
 
 def require_realmocap(root=REALMOCAP_DIR):
@@ -279,7 +280,8 @@ def run_experiments(options):
     waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
     env = FKEnvironment()
     references = ClipReferences(env)
-    command = f"nice -n 15 python -m trainer.realmocap --epochs {options.epochs} --preset {options.preset} --seed {options.seed}"
+    command = (f"nice -n 15 python -m trainer.realmocap --epochs {options.epochs} --preset {options.preset} "
+               f"--seed {options.seed}")
     if options.point_agent:
         command += f" --point-agent {options.point_agent}"
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
@@ -351,7 +353,8 @@ def realmocap_markdown(results):
     for style, row in results["labels"]["wave"].items():
         lines.append(f"| {style} | {row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f} | {row['elevation_deg']:.0f} | "
                      f"{row['stroke_arm_lengths']:.2f} | {row['arm_correct']}/{row['clips']} |")
-    lines += ["", "Goodbye waves: " + ", ".join(f"{s} {r['exaggeration']:.2f}" for s, r in results["labels"]["bye"].items()), ""]
+    bye = results["labels"]["bye"].items()
+    lines += ["", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), ""]
     lines += ["## Score and smoothness", "",
               "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
               "| experiment | test set | method | score | smoothness | label error |", "|---|---|---|---|---|---|"]
