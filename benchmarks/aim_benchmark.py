@@ -5,7 +5,7 @@ For targets 1.5-4 m from the shoulder (azimuth -30..70 degrees towards the arm's
 the apex (the frame where the finger base is farthest from its start), and the smoothness of the
 description joints, for the raw agent and after `core.aim.aim_at`, as docs/EXTENSION.md reports.
 
-Run: `nice -n 10 python benchmarks/aim_benchmark.py [--targets 80] [--frames 120] [--seed 7]`
+Run: `nice -n 10 python benchmarks/aim_benchmark.py [--targets 80] [--frames 120] [--seed 7] [--agent FILE]`
 """
 import argparse
 import math
@@ -48,8 +48,9 @@ def main():
     parser.add_argument("--targets", type=int, default=80)
     parser.add_argument("--frames", type=int, default=120)
     parser.add_argument("--seed", type=int, default=7)
+    parser.add_argument("--agent", default=str(ROOT / "rlanimate_addon" / "agents" / "default.npz"))
     args = parser.parse_args()
-    agent = runtime.load_agent(str(ROOT / "rlanimate_addon" / "agents" / "default.npz"))
+    agent = runtime.load_agent(args.agent)
     rest_heads = gesture.canonical_rig_pose().rest_heads
     rng = np.random.default_rng(args.seed)
     rows = []  # (raw angle, aimed angle, raw smoothness, aimed smoothness)

@@ -18,7 +18,7 @@ from .rotations import matrix_to_rotvec, rotvec_to_matrix
 MAX_ITERATIONS = 30
 TOLERANCE = 1e-5
 #: The correction fades in between these fractions of the finger base's largest excursion from its
-#: start (and out again on the return): 0 below the first, 1 above the second.
+#: start and end positions (and out again on the return): 0 below the first, 1 above the second.
 PHASE_RAMP = (0.05, 0.9)
 
 
@@ -65,9 +65,10 @@ def shoulder_corrections(shoulder, base, finger, targets):
 
 
 def pointing_phase(base):
-    """(N,) weight in [0, 1]: a smoothstep of the finger base's distance from its start, relative to its
-    largest, so the correction fades in with the stroke and out with the return."""
-    travel = np.linalg.norm(base - base[0], axis=1)
+    """(N,) weight in [0, 1]: a smoothstep of the finger base's distance from its start and end positions
+    (the nearer one), relative to its largest, so the correction fades in with the stroke and out with
+    the return, and is 0 at the first and last frames even if the hand does not come quite back."""
+    travel = np.minimum(np.linalg.norm(base - base[0], axis=1), np.linalg.norm(base - base[-1], axis=1))
     relative = travel / max(travel.max(), 1e-9)
     low, high = PHASE_RAMP
     s = np.clip((relative - low) / (high - low), 0.0, 1.0)

@@ -68,7 +68,7 @@ def test_phase_weight_keeps_the_ends_and_smoothness_and_aims_the_apex(agent, arm
     raw = agent_gesture(agent, arm, target)
     aimed = aim.aim_at(raw, arm, target)
     np.testing.assert_allclose(aimed[0], raw[0], atol=1e-9)
-    np.testing.assert_allclose(aimed[-1], raw[-1], atol=1e-3)  # the hand is back, the weight (near) 0
+    np.testing.assert_allclose(aimed[-1], raw[-1], atol=1e-9)
     _, base, _, _ = aim.finger_lines(aimed, arm)
     apex = int(np.argmax(np.linalg.norm(base - base[0], axis=1)))
     # The corrected apex may fall a frame or two from the raw one, where the weight is just under 1.
