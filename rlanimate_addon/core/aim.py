@@ -6,7 +6,8 @@ posed shoulder joint S (the Arm bone's head) by the rotation R that lays f onto 
 seen from b. Rotating about S moves b too, so R is refined (about ten passes); this converges
 because |T - S| (1.5-4 m) is well above |b - S| (an arm's length). R is applied to the Arm bone's
 local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation), with its rotation
-vector scaled by a smooth pointing-phase weight: 0 while the hand is near where it starts or ends, 1 around the apex of the stroke.
+vector scaled by a smooth pointing-phase weight: 0 while the hand is near where it starts or ends,
+1 around the apex of the stroke.
 """
 import numpy as np
 
