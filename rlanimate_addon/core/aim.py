@@ -6,8 +6,8 @@ posed shoulder joint S (the Arm bone's head) by the rotation R that lays f onto 
 seen from b. Rotating about S moves b too, so R is refined (about ten passes); this converges
 because |T - S| (1.5-4 m) is well above |b - S| (an arm's length). R is applied to the Arm bone's
 local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation), with its rotation
-vector scaled by a smooth pointing-phase weight: 0 while the hand is near where it starts or ends,
-1 around the apex of the stroke.
+vector scaled by a pointing-phase weight that ramps with minimum jerk from 0 at the start of the
+stroke to 1 near its end, and back to 0 over the return.
 """
 import numpy as np
 
@@ -18,9 +18,10 @@ from .rotations import matrix_to_rotvec, rotvec_to_matrix
 #: (0.2-0.4 for targets 1.5-4 m away); they stop once every frame is within TOLERANCE radians.
 MAX_ITERATIONS = 30
 TOLERANCE = 1e-5
-#: The correction fades in between these fractions of the finger base's largest excursion from its
-#: start and end positions (and out again on the return): 0 below the first, 1 above the second.
-PHASE_RAMP = (0.05, 0.9)
+#: The correction fades in while the finger base travels between these fractions of its largest
+#: excursion from its start position, and out again while it travels back between the same fractions
+#: of its largest excursion from its end position.
+PHASE_RAMP = (0.01, 0.85)
 
 
 def finger_lines(rotvecs, arm):
@@ -65,15 +66,33 @@ def shoulder_corrections(shoulder, base, finger, targets):
     return matrix_to_rotvec(total)
 
 
+def minimum_jerk(s):
+    """The minimum-jerk ramp 10 s^3 - 15 s^4 + 6 s^5 from 0 to 1 on s in [0, 1]: zero velocity and
+    acceleration at both ends."""
+    return s * s * s * (s * (6.0 * s - 15.0) + 10.0)
+
+
 def pointing_phase(base):
-    """(N,) weight in [0, 1]: a smoothstep of the finger base's distance from its start and end positions
-    (the nearer one), relative to its largest, so the correction fades in with the stroke and out with
-    the return, and is 0 at the first and last frames even if the hand does not come quite back."""
-    travel = np.minimum(np.linalg.norm(base - base[0], axis=1), np.linalg.norm(base - base[-1], axis=1))
-    relative = travel / max(travel.max(), 1e-9)
-    low, high = PHASE_RAMP
-    s = np.clip((relative - low) / (high - low), 0.0, 1.0)
-    return s * s * (3.0 - 2.0 * s)
+    """(N,) weight in [0, 1] for finger-base positions (N, 3): 0 at the first and last frames, 1 from
+    the stroke's near end to the start of the return.
+
+    The weight is a minimum-jerk ramp in time, from the frame the finger base first leaves
+    PHASE_RAMP[0] of its largest distance from its start to the frame it first reaches PHASE_RAMP[1]
+    of it, and back down over the mirrored frames of its distance from its end position. Ramping in
+    time spreads the correction over the whole stroke, even in short gestures whose stroke takes a few
+    frames. A finger base that does not move gets no correction."""
+    count = len(base)
+    frames = np.arange(count)
+    weight = np.ones(count)
+    for sign, positions in ((1, base), (-1, base[::-1])):
+        travel = np.linalg.norm(positions - positions[0], axis=1)
+        if travel.max() < 1e-9:
+            return np.zeros(count)
+        relative = travel / travel.max()
+        start, full = (int(np.argmax(relative >= fraction)) for fraction in PHASE_RAMP)
+        ramp = minimum_jerk(np.clip((frames - start) / max(full - start, 1), 0.0, 1.0))
+        weight = np.minimum(weight, ramp[::sign])
+    return weight
 
 
 def aim_at(rotvecs, arm, targets, weights=None):

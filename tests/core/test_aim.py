@@ -7,6 +7,7 @@ import pytest
 from rlanimate_addon.core import aim, gesture, kinematics, metrics, runtime, skeleton
 
 FRAMES = 120  # about the agent's average Point length
+SHORTEST = 46  # 0.4 x that: the shortest length the panel offers
 
 
 @pytest.fixture(scope="module")
@@ -24,8 +25,8 @@ def random_target(arm, rng):
     return skeleton.shoulder_rest_position(arm) + rng.uniform(1.5, 4.0) * direction
 
 
-def agent_gesture(agent, arm, target):
-    objectives = gesture.build_objectives("POINT", arm, FRAMES, targets=np.tile(target, (FRAMES, 1)),
+def agent_gesture(agent, arm, target, frames=FRAMES):
+    objectives = gesture.build_objectives("POINT", arm, frames, targets=np.tile(target, (frames, 1)),
                                           rest_heads=gesture.canonical_rig_pose().rest_heads)
     return gesture.run_agent(agent, "POINT", objectives)  # (N, 15, 3)
 
@@ -62,10 +63,11 @@ def test_zero_weight_changes_nothing(agent):
     np.testing.assert_allclose(aim.aim_at(raw, "RIGHT", target, weights=np.zeros(FRAMES)), raw, atol=1e-9)
 
 
+@pytest.mark.parametrize("frames", [SHORTEST, FRAMES])
 @pytest.mark.parametrize("arm", skeleton.ARMS)
-def test_phase_weight_keeps_the_ends_and_smoothness_and_aims_the_apex(agent, arm):
+def test_phase_weight_keeps_the_ends_and_smoothness_and_aims_the_apex(agent, arm, frames):
     target = random_target(arm, np.random.default_rng())
-    raw = agent_gesture(agent, arm, target)
+    raw = agent_gesture(agent, arm, target, frames)
     aimed = aim.aim_at(raw, arm, target)
     np.testing.assert_allclose(aimed[0], raw[0], atol=1e-9)
     np.testing.assert_allclose(aimed[-1], raw[-1], atol=1e-9)
@@ -85,3 +87,19 @@ def test_pointing_phase_rises_to_one_at_the_apex_and_is_zero_at_the_start():
     assert weights[0] == 0.0 and weights[-1] == 0.0
     assert weights[np.argmax(base[:, 0])] == 1.0
     assert np.all((weights >= 0.0) & (weights <= 1.0))
+
+
+def test_pointing_phase_is_a_minimum_jerk_ramp_in_time_however_the_hand_accelerates():
+    frames = np.arange(60)
+    out = np.clip(frames / 20.0, 0.0, 1.0) ** 4  # a stroke that starts slowly and ends fast
+    back = np.clip((frames - 40) / 20.0, 0.0, 1.0) ** 0.25  # a return that starts fast and ends slowly
+    base = np.stack([out - back, np.zeros(60), np.zeros(60)], axis=1)
+    weights = aim.pointing_phase(base)
+    start, full = 7, 20  # first frames at 1% and 85% of the largest distance: (t / 20)^4
+    expected = aim.minimum_jerk(np.clip((frames - start) / (full - start), 0.0, 1.0))
+    np.testing.assert_allclose(weights[:40], expected[:40], atol=1e-12)
+    assert weights[-1] == 0.0 and np.all(np.diff(weights[40:]) <= 0.0) and weights[40] == 1.0
+
+
+def test_a_finger_that_does_not_move_gets_no_correction():
+    assert np.all(aim.pointing_phase(np.ones((30, 3))) == 0.0)
