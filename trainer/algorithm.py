@@ -1,7 +1,8 @@
 """Algorithm 1 of the paper: collect a rollout per iteration, then T model updates on buffer chunks.
 
 One iteration (which we count as one epoch, as the paper's Figure 3 does):
-    1. draw one training clip at random, or one per behaviour when training both;
+    1. draw one training clip at random, or one per behaviour when training both (without
+       replacement, in passes over each behaviour's clips);
     2. roll the current agent out on each clip's objectives (from its label and frame count), then
        play every frame through the bpy FK environment in one batch. The agent's inputs are the
        objectives only (it self-describes with its portrayal model), so the whole rollout can be
@@ -83,14 +84,23 @@ class Trainer:
         self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
         self.buffer = EpisodeBuffer()
         self.rng = np.random.default_rng(seed)
+        self.decks = [[] for _ in self.clip_groups]  # per group: clip indices still to draw this pass
         self.rollout_generator = torch.Generator().manual_seed(seed)
         self.epochs = epochs  # the planned length of the run, for the learning-rate schedule
         self.epoch = 0
         self.history = []  # one metrics dict per epoch
 
+    def draw(self, group_index):
+        """The next clip of a group: clips are drawn at random without replacement, in passes over the
+        group, so that every training clip is rolled out once before any is rolled out twice."""
+        deck = self.decks[group_index]
+        if not deck:
+            deck.extend(int(k) for k in self.rng.permutation(len(self.clip_groups[group_index])))
+        return self.clip_groups[group_index][deck.pop()]
+
     def collect(self):
         """Steps 1-2: draw a clip per group, roll the agent out, evaluate all frames in one FK batch."""
-        drawn = [group[int(self.rng.integers(len(group)))] for group in self.clip_groups]
+        drawn = [self.draw(k) for k in range(len(self.clip_groups))]
         objectives = [clip_objective(clip) for clip in drawn]
         self.agent.eval()
         actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
@@ -168,6 +178,7 @@ class Trainer:
             "optimizer": self.optimizer.state_dict(),
             "buffer": self.buffer.state_dict(),
             "history": self.history,
+            "decks": [list(deck) for deck in self.decks],
             "rng": checkpoint.capture_rng_states(self.rng, self.rollout_generator),
         }
 
@@ -177,4 +188,5 @@ class Trainer:
         self.optimizer.load_state_dict(state["optimizer"])
         self.buffer.load_state_dict(state["buffer"])
         self.history = list(state["history"])
+        self.decks = [list(deck) for deck in state["decks"]]
         checkpoint.restore_rng_states(state["rng"], self.rng, self.rollout_generator)

@@ -113,3 +113,12 @@ def test_one_behaviour_runs_take_their_own_update_count(env, library, behaviour,
     trainer.collect()
     trainer.update()
     assert trainer.optimizer.state_dict()["state"][0]["step"] == expected
+
+
+def test_clips_are_drawn_in_passes_without_replacement(env, library):
+    agent_config, train_config = load_preset("debug")
+    trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "wave", seed=4)
+    waves = trainer.clip_groups[0]
+    drawn = [id(trainer.draw(0)) for _ in range(2 * len(waves))]
+    assert sorted(drawn[:len(waves)]) == sorted(id(clip) for clip in waves)  # each clip once per pass
+    assert sorted(drawn[len(waves):]) == sorted(drawn[:len(waves)]) and drawn[len(waves):] != drawn[:len(waves)]
