@@ -245,16 +245,3 @@ def test_cursor_fallback_and_an_animated_target_is_tracked(settings):
     bpy.context.scene.frame_set(5)
     assert helpers.generate(rig, settings, target=target, start_frame=300, frame_count=61) == {"FINISHED"}
     assert bpy.context.scene.frame_current == 5, "the scene frame must be restored"
-
-
-def test_generate_120_frames_on_the_sample_rig_is_fast(settings):
-    import time
-
-    rig = helpers.load_sample_rig()
-    target = helpers.add_empty("Target", (-1.0, -2.5, 1.6))
-    helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, frame_count=120)  # warm
-    bpy.data.actions.remove(rig.animation_data.action)
-    start = time.perf_counter()
-    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
-    elapsed = time.perf_counter() - start
-    assert elapsed < 0.1 * 3, f"120 frames took {elapsed * 1000:.0f} ms (budget 100 ms; 3x slack for a busy CI)"
