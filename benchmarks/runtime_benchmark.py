@@ -4,27 +4,19 @@ Run: `nice -n 10 python benchmarks/runtime_benchmark.py`. It pins itself to one 
 `GestureAgent.rollout` (deterministic, and with a variation seed) on the shipped default agent and on
 default-size agents of the other variants, for gestures of 0.4x, 1x and 1.5x the default length,
 and the torch agent's rollout for reference. A frame's cost is the whole rollout's CPU time (precompute
-included) over its frames, the least of REPEATS interleaved rounds. A second process (the same
-script with --busy-cpu, unpinned) times the shipped agent's wall clock while every core is busy with
-another process, with the runtime's own products and with every product sent to BLAS. It prints a
-markdown section and replaces the "Numpy runtime" section of docs/BENCHMARKS.md with it (other
-sections are kept).
+included) over its frames, the least of REPEATS interleaved rounds. It prints a markdown section
+and replaces the "Numpy runtime" section of docs/BENCHMARKS.md with it (other sections are kept).
 """
-import json
-import multiprocessing
 import os
 import platform
 import re
-import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from datetime import datetime, timezone
 from pathlib import Path
 
-BUSY_FLAG = "--busy-cpu"
-if hasattr(os, "sched_setaffinity") and BUSY_FLAG not in sys.argv:  # before numpy starts its BLAS threads
+if hasattr(os, "sched_setaffinity"):
     os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
@@ -33,7 +25,7 @@ sys.path.insert(0, str(REPO_ROOT))
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
-from rlanimate_addon.core import runtime, spaces  # noqa: E402
+from rlanimate_addon.core import spaces  # noqa: E402
 from rlanimate_addon.core.runtime import load_agent  # noqa: E402
 from trainer.config import load_preset  # noqa: E402
 from trainer.export import export_agent  # noqa: E402
@@ -99,44 +91,7 @@ def measure():
     return rows
 
 
-def spin():
-    while True:
-        pass
-
-
-def measure_busy():
-    """{label: median wall-clock us/frame} of the shipped agent's 1x rollout while every core runs a
-    busy loop: with the runtime's products, and with every vector-matrix product sent to BLAS."""
-    agent = load_agent(DEFAULT_AGENT)
-    frames = int(round(agent.average_frames["POINT"]))
-    objectives = spaces.make_objective("POINT", "RIGHT", [-0.3, -0.9, 0.2], frames)
-    spinners = [multiprocessing.Process(target=spin, daemon=True) for _ in range(os.cpu_count())]
-    for spinner in spinners:
-        spinner.start()
-    results = {"frames": frames}
-    try:
-        for label, size in (("runtime", runtime.BLAS_THREADED_SIZE), ("all BLAS", float("inf"))):
-            runtime.BLAS_THREADED_SIZE = size
-            agent.rollout(objectives)
-            walls = []
-            for _ in range(REPEATS // 2):
-                start = time.perf_counter()
-                agent.rollout(objectives)
-                walls.append(time.perf_counter() - start)
-            results[label] = statistics.median(walls) / frames * 1e6
-    finally:
-        for spinner in spinners:
-            spinner.terminate()
-    return results
-
-
-def busy_rows():
-    """measure_busy() in a fresh, unpinned process."""
-    done = subprocess.run([sys.executable, __file__, BUSY_FLAG], capture_output=True, text=True, check=True)
-    return json.loads(done.stdout)
-
-
-def section(rows, busy):
+def section(rows):
     """The markdown section for docs/BENCHMARKS.md."""
     worst = max(max(r[2], r[3]) for r in rows)
     lines = [
@@ -156,12 +111,7 @@ def section(rows, busy):
         torch_text = "-" if torch_us is None else f"{torch_us:.1f}"
         lines.append(f"| {label} | {frames} | {numpy_us:.1f} | {seeded_us:.1f} | {torch_text} |")
     lines += ["", f"Slowest: {worst:.1f} us per frame against a budget of {BUDGET_US:.0f} us "
-                  f"({'within' if worst <= BUDGET_US else 'OVER'} budget).", "",
-              f"On a busy CPU (`{BUSY_FLAG}`: a busy loop on each of the {os.cpu_count()} cores, as when Blender "
-              f"renders beside it; unpinned; median wall clock of {REPEATS // 2} rollouts of the shipped agent, "
-              f"{busy['frames']} frames): {busy['runtime']:.0f} us per frame, against {busy['all BLAS']:.0f} us "
-              "when every vector-matrix product goes to BLAS, which splits the larger ones across threads "
-              "that then wait for a core (`runtime._vector_times`)."]
+                  f"({'within' if worst <= BUDGET_US else 'OVER'} budget)."]
     return "\n".join(lines) + "\n"
 
 
@@ -174,9 +124,6 @@ def write_section(text, path=BENCHMARKS_MD):
 
 
 if __name__ == "__main__":
-    if BUSY_FLAG in sys.argv:
-        print(json.dumps(measure_busy()))
-        sys.exit(0)
-    table = section(measure(), busy_rows())
+    table = section(measure())
     print(table)
     write_section(table)

@@ -32,20 +32,6 @@ def _sigmoid(x):
     return 0.5 * (1.0 + np.tanh(0.5 * x))
 
 
-#: OpenBLAS runs a vector-matrix product (gemv) on several threads from this many matrix entries on
-#: (2304 x its GEMM_MULTITHREAD_THRESHOLD of 4).
-BLAS_THREADED_SIZE = 9216
-
-
-def _vector_times(vector, matrix):
-    """vector (K,) @ matrix (K, M) -> (M,). Products big enough for OpenBLAS to thread go through
-    einsum's own loop instead: a thread hand-off costs far more than a product this small, up to a
-    millisecond each on a CPU busy with other work (Blender's own, say), against a few microseconds."""
-    if matrix.size < BLAS_THREADED_SIZE:
-        return vector @ matrix
-    return np.einsum("k,km->m", vector, matrix)
-
-
 def _mlp_arrays(weights, name, layers):
     """[(weight (in, out), bias (out,))] of an MLP: Linear layers with tanh between them."""
     return [(weights[f"{name}.layers.{k}.weight"].T.copy(), weights[f"{name}.layers.{k}.bias"])
@@ -53,11 +39,10 @@ def _mlp_arrays(weights, name, layers):
 
 
 def _mlp_tail(layers, first_preactivation):
-    """An MLP from its first layer's pre-activation on: tanh, then the remaining Linear layers.
-    first_preactivation: (N, hidden) for all frames at once, or (hidden,) for one frame."""
+    """An MLP from its first layer's pre-activation on: tanh, then the remaining Linear layers."""
     x = first_preactivation
     for weight, bias in layers[1:]:
-        x = (np.tanh(x) @ weight if x.ndim > 1 else _vector_times(np.tanh(x), weight)) + bias
+        x = np.tanh(x) @ weight + bias
     return x
 
 
@@ -82,7 +67,7 @@ def _gru_sequence(inputs, gru):
     h = np.zeros(hidden_weight.shape[0])
     states = np.empty((len(inputs), len(h)))
     for t in range(len(inputs)):
-        h = states[t] = _gru_step(input_gates[t], _vector_times(h, hidden_weight) + hidden_bias, h)
+        h = states[t] = _gru_step(input_gates[t], h @ hidden_weight + hidden_bias, h)
     return states
 
 
@@ -165,15 +150,15 @@ class GestureAgent:
         actions = np.empty((count, A))
         for t in range(count):
             e = _gru_step(cell_inputs[t] + recurrent_gates, hidden_gates, e)
-            from_e = _vector_times(e, self._from_e)
+            from_e = e @ self._from_e
             hidden_gates = from_e[:gates] + self._cell_hidden_bias
             belief = _mlp_tail(self._belief, from_e[gates:belief_end] + belief_inputs[t])
             z = belief[:Z]
             if rng is not None:
                 z = z + (_softplus(belief[Z:]) + self._min_std) * rng.standard_normal(Z)
-            from_z = _vector_times(z, self._from_z)
+            from_z = z @ self._from_z
             out = _mlp_tail(self._animation, animation_inputs[t] + from_e[belief_end:] + from_z[gates:])
             concentrations = self._floor + self._concentration_scale * _softplus(out)  # (90,): alpha, beta
             a = actions[t] = concentrations[:A] / (concentrations[:A] + concentrations[A:])
-            recurrent_gates = from_z[:gates] + _vector_times(a, self._from_a)
+            recurrent_gates = from_z[:gates] + a @ self._from_a
         return actions

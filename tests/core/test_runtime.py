@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 import torch
 
-from rlanimate_addon.core import runtime, spaces
+from rlanimate_addon.core import spaces
 from rlanimate_addon.core.runtime import GestureAgent, load_agent
 from trainer.config import load_preset
 from trainer.export import export_agent
@@ -109,10 +109,3 @@ def test_single_behaviour_agent_plays_only_its_behaviour(tmp_path):
     assert runtime.rollout(point).shape == (len(point), spaces.ACTION_SIZE)
     with pytest.raises(RLAnimateError, match="trained for point only"):
         runtime.rollout(wave)
-
-
-@pytest.mark.parametrize("rows, columns", [(45, 192), (64, 320)])  # under and over BLAS_THREADED_SIZE
-def test_vector_times_is_the_matrix_product_on_either_path(rows, columns):
-    rng = np.random.default_rng(0)
-    vector, matrix = rng.standard_normal(rows), rng.standard_normal((rows, columns))
-    np.testing.assert_allclose(runtime._vector_times(vector, matrix), vector @ matrix, rtol=1e-12, atol=1e-12)
