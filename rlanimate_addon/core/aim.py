@@ -7,7 +7,7 @@ seen from b. Rotating about S moves b too, so R is refined (about ten passes); t
 because |T - S| (1.5-4 m) is well above |b - S| (an arm's length). R is applied to the Arm bone's
 local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation), with its rotation
 vector scaled by a pointing-phase weight that ramps with minimum jerk from 0 at the start of the
-stroke to 1 near its end, and back to 0 over the return.
+stroke to 1 by its middle, and back to 0 over the return.
 """
 import numpy as np
 
@@ -20,8 +20,11 @@ MAX_ITERATIONS = 30
 TOLERANCE = 1e-5
 #: The correction fades in while the finger base travels between these fractions of its largest
 #: excursion from its start position, and out again while it travels back between the same fractions
-#: of its largest excursion from its end position.
-PHASE_RAMP = (0.01, 0.85)
+#: of its largest excursion from its end position ...
+PHASE_RAMP = (0.01, 0.5)
+#: ... over at least this share of the gesture's frames: a quicker stroke gets a ramp that starts
+#: before it, while the hand is still at rest.
+MIN_RAMP_SHARE = 0.2
 
 
 def finger_lines(rotvecs, arm):
@@ -74,15 +77,18 @@ def minimum_jerk(s):
 
 def pointing_phase(base):
     """(N,) weight in [0, 1] for finger-base positions (N, 3): 0 at the first and last frames, 1 from
-    the stroke's near end to the start of the return.
+    the middle of the stroke to the middle of the return.
 
     The weight is a minimum-jerk ramp in time, from the frame the finger base first leaves
     PHASE_RAMP[0] of its largest distance from its start to the frame it first reaches PHASE_RAMP[1]
-    of it, and back down over the mirrored frames of its distance from its end position. Ramping in
-    time spreads the correction over the whole stroke, even in short gestures whose stroke takes a few
-    frames. A finger base that does not move gets no correction."""
+    of it, and back down over the mirrored frames of its distance from its end position. A ramp
+    shorter than MIN_RAMP_SHARE of the frames starts earlier. Ramping in time spreads the correction
+    over the stroke and beyond, even in short gestures whose stroke takes a few frames, and full
+    weight from mid-stroke on puts the target on the finger line wherever the apex falls. A finger
+    base that does not move gets no correction."""
     count = len(base)
     frames = np.arange(count)
+    shortest = int(round(MIN_RAMP_SHARE * count))
     weight = np.ones(count)
     for sign, positions in ((1, base), (-1, base[::-1])):
         travel = np.linalg.norm(positions - positions[0], axis=1)
@@ -90,6 +96,7 @@ def pointing_phase(base):
             return np.zeros(count)
         relative = travel / travel.max()
         start, full = (int(np.argmax(relative >= fraction)) for fraction in PHASE_RAMP)
+        start = max(0, min(start, full - shortest))
         ramp = minimum_jerk(np.clip((frames - start) / max(full - start, 1), 0.0, 1.0))
         weight = np.minimum(weight, ramp[::sign])
     return weight

@@ -95,7 +95,9 @@ def test_pointing_phase_is_a_minimum_jerk_ramp_in_time_however_the_hand_accelera
     back = np.clip((frames - 40) / 20.0, 0.0, 1.0) ** 0.25  # a return that starts fast and ends slowly
     base = np.stack([out - back, np.zeros(60), np.zeros(60)], axis=1)
     weights = aim.pointing_phase(base)
-    start, full = 7, 20  # first frames at 1% and 85% of the largest distance: (t / 20)^4
+    # First frames at 1% and 50% of the largest distance, (t / 20)^4: 7 and 17; the ramp is stretched
+    # back to MIN_RAMP_SHARE of the 60 frames, 12.
+    start, full = 5, 17
     expected = aim.minimum_jerk(np.clip((frames - start) / (full - start), 0.0, 1.0))
     np.testing.assert_allclose(weights[:40], expected[:40], atol=1e-12)
     assert weights[-1] == 0.0 and np.all(np.diff(weights[40:]) <= 0.0) and weights[40] == 1.0
