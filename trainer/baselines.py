@@ -332,7 +332,7 @@ def main(argv=None):
     import torch
 
     from .bpy_support import new_empty_scene, script_args
-    from .train import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR
+    from .train import DEFAULT_MANIFEST, INSTALLED_AGENT, REPO_ROOT, RESULTS_DIR
     parser = argparse.ArgumentParser(prog="python -m trainer.baselines", description=main.__doc__.split(":")[0])
     parser.add_argument("--agent", default=str(INSTALLED_AGENT), help="exported RLAnimate agent (.npz)")
     parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
@@ -345,12 +345,14 @@ def main(argv=None):
     except RLAnimateError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+    agent = Path(options.agent).resolve()
+    shown = agent.relative_to(REPO_ROOT) if agent.is_relative_to(REPO_ROOT) else agent  # no machine paths in docs
     provenance = "untrained" if training.get("untrained") else ", ".join(
         f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
     write_results(options.results, "sample library",
                   f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
-                  f"RLAnimate: `{options.agent}` ({provenance}). "
-                  f"Regenerate: `nice -n 10 python -m trainer.baselines --agent {options.agent}`.", sets)
+                  f"RLAnimate: `{shown}` ({provenance}). "
+                  f"Regenerate: `nice -n 10 python -m trainer.baselines --agent {shown}`.", sets)
     print(open(Path(options.results) / "baselines.md").read())
     return 0
 
