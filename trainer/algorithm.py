@@ -133,7 +133,7 @@ class Trainer:
     def update_steps(self):
         """T for this run: the config's one-behaviour T when training one behaviour, if it sets one."""
         config = self.train_config
-        if self.behaviour != "both" and getattr(config, "update_steps_one_behaviour", None):
+        if self.behaviour != "both" and config.update_steps_one_behaviour:
             return config.update_steps_one_behaviour
         return config.update_steps
 
@@ -188,5 +188,6 @@ class Trainer:
         self.optimizer.load_state_dict(state["optimizer"])
         self.buffer.load_state_dict(state["buffer"])
         self.history = list(state["history"])
-        self.decks = [list(deck) for deck in state["decks"]]
+        # A checkpoint from before the draws were in passes starts a fresh pass.
+        self.decks = [list(deck) for deck in state.get("decks", [[] for _ in self.clip_groups])]
         checkpoint.restore_rng_states(state["rng"], self.rng, self.rollout_generator)

@@ -73,8 +73,8 @@ PRESETS = {
                     portrayal_hidden_size=8, hidden_layers=1),
         TrainConfig(epochs_single=2, epochs_both=2, update_steps=3, chunk_count=4, chunk_length=8),
     ),
-    "default": (AgentConfig(), TrainConfig(update_steps=30, update_steps_one_behaviour=60, chunk_count=32, learning_rate=3e-3,
-                                           learning_rate_final=1e-4)),
+    "default": (AgentConfig(), TrainConfig(update_steps=30, update_steps_one_behaviour=60, chunk_count=32,
+                                           learning_rate=3e-3, learning_rate_final=1e-4)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),
