@@ -130,13 +130,6 @@ class Trainer:
         progress = min(self.epoch / self.epochs, 1.0)
         return final + (config.learning_rate - final) * 0.5 * (1.0 + math.cos(math.pi * progress))
 
-    def update_steps(self):
-        """T for this run: the config's one-behaviour T when training one behaviour, if it sets one."""
-        config = self.train_config
-        if self.behaviour != "both" and config.update_steps_one_behaviour:
-            return config.update_steps_one_behaviour
-        return config.update_steps
-
     def update(self):
         """Step 3: T gradient steps on C chunks of L frames; returns each loss's mean over the steps."""
         config = self.train_config
@@ -144,8 +137,7 @@ class Trainer:
             group["lr"] = self.learning_rate()
         self.agent.train()
         totals = {}
-        steps = self.update_steps()
-        for _ in range(steps):
+        for _ in range(config.update_steps):
             batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng)
             losses = self.agent.losses(batch, config)
             self.optimizer.zero_grad(set_to_none=True)
@@ -155,7 +147,7 @@ class Trainer:
             self.optimizer.step()
             for name, value in losses.items():
                 totals[name] = totals.get(name, 0.0) + float(value.detach())
-        return {name: value / steps for name, value in totals.items()}
+        return {name: value / config.update_steps for name, value in totals.items()}
 
     def run_epoch(self):
         """One iteration of Algorithm 1; appends and returns its metrics."""

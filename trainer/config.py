@@ -37,8 +37,7 @@ class AgentConfig:
 class TrainConfig:
     epochs_single: int = 50  # iterations of Algorithm 1 for one behaviour (the paper's 50)
     epochs_both: int = 100  # ... and for both behaviours (the paper's 100)
-    update_steps: int = 20  # T: model updates per iteration when training both behaviours
-    update_steps_one_behaviour: int = None  # T for one behaviour (None: update_steps)
+    update_steps: int = 20  # T: model updates per iteration
     chunk_count: int = 16  # C: chunks per update
     chunk_length: int = 32  # L: frames per chunk
     learning_rate: float = 1e-3  # Adam
@@ -73,8 +72,8 @@ PRESETS = {
                     portrayal_hidden_size=8, hidden_layers=1),
         TrainConfig(epochs_single=2, epochs_both=2, update_steps=3, chunk_count=4, chunk_length=8),
     ),
-    "default": (AgentConfig(), TrainConfig(update_steps=30, update_steps_one_behaviour=60, chunk_count=32,
-                                           learning_rate=3e-3, learning_rate_final=1e-4)),
+    "default": (AgentConfig(), TrainConfig(update_steps=60, chunk_count=32, learning_rate=3e-3,
+                                           learning_rate_final=1e-4)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

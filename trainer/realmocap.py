@@ -1,6 +1,6 @@
 """Learn from real motion capture (Bandai Namco Research, CC BY-NC 4.0) and compare with the baselines.
 
-    nice -n 15 python -m trainer.realmocap [--epochs 50] [--point-agent PATH] [--skip-training]
+    nice -n 15 python -m trainer.realmocap [--epochs 50] [--point-agent PATH]   (finished runs are reused)
 
 The clips are read from ../shared/realmocap/ beside the repository (never copied into it; see
 docs/REALMOCAP.md). Each BVH goes through trainer.clip_import (Blender's BVH importer and the

@@ -41,8 +41,8 @@ def test_fbx_round_trip_reproduces_every_joint_within_a_millimetre(settings, tmp
     error = np.abs(read_back - baked).max(axis=2)  # (frames, joints), metres
     # Known defect (docs/EXTENSION.md, Known limits): the sample rig's collars rest at exactly 90 degrees
     # to Spine2 (Euler Y = 90), gimbal lock for the FBX's XYZ Euler keys, so a frame whose collar turn is
-    # tiny can read back a few millimetres off (1.9 mm on Blender 5.0, 3.2 on 4.2 here). The rest of
-    # the frames are held to the 1 mm contract.
+    # tiny can read back a few millimetres off (one frame here: 1.1 mm on Blender 5.0 and 1.4 on 4.2 with
+    # the shipped agent; 1.9 and 3.2 with the one before). The rest of the frames are held to 1 mm.
     assert np.mean(error.max(axis=1) < 1e-3) >= 0.95
     assert error.max() < 5e-3
 

@@ -1,6 +1,4 @@
 """Algorithm 1: the episode buffer's chunks, one iteration's collection, and a debug run whose loss falls."""
-import dataclasses
-
 import numpy as np
 import pytest
 import torch
@@ -102,17 +100,6 @@ def test_debug_preset_trains_end_to_end_and_its_loss_falls(env, library):
     assert metrics["epoch"] == 15 and metrics["episodes"] == 2 + 15 * 2
     assert all(np.isfinite(v) for k, v in metrics.items() if k.startswith("loss/"))
     assert probe_loss() < 0.8 * before
-
-
-@pytest.mark.parametrize("behaviour, expected", [("both", 2), ("wave", 5), ("point", 5)])
-def test_one_behaviour_runs_take_their_own_update_count(env, library, behaviour, expected):
-    agent_config, train_config = load_preset("debug")
-    train_config = dataclasses.replace(train_config, update_steps=2, update_steps_one_behaviour=5)
-    torch.manual_seed(0)
-    trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, behaviour)
-    trainer.collect()
-    trainer.update()
-    assert trainer.optimizer.state_dict()["state"][0]["step"] == expected
 
 
 def test_clips_are_drawn_in_passes_without_replacement(env, library):
