@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from rlanimate_addon.core import metrics, rotations, skeleton, spaces
+from rlanimate_addon.core.easing import minimum_jerk
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 
@@ -71,12 +72,6 @@ def _blend(start, end, weights):
     q0 = np.broadcast_to(rotations.rotvec_to_quat(start), end.shape[:-1] + (4,))
     w = np.broadcast_to(np.asarray(weights)[:, None], end.shape[:-1])
     return rotations.quat_to_rotvec(slerp(q0, rotations.rotvec_to_quat(end), w))
-
-
-def minimum_jerk(s):
-    """Minimum-jerk progress 10s^3 - 15s^4 + 6s^5 of s clipped to [0, 1]: a bell-shaped speed."""
-    s = np.clip(s, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
 
 
 def envelope(frame_count, rise_start, rise_end, fall_start, fall_end):

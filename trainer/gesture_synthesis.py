@@ -24,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core.easing import minimum_jerk
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import matrix_to_rotvec, rotvec_to_matrix
 
@@ -174,12 +175,6 @@ def draw_style(seed):
 
 # ---------------------------------------------------------------------------------------------
 # Timing.
-
-def minimum_jerk(s):
-    """Minimum-jerk progress 10s^3 - 15s^4 + 6s^5 on s in [0, 1] (clipped): bell-shaped speed."""
-    s = np.clip(s, 0.0, 1.0)
-    return s**3 * (10.0 - 15.0 * s + 6.0 * s * s)
-
 
 def keyed_progress(times, knots):
     """Progress at `times` (T,) through (time, value) knots, minimum-jerk between consecutive knots:

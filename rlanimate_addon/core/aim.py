@@ -12,6 +12,7 @@ stroke to 1 by its middle, and back to 0 over the return.
 import numpy as np
 
 from . import kinematics, skeleton
+from .easing import minimum_jerk
 from .rotations import matrix_to_rotvec, rotvec_to_matrix
 
 #: Refinements of the shoulder rotation: each one shrinks the residual by about |b - S| / |T - S|
@@ -69,12 +70,6 @@ def shoulder_corrections(shoulder, base, finger, targets):
     return matrix_to_rotvec(total)
 
 
-def minimum_jerk(s):
-    """The minimum-jerk ramp 10 s^3 - 15 s^4 + 6 s^5 from 0 to 1 on s in [0, 1]: zero velocity and
-    acceleration at both ends."""
-    return s * s * s * (s * (6.0 * s - 15.0) + 10.0)
-
-
 def pointing_phase(base):
     """(N,) weight in [0, 1] for finger-base positions (N, 3): 0 at the first and last frames, 1 from
     the middle of the stroke to the middle of the return.
@@ -97,7 +92,7 @@ def pointing_phase(base):
         relative = travel / travel.max()
         start, full = (int(np.argmax(relative >= fraction)) for fraction in PHASE_RAMP)
         start = max(0, min(start, full - shortest))
-        ramp = minimum_jerk(np.clip((frames - start) / max(full - start, 1), 0.0, 1.0))
+        ramp = minimum_jerk((frames - start) / max(full - start, 1))
         weight = np.minimum(weight, ramp[::sign])
     return weight
 

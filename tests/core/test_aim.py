@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import aim, gesture, kinematics, metrics, runtime, skeleton
+from rlanimate_addon.core.easing import minimum_jerk
 
 FRAMES = 120  # about the agent's average Point length
 SHORTEST = 46  # 0.4 x that: the shortest length the panel offers
@@ -98,7 +99,7 @@ def test_pointing_phase_is_a_minimum_jerk_ramp_in_time_however_the_hand_accelera
     # First frames at 1% and 50% of the largest distance, (t / 20)^4: 7 and 17; the ramp is stretched
     # back to MIN_RAMP_SHARE of the 60 frames, 12.
     start, full = 5, 17
-    expected = aim.minimum_jerk(np.clip((frames - start) / (full - start), 0.0, 1.0))
+    expected = minimum_jerk((frames - start) / (full - start))
     np.testing.assert_allclose(weights[:40], expected[:40], atol=1e-12)
     assert weights[-1] == 0.0 and np.all(np.diff(weights[40:]) <= 0.0) and weights[40] == 1.0
 

@@ -6,15 +6,11 @@ import pytest
 from scipy.signal import savgol_filter
 
 from rlanimate_addon.core import metrics
+from rlanimate_addon.core.easing import minimum_jerk
 from rlanimate_addon.core.errors import RLAnimateError
 
 FPS = 30
 JOINTS = 10
-
-
-def minimum_jerk(s):
-    s = np.clip(s, 0.0, 1.0)
-    return 10 * s**3 - 15 * s**4 + 6 * s**5
 
 
 def gesture(rng, frames, reach, wave_hz=0.0):
