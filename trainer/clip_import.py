@@ -319,7 +319,9 @@ def _import_uncached(path, expected_fps, bone_map):
 # --- cache ----------------------------------------------------------------------------------------
 
 def _file_hash(path):
-    digest = hashlib.sha256(f"v{IMPORT_VERSION}:".encode())
+    """Cache key of a clip file: its bytes, the importer version and the canonical skeleton it is
+    retargeted onto (a clip's local rotations are relative to the skeleton's rest frames)."""
+    digest = hashlib.sha256(f"v{IMPORT_VERSION}:{skeleton.BONES!r}:".encode())
     with open(path, "rb") as handle:
         for block in iter(lambda: handle.read(1 << 20), b""):
             digest.update(block)

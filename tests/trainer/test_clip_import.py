@@ -211,13 +211,8 @@ def test_load_clip_set_attaches_the_manifest_labels_and_split(library, tmp_path)
     assert objective.shape == (FRAMES, spaces.OBJECTIVE_SIZE)
 
 
-def test_imported_clips_are_cached_and_reused_without_reimporting(library, tmp_path, monkeypatch):
-    files, _, _ = library
-    manifest, _ = write_manifest(tmp_path, files)
-    first = clip_import.load_clip_set(manifest)
-    cached = sorted((tmp_path / clip_import.CACHE_DIR_NAME).glob("*.npz"))
-    assert len(cached) == 2  # the two good files; the bad one is not cached
-
+def count_imports(monkeypatch):
+    """A list that collects the name of every file clip_import really imports (not from its cache)."""
     imported = []
     real_import = clip_import._import_uncached
 
@@ -226,6 +221,17 @@ def test_imported_clips_are_cached_and_reused_without_reimporting(library, tmp_p
         return real_import(path, *args)
 
     monkeypatch.setattr(clip_import, "_import_uncached", counting_import)
+    return imported
+
+
+def test_imported_clips_are_cached_and_reused_without_reimporting(library, tmp_path, monkeypatch):
+    files, _, _ = library
+    manifest, _ = write_manifest(tmp_path, files)
+    first = clip_import.load_clip_set(manifest)
+    cached = sorted((tmp_path / clip_import.CACHE_DIR_NAME).glob("*.npz"))
+    assert len(cached) == 2  # the two good files; the bad one is not cached
+
+    imported = count_imports(monkeypatch)
     second = clip_import.load_clip_set(manifest)
     assert imported == ["point_right_001.fbx"]  # only the bad file, which has no cache entry
     for a, b in zip(first.clips, second.clips):
@@ -243,3 +249,14 @@ def test_a_manifest_whose_frame_count_disagrees_with_the_file_is_reported(librar
     clips, problems = clip_import.import_clip_directory(manifest, cache_dir=False)
     assert [c.name for c in clips] == ["wave_right_000"]
     assert any(f"has {FRAMES} frames but the manifest says {FRAMES + 3}" in p for p in problems)
+
+
+def test_a_changed_skeleton_does_not_reuse_clips_cached_for_the_old_one(library, tmp_path, monkeypatch):
+    files, _, _ = library
+    clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
+    moved = tuple(b._replace(head=(0.06, -0.03, 1.44)) if b.name == "LeftShoulder" else b for b in skeleton.BONES)
+    monkeypatch.setattr(skeleton, "BONES", moved)
+    imported = count_imports(monkeypatch)
+    clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
+    assert imported == [files["fbx"].name], "a clip cached for other rest frames must be imported again"
+    assert len(list(tmp_path.glob("*.npz"))) == 2
