@@ -40,7 +40,11 @@ _FINGER_BASES = {  # name: (base position, direction, phalanx lengths 1-4)
 def _left_side_bones():
     bones = [
         Bone("LeftEye", "Head", (0.032, -0.085, 1.665), (0.032, -0.110, 1.665), _UP),
-        Bone("LeftShoulder", "Spine2", (0.060, 0.0, 1.440), (0.170, 0.0, 1.450), _UP),
+        # The collar starts 2 cm in front of the shoulder joint, as a clavicle runs back from the
+        # sternum. This also keeps its rest frame 10 degrees off gimbal lock relative to Spine2 (Euler
+        # XYZ (-84.9, -79.7, 0)); in the spine's plane it sat at Y = 90, where the XYZ Euler keys of an
+        # FBX file lose up to a few millimetres on frames whose collar turn is tiny.
+        Bone("LeftShoulder", "Spine2", (0.060, -0.020, 1.440), (0.170, 0.0, 1.450), _UP),
         Bone("LeftArm", "LeftShoulder", (0.170, 0.0, 1.450), (0.450, 0.0, 1.450), _UP),
         Bone("LeftForeArm", "LeftArm", (0.450, 0.0, 1.450), (0.700, 0.0, 1.450), _UP),
         Bone("LeftHand", "LeftForeArm", (0.700, 0.0, 1.450), (0.800, -0.006, 1.450), _UP),

@@ -24,3 +24,14 @@ def test_batched_poses_match_single_poses():
     batched = kinematics.pose_matrices({"LeftForeArm": rot})
     for i in range(4):
         np.testing.assert_allclose(batched[i], kinematics.pose_matrices({"LeftForeArm": rot[i]}), atol=1e-12)
+
+
+def test_no_bone_rests_near_gimbal_lock_of_the_euler_keys_an_fbx_file_stores():
+    # FBX stores a bone's rotation relative to its parent as XYZ Euler angles (R = Rz Ry Rx); at Y = +-90
+    # degrees the decomposition is singular and a frame with a tiny turn reads back millimetres off.
+    for bone in skeleton.BONES:
+        if bone.parent is None:
+            continue
+        relative = skeleton.rest_frame(skeleton.BONE_BY_NAME[bone.parent]).T @ skeleton.rest_frame(bone)
+        euler_y = np.degrees(np.arcsin(np.clip(-relative[2, 0], -1.0, 1.0)))
+        assert abs(euler_y) < 80.0, f"{bone.name} rests {90 - abs(euler_y):.1f} degrees from gimbal lock"

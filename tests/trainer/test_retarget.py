@@ -22,8 +22,8 @@ def world_frames(local):
 
 
 def angle_degrees(a, b):
-    cos = np.sum(a * b, axis=-1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    """Angle between vectors; atan2 keeps it exact near 0, where arccos of the cosine has a 1e-6 deg floor."""
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(a, b), axis=-1), np.sum(a * b, axis=-1)))
 
 
 def test_swing_is_the_shortest_rotation_between_directions():
