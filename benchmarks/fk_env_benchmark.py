@@ -6,7 +6,6 @@ replaces the "FK environment" section of docs/BENCHMARKS.md with it (other secti
 """
 import os
 import platform
-import re
 import sys
 import time
 from datetime import datetime, timezone
@@ -22,13 +21,13 @@ import numpy as np  # noqa: E402
 from rlanimate_addon.core import kinematics, skeleton, spaces  # noqa: E402
 from trainer import bpy_support  # noqa: E402
 from trainer.fk_env import FKEnvironment  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 INSTANCE_COUNTS = (1, 4, 8, 16, 64, 256)
 POSES = 2048
 REPEATS = 5
 COMMAND = "nice -n 10 python benchmarks/fk_env_benchmark.py"
 HEADING = "## FK environment"
-BENCHMARKS_MD = bpy_support.REPO_ROOT / "docs" / "BENCHMARKS.md"
 
 
 LOAD_AT_START = os.getloadavg()[0]
@@ -93,16 +92,7 @@ def section(rows):
     return "\n".join(lines) + "\n"
 
 
-def write_section(text, path=BENCHMARKS_MD):
-    """Replace this benchmark's section of `path` (or append it), keeping every other section."""
-    old = path.read_text() if path.exists() else "# Benchmarks\n"
-    pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.S | re.M)
-    new = pattern.sub(lambda _: text + "\n", old) if pattern.search(old) else old.rstrip("\n") + "\n\n" + text
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(new.rstrip("\n") + "\n")
-
-
 if __name__ == "__main__":
     table = section(measure())
     print(table)
-    write_section(table)
+    report.write_section(HEADING, table)

@@ -26,10 +26,10 @@ import numpy as np  # noqa: E402
 
 from rlanimate_addon.blender import armature_io, preferences  # noqa: E402
 from rlanimate_addon.core import gesture  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 FRAMES = 120
 SECTION = "## Generate Gesture"
-REPORT = ROOT / "docs" / "BENCHMARKS.md"
 
 
 def fresh_scene():
@@ -102,17 +102,6 @@ def ms(values):
     return f"{1000 * min(values):.1f} | {1000 * statistics.median(values):.1f}"
 
 
-def write_section(text):
-    report = REPORT.read_text() if REPORT.exists() else "# Benchmarks\n"
-    if SECTION in report:
-        head, rest = report.split(SECTION, 1)
-        tail = rest[rest.find("\n## "):] if "\n## " in rest else ""
-        report = head + text + tail
-    else:
-        report = report.rstrip("\n") + "\n\n" + text
-    REPORT.write_text(report.rstrip("\n") + "\n")
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=25)
@@ -154,7 +143,7 @@ Generate / playback ratio (Point, best): {ratio:.2f}. Budget: under 100 ms; aim:
 """
     print(text)
     if not args.no_write:
-        write_section(text)
+        report.write_section(SECTION, text)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,6 @@ and replaces the "Numpy runtime" section of docs/BENCHMARKS.md with it (other se
 """
 import os
 import platform
-import re
 import sys
 import tempfile
 import time
@@ -30,6 +29,7 @@ from rlanimate_addon.core.runtime import load_agent  # noqa: E402
 from trainer.config import load_preset  # noqa: E402
 from trainer.export import export_agent  # noqa: E402
 from trainer.models import VARIANTS, RLAnimateAgent  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 DEFAULT_AGENT = REPO_ROOT / "rlanimate_addon" / "agents" / "default.npz"
 LENGTH_SCALES = (0.4, 1.0, 1.5)
@@ -37,7 +37,6 @@ REPEATS = 30
 BUDGET_US = 100.0
 COMMAND = "nice -n 10 python benchmarks/runtime_benchmark.py"
 HEADING = "## Numpy runtime"
-BENCHMARKS_MD = REPO_ROOT / "docs" / "BENCHMARKS.md"
 LOAD_AT_START = os.getloadavg()[0]
 
 
@@ -115,15 +114,7 @@ def section(rows):
     return "\n".join(lines) + "\n"
 
 
-def write_section(text, path=BENCHMARKS_MD):
-    """Replace this benchmark's section of `path` (or append it), keeping every other section."""
-    old = path.read_text() if path.exists() else "# Benchmarks\n"
-    pattern = re.compile(rf"^{re.escape(HEADING)}\n.*?(?=^## |\Z)", re.S | re.M)
-    new = pattern.sub(lambda _: text + "\n", old) if pattern.search(old) else old.rstrip("\n") + "\n\n" + text
-    path.write_text(new.rstrip("\n") + "\n")
-
-
 if __name__ == "__main__":
     table = section(measure())
     print(table)
-    write_section(table)
+    report.write_section(HEADING, table)
