@@ -3,7 +3,8 @@
 It mirrors `trainer/models.py` (whose docstring has the timing diagram) equation for equation, in
 float64 from the file's float32 weights, so its deterministic rollout reproduces the torch agent's
 within 1e-5. Work that does not depend on the recurrence (the portrayal model, the task state and
-their contributions to each layer) is done for all frames at once before the per-frame loop.
+their contributions to each layer) is done for all frames at once before the per-frame loop, and
+the rollout runs on one BLAS thread (core/blas_threads.py).
 
 `GestureAgent.rollout(objectives, seed=None)`:
     seed None  the deterministic rollout: z_t is the posterior mean (the prior mean for a
@@ -14,7 +15,7 @@ their contributions to each layer) is done for all frames at once before the per
 """
 import numpy as np
 
-from . import agent_file, spaces
+from . import agent_file, blas_threads, spaces
 from .errors import RLAnimateError
 
 
@@ -130,7 +131,10 @@ class GestureAgent:
             raise RLAnimateError(f"This agent was trained for {' and '.join(b.lower() for b in self.behaviours)} "
                                  f"only: choose an agent trained for the requested behaviour in the add-on "
                                  f"preferences.")
-        rng = None if seed is None else np.random.default_rng(seed)
+        with blas_threads.single_blas_thread():
+            return self._rollout(objectives, None if seed is None else np.random.default_rng(seed))
+
+    def _rollout(self, objectives, rng):
         E, Z = self._sizes
         A = spaces.ACTION_SIZE
         count = len(objectives)

@@ -35,7 +35,8 @@ def test_built_zip_holds_only_the_add_on(tmp_path):
     with zipfile.ZipFile(_build(tmp_path)) as package:
         names = package.namelist()
     assert {"blender_manifest.toml", "__init__.py", "rlanimate_addon/__init__.py",
-            "rlanimate_addon/blender/registration.py", "rlanimate_addon/core/gesture.py"} <= set(names)
+            "rlanimate_addon/blender/registration.py", "rlanimate_addon/core/gesture.py",
+            "wheels/threadpoolctl-3.8.0-py3-none-any.whl"} <= set(names)
     for excluded in ("trainer/", "tests/", "docs/", "benchmarks/", "sample_rigs/", ".ci/", "scripts/"):
         assert not any(n.startswith(excluded) for n in names), excluded
     assert not any("__pycache__" in n or n.endswith(".pyc") for n in names)
@@ -77,3 +78,4 @@ def test_built_zip_installs_and_enables_in_a_fresh_session(tmp_path):
     assert report["enabled"] and report["preferences"] and report["scene_settings"]
     assert report["operators"] == ["export_fbx", "generate_gesture"]
     assert Path(report["module_file"]).is_relative_to(user), "the add-on must run from the installed copy"
+    assert list((user / "extensions").rglob("site-packages/threadpoolctl.py")), "the bundled wheel must be installed"

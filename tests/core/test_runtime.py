@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 import torch
 
+from rlanimate_addon.core import runtime as runtime_module
 from rlanimate_addon.core import spaces
 from rlanimate_addon.core.runtime import GestureAgent, load_agent
 from trainer.config import load_preset
@@ -54,6 +55,23 @@ def test_rollout_is_a_pure_function_of_the_objectives(tmp_path):
     first = runtime.rollout(objectives)
     runtime.rollout(objectives_for_tests()[1])
     np.testing.assert_array_equal(runtime.rollout(objectives), first)
+
+
+def test_the_rollout_runs_numpy_blas_on_one_thread_and_restores_the_setting(tmp_path, monkeypatch):
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads():
+        return {info["num_threads"] for info in threadpoolctl.threadpool_info() if info["user_api"] == "blas"}
+
+    assert blas_threads(), "numpy should load a BLAS library threadpoolctl can see"
+    runtime = load_agent(exported_agent(tmp_path, "debug", "rlanimate")[1])
+    seen = []
+    gru_step = runtime_module._gru_step
+    monkeypatch.setattr(runtime_module, "_gru_step", lambda *args: seen.append(blas_threads()) or gru_step(*args))
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        runtime.rollout(objectives_for_tests()[0])
+        assert blas_threads() == {2}, "the user's BLAS setting must be restored"
+    assert seen and all(threads == {1} for threads in seen)
 
 
 @pytest.mark.parametrize("variant", VARIANTS)
