@@ -31,9 +31,10 @@ MIN_RAMP_SHARE = 0.2
 def finger_lines(rotvecs, arm):
     """Posed shoulder S, index base b and unit finger direction f, each (N, 3), and the Arm bone's
     armature-space pose rotation W (N, 3, 3), for canonical action-joint rotations (N, 15, 3)."""
-    pose = kinematics.pose_matrices({j: rotvecs[:, i] for i, j in enumerate(skeleton.ACTION_JOINTS)})
-    heads = kinematics.head_positions(pose)  # (N, B, 3)
     prefix = skeleton.ARM_PREFIX[arm]
+    pose = kinematics.pose_matrices({j: rotvecs[:, i] for i, j in enumerate(skeleton.ACTION_JOINTS)},
+                                    only=(prefix + "Arm", prefix + "HandIndex1", prefix + "HandIndex4"))
+    heads = kinematics.head_positions(pose)  # (N, B, 3), NaN off the arm's chain
     arm_index = kinematics.bone_index(prefix + "Arm")
     base = heads[:, kinematics.bone_index(prefix + "HandIndex1")]
     finger = heads[:, kinematics.bone_index(prefix + "HandIndex4")] - base

@@ -20,20 +20,36 @@ def bone_index(name):
     return _INDEX[name]
 
 
-def pose_matrices(local_rotvecs):
+def pose_matrices(local_rotvecs, only=None):
     """Armature-space pose matrices (..., B, 4, 4) from {bone name: (..., 3) local rotation vector}.
 
-    Bones not named keep their rest rotation. Every value must share one batch shape.
+    Bones not named keep their rest rotation. Every value must share one batch shape. only: bone
+    names; when given, just they and their ancestors are evaluated (a quicker pass for code that reads
+    a few bones) and every other bone's matrix is NaN.
     """
     batch = np.shape(next(iter(local_rotvecs.values())))[:-1] if local_rotvecs else ()
+    evaluated = range(len(_PARENT)) if only is None else _with_ancestors(only)
     basis = np.broadcast_to(np.eye(4), batch + (len(skeleton.BONES), 4, 4)).copy()
     for name, rotvec in local_rotvecs.items():
-        basis[..., _INDEX[name], :3, :3] = rotvec_to_matrix(rotvec)
-    pose = np.empty_like(basis)
-    for i, parent in enumerate(_PARENT):
+        if _INDEX[name] in evaluated:
+            basis[..., _INDEX[name], :3, :3] = rotvec_to_matrix(rotvec)
+    pose = np.full_like(basis, np.nan)
+    for i in evaluated:
         local = _REST_LOCAL[i] @ basis[..., i, :, :]
+        parent = _PARENT[i]
         pose[..., i, :, :] = local if parent < 0 else pose[..., parent, :, :] @ local
     return pose
+
+
+def _with_ancestors(names):
+    """Sorted indices of the named bones and all their ancestors (parents come before children)."""
+    indices = set()
+    for name in names:
+        i = _INDEX[name]
+        while i >= 0 and i not in indices:
+            indices.add(i)
+            i = _PARENT[i]
+    return sorted(indices)
 
 
 def head_positions(pose):

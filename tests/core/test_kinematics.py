@@ -35,3 +35,19 @@ def test_no_bone_rests_near_gimbal_lock_of_the_euler_keys_an_fbx_file_stores():
         relative = skeleton.rest_frame(skeleton.BONE_BY_NAME[bone.parent]).T @ skeleton.rest_frame(bone)
         euler_y = np.degrees(np.arcsin(np.clip(-relative[2, 0], -1.0, 1.0)))
         assert abs(euler_y) < 80.0, f"{bone.name} rests {90 - abs(euler_y):.1f} degrees from gimbal lock"
+
+
+def test_evaluating_only_some_bones_gives_their_full_pose_and_nan_elsewhere():
+    rng = np.random.default_rng(5)
+    local = {name: rng.normal(scale=0.5, size=(6, 3)) for name in skeleton.ACTION_JOINTS}
+    full = kinematics.pose_matrices(local)
+    only = ("RightArm", "RightHandIndex4")
+    partial = kinematics.pose_matrices(local, only=only)
+    chain = {kinematics.bone_index(n) for n in ("Hips", "Spine", "Spine1", "Spine2", "RightShoulder", "RightArm",
+                                                 "RightForeArm", "RightHand", "RightHandIndex1", "RightHandIndex2",
+                                                 "RightHandIndex3", "RightHandIndex4")}
+    for i in range(len(skeleton.BONES)):
+        if i in chain:
+            np.testing.assert_allclose(partial[:, i], full[:, i], atol=1e-12)
+        else:
+            assert np.isnan(partial[:, i]).all(), skeleton.BONES[i].name
