@@ -2,10 +2,9 @@
 
 The agent's own aim is a few degrees off on unseen targets (docs/EXTENSION.md, "Aim correction").
 On the canonical skeleton, each frame's finger line (index base b, direction f) is turned about the
-posed shoulder joint S (the Arm bone's head) by the rotation R that lays f onto the target T as
-seen from b. Rotating about S moves b too, so R is refined (about ten passes); this converges
-because |T - S| (1.5-4 m) is well above |b - S| (an arm's length). R is applied to the Arm bone's
-local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation), with its rotation
+posed shoulder joint S (the Arm bone's head) by a rotation R that puts T on the line: in closed
+form, the shortest rotation taking the point of the line as far from S as T is onto T. R is applied
+to the Arm bone's local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation), with its rotation
 vector scaled by a pointing-phase weight that ramps with minimum jerk from 0 at the start of the
 stroke to 1 by its middle, and back to 0 over the return.
 """
@@ -15,10 +14,6 @@ from . import kinematics, skeleton
 from .easing import minimum_jerk
 from .rotations import matrix_to_rotvec, rotvec_to_matrix
 
-#: Refinements of the shoulder rotation: each one shrinks the residual by about |b - S| / |T - S|
-#: (0.2-0.4 for targets 1.5-4 m away); they stop once every frame is within TOLERANCE radians.
-MAX_ITERATIONS = 30
-TOLERANCE = 1e-5
 #: The correction fades in while the finger base travels between these fractions of its largest
 #: excursion from its start position, and out again while it travels back between the same fractions
 #: of its largest excursion from its end position ...
@@ -54,21 +49,23 @@ def rotation_between(a, b):
 def shoulder_corrections(shoulder, base, finger, targets):
     """(N, 3) armature-space rotation vectors about the shoulder that aim each finger line at its target.
 
-    shoulder, base, targets: (N, 3) positions; finger: (N, 3) unit directions. The finger line moves
-    rigidly with the arm, so each refinement only re-rotates b and f, with no new forward kinematics.
+    shoulder, base, targets: (N, 3) positions; finger: (N, 3) unit directions. In the arm's own frame
+    the target must lie on the finger line, at the point base + lambda * finger that is as far from the
+    shoulder as the target is (the root of |a + lambda f|^2 = |T - S|^2, a = b - S); the correction is
+    the shortest rotation taking that point's direction from the shoulder onto the target's. A target
+    nearer the shoulder than the finger line passes gets the line's nearest point.
     """
-    total = np.broadcast_to(np.eye(3), (len(base), 3, 3))
     arm_offset = base - shoulder  # (N, 3)
-    for _ in range(MAX_ITERATIONS):
-        moved_base = shoulder + np.einsum("nij,nj->ni", total, arm_offset)
-        moved_finger = np.einsum("nij,nj->ni", total, finger)
-        wanted = targets - moved_base
-        wanted /= np.linalg.norm(wanted, axis=1, keepdims=True)
-        step = rotation_between(moved_finger, wanted)
-        total = step @ total
-        if np.max(np.arccos(np.clip(np.trace(step, axis1=1, axis2=2) * 0.5 - 0.5, -1.0, 1.0))) < TOLERANCE:
-            break
-    return matrix_to_rotvec(total)
+    to_target = targets - shoulder
+    along = np.sum(arm_offset * finger, axis=1)
+    reach = np.sum(to_target * to_target, axis=1) - np.sum(arm_offset * arm_offset, axis=1)
+    distance = -along + np.sqrt(np.maximum(along ** 2 + reach, 0.0))  # lambda, (N,)
+    on_line = arm_offset + distance[:, None] * finger
+    return matrix_to_rotvec(rotation_between(_unit(on_line), _unit(to_target)))
+
+
+def _unit(vectors):
+    return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
 
 
 def pointing_phase(base):

@@ -4,7 +4,7 @@ import math
 import numpy as np
 import pytest
 
-from rlanimate_addon.core import aim, gesture, kinematics, metrics, runtime, skeleton
+from rlanimate_addon.core import aim, gesture, kinematics, metrics, rotations, runtime, skeleton
 from rlanimate_addon.core.easing import minimum_jerk
 
 FRAMES = 120  # about the agent's average Point length
@@ -106,3 +106,20 @@ def test_pointing_phase_is_a_minimum_jerk_ramp_in_time_however_the_hand_accelera
 
 def test_a_finger_that_does_not_move_gets_no_correction():
     assert np.all(aim.pointing_phase(np.ones((30, 3))) == 0.0)
+
+
+def test_shoulder_correction_puts_each_target_exactly_on_its_turned_finger_line():
+    rng = np.random.default_rng(11)
+    shoulder = rng.normal(scale=0.1, size=(200, 3))
+    base = shoulder + rng.normal(scale=0.35, size=(200, 3))
+    finger = rng.normal(size=(200, 3))
+    finger /= np.linalg.norm(finger, axis=1, keepdims=True)
+    directions = rng.normal(size=(200, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    targets = shoulder + directions * rng.uniform(1.5, 4.0, (200, 1))  # 1.5-4 m away
+    turn = rotations.rotvec_to_matrix(aim.shoulder_corrections(shoulder, base, finger, targets))  # (200, 3, 3)
+    turned_base = shoulder + np.einsum("nij,nj->ni", turn, base - shoulder)
+    turned_finger = np.einsum("nij,nj->ni", turn, finger)
+    to_target = targets - turned_base
+    cos = np.sum(to_target * turned_finger, axis=1) / np.linalg.norm(to_target, axis=1)
+    assert np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))).max() < 1e-5, "the target must lie ahead on the line"
