@@ -4,9 +4,9 @@ The agent's own aim is a few degrees off on unseen targets (docs/EXTENSION.md, "
 On the canonical skeleton, each frame's finger line (index base b, direction f) is turned about the
 posed shoulder joint S (the Arm bone's head) by a rotation R that puts T on the line: in closed
 form, the shortest rotation taking the point of the line as far from S as T is onto T. R is applied
-to the Arm bone's local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation), with its rotation
-vector scaled by a pointing-phase weight that ramps with minimum jerk from 0 at the start of the
-stroke to 1 by its middle, and back to 0 over the return.
+to the Arm bone's local rotation, B' = B W^-1 R W (W: the Arm bone's armature-space pose rotation),
+with its rotation vector scaled by a pointing-phase weight that ramps with minimum jerk from 0 at
+the start of the stroke to 1 by its middle, and back to 0 over the return.
 """
 import numpy as np
 

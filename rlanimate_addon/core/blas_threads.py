@@ -2,8 +2,9 @@
 
 numpy's OpenBLAS splits even a 64 x 320 vector-matrix product over every core. The rollout does a
 few such products per frame, too small to gain from threads, and on a machine whose cores are busy
-(a render, a simulation, another program) each product waits for a descheduled BLAS thread: a
-120-frame rollout that takes 15 ms took over a second (docs/BENCHMARKS.md, "BLAS threads").
+(a render, a simulation, another program) each product waits for a descheduled BLAS thread: beside
+busy processes a 120-frame rollout took a median 0.9 s, against 47 ms on one thread
+(docs/BENCHMARKS.md, "BLAS threads").
 threadpoolctl, which the extension bundles as a wheel, caps BLAS at one thread for the rollout and
 restores the user's setting afterwards. Where it is not installed, nothing is capped.
 """
