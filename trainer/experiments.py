@@ -5,7 +5,8 @@
 Trains the four methods (RLAnimate and its three ablations) on each column (wave, point, both)
 for the paper's 50 / 100 epochs times --epoch-scale, each run by `trainer/train.py` in its own
 process, --jobs at a time, into runs/experiments/<method>_<column>/. Runs that already finished are
-kept and interrupted ones resume from their checkpoints. Then it writes to docs/results/:
+kept and interrupted ones resume from their checkpoints. Then it writes to docs/results/ (with
+--seed N other than 0: runs/experiments_seedN/ and docs/results/seedN/):
     table4.json   {method: {column: {score, smoothness, episodes, train_seconds}}} (held-out clips)
     table4.md     the same as a table, with the training-clip scores and the run settings
     figure3_seen.png, figure3_unseen.png   score over epochs on seen and unseen clips
@@ -43,12 +44,23 @@ def build_parser():
     parser.add_argument("--methods", nargs="+", choices=train.VARIANTS, default=list(train.VARIANTS))
     parser.add_argument("--columns", nargs="+", choices=COLUMNS, default=list(COLUMNS))
     parser.add_argument("--clips", default=str(train.DEFAULT_MANIFEST))
-    parser.add_argument("--runs", default=str(REPO_ROOT / "runs" / "experiments"))
-    parser.add_argument("--results", default=str(train.RESULTS_DIR))
+    parser.add_argument("--runs", help="default: runs/experiments, runs/experiments_seed<N> for another seed")
+    parser.add_argument("--results", help="default: docs/results, docs/results/seed<N> for another seed")
     parser.add_argument("--eval-every", type=int, default=5)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--jobs", type=int, default=1, help="training runs at a time, one process each")
     return parser
+
+
+def parse_options(argv=None):
+    """The command line, with --runs and --results defaulting to per-seed folders beyond seed 0, so
+    that another seed never reuses seed 0's runs or overwrites its results."""
+    options = build_parser().parse_args(script_args(argv))
+    suffix = "" if options.seed == 0 else f"_seed{options.seed}"
+    options.runs = options.runs or str(REPO_ROOT / "runs" / f"experiments{suffix}")
+    default_results = Path(train.RESULTS_DIR) if options.seed == 0 else Path(train.RESULTS_DIR) / f"seed{options.seed}"
+    options.results = options.results or str(default_results)
+    return options
 
 
 def run_folder(options, method, column):
@@ -141,7 +153,7 @@ def write_table_and_figures(options, results):
     settings = (f"Preset `{options.preset}`, seed {options.seed}, epochs = {options.epoch_scale:g} x the paper's "
                 f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1). "
                 f"Regenerate: `nice -n 10 python -m trainer.experiments --preset {options.preset} "
-                f"--epoch-scale {options.epoch_scale:g}`.")
+                f"--epoch-scale {options.epoch_scale:g}{f' --seed {options.seed}' if options.seed else ''}`.")
     (results / "table4.json").write_text(json.dumps(table, indent=2) + "\n")
     (results / "table4.md").write_text(table4_markdown(table, seen, settings))
     for split in ("seen", "unseen"):
@@ -175,7 +187,7 @@ def write_length_flexibility(options, results):
 
 
 def main(argv=None):
-    options = build_parser().parse_args(script_args(argv))
+    options = parse_options(argv)
     torch.set_num_threads(1)
     results = Path(options.results)
     results.mkdir(parents=True, exist_ok=True)
