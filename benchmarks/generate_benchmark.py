@@ -26,6 +26,7 @@ import numpy as np  # noqa: E402
 
 from rlanimate_addon.blender import armature_io, preferences  # noqa: E402
 from rlanimate_addon.core import gesture  # noqa: E402
+from trainer import bpy_support  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
 FRAMES = 120
@@ -35,11 +36,7 @@ SECTION = "## Generate Gesture"
 def fresh_scene():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon_utils.enable("rlanimate_addon", default_set=True)
-    with bpy.data.libraries.load(str(ROOT / "sample_rigs" / "character.blend"), link=False) as (source, target):
-        target.objects = list(source.objects)
-    for obj in target.objects:
-        bpy.context.scene.collection.objects.link(obj)
-    rig = bpy.data.objects["RLAnimate_Character"]
+    rig = bpy_support.load_rig(bpy_support.SAMPLE_RIG_BLEND, with_mesh=True)
     bpy.context.view_layer.objects.active = rig
     target = bpy.data.objects.new("Target", None)
     target.location = (-1.2, -2.5, 1.7)
