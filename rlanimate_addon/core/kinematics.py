@@ -6,7 +6,7 @@ the clip generator's inverse kinematics, can predict what Blender will show.
 """
 import numpy as np
 
-from . import skeleton
+from . import skeleton, spaces
 from .rotations import rotvec_to_matrix
 
 _INDEX = {name: i for i, name in enumerate(skeleton.BONE_NAMES)}
@@ -55,3 +55,18 @@ def _with_ancestors(names):
 def head_positions(pose):
     """(..., B, 4, 4) pose matrices -> (..., B, 3) bone head positions."""
     return pose[..., :3, 3]
+
+
+_DESCRIBED = tuple(sorted({b for _, b in skeleton.DESCRIPTION_JOINTS}
+                          | {b for _, start, end in skeleton.EFFECTORS for b in (start, end) if b}))
+
+
+def describe(action_rotvecs):
+    """(..., 42) descriptions (spaces.describe) of the canonical skeleton posed by action-joint
+    rotations (..., 15, 3): what the Blender environment reports, without Blender."""
+    rotvecs = np.asarray(action_rotvecs, dtype=np.float64)
+    pose = pose_matrices({j: rotvecs[..., k, :] for k, j in enumerate(skeleton.ACTION_JOINTS)}, only=_DESCRIBED)
+    heads = head_positions(pose)
+    positions = {name: heads[..., _INDEX[name], :] for name in _DESCRIBED}
+    eyes = {name: pose[..., _INDEX[name], :3, 1] for name in ("LeftEye", "RightEye")}
+    return spaces.describe(positions, eyes)

@@ -141,3 +141,9 @@ def test_bad_actions_and_setup_raise_clear_errors(env, tmp_path):
         FKEnvironment(instances=0)
     with pytest.raises(RLAnimateError, match="does not exist"):
         FKEnvironment(tmp_path / "missing.blend")
+
+
+def test_numpy_describe_matches_the_environment(env):
+    rng = np.random.default_rng(11)
+    actions = rng.uniform(-1.0, 1.0, size=(5, JOINTS, 3))
+    np.testing.assert_allclose(kinematics.describe(actions), env.evaluate(actions).descriptions, atol=1e-5)

@@ -221,3 +221,22 @@ def test_blend_follows_a_great_circle_and_reaches_both_ends():
 def test_unusable_specs_raise_the_domain_error(spec):
     with pytest.raises(RLAnimateError):
         gs.synthesise(spec)
+
+
+def test_waves_measure_as_waves_and_their_class_mean_does_not():
+    """The behaviour metrics on the generator's own waves: 3-5 cycles at 2-3 Hz with the hand up;
+    the per-frame mean of several (a still-ish arm, as a regressing agent makes) fails the swing bound."""
+    from rlanimate_addon.core import behaviour_metrics as bm
+
+    waves = [spaces.description_joint_positions(kinematics.describe(
+        gs.synthesise(gs.GestureSpec("WAVE", "RIGHT", exaggeration=0.5, seed=seed)).action_rotvecs()))
+        for seed in range(6)]
+    for wave in waves:
+        measures = bm.wave_measures(wave, "RIGHT")
+        assert 3 <= measures["cycles"] <= 5 and 2.0 <= measures["frequency"] <= 3.0
+        assert 0.1 <= measures["swing"] <= 0.3
+    length = min(len(w) for w in waves)
+    mean = np.mean([bm.resample(w, length) for w in waves], axis=0)
+    comparison = bm.compare_wave(mean, bm.resample(waves[0], length), "RIGHT")
+    assert not bm.wave_accepted(comparison)
+    assert comparison["swing_ratio"] < bm.WAVE_SWING_RATIO[0]

@@ -1,0 +1,318 @@
+"""Behaviour metrics: does a generated gesture wave, point, raise and lower the arm like its reference?
+
+The paper's score (core.metrics) is dominated by joints that barely move and leans on each clip's own
+timing, so a still arm or a class mean scores close to a real wave. These measures read what an
+animator sees. All take joint positions (F, 10, 3) of skeleton.DESCRIPTION_JOINTS in the character
+frame (+X the character's left, -Y forward, +Z up, metres), as `spaces.description_joint_positions`
+gives them, and the gesturing arm ('LEFT' or 'RIGHT'). Definitions and thresholds: docs/METRICS.md.
+
+Wave, over the *hand-up run*: the longest run of frames whose wrist is at most HAND_UP_DROP arm
+lengths below the same arm's shoulder joint. The side-to-side coordinate is the wrist's X relative to
+that shoulder; a *stroke* is one leg between turning points of it found with hysteresis
+STROKE_FRACTION x shoulder width (each stroke moves at least that far); a full cycle is two strokes.
+Point: the finger line (index base b, unit direction f) against the target T; the *hold* is the run
+of frames, around the frame where b is farthest from its first position, with b within
+HOLD_FRACTION x shoulder width of that apex position.
+"""
+import numpy as np
+
+from . import metrics, skeleton, spaces
+from .errors import RLAnimateError
+
+FPS = 30
+#: The hand is up while the wrist is at most this many arm lengths below its shoulder joint.
+HAND_UP_DROP = 0.25
+#: A stroke moves the wrist side to side by at least this share of the shoulder width (the issue's 8%).
+STROKE_FRACTION = 0.08
+#: The pointing hold: the finger base moves slower than this many shoulder widths per second ...
+HOLD_SPEED = 0.25
+#: Sakoe-Chiba band of the time-aligned score, as a share of the longer clip.
+DTW_BAND = 0.15
+
+_JOINT = {name: k for k, (name, _) in enumerate(skeleton.DESCRIPTION_JOINTS)}
+
+
+def _side(arm):
+    if arm not in skeleton.ARMS:
+        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
+    return arm.lower()
+
+
+def _positions(positions, name="The clip"):
+    p = np.asarray(positions, dtype=np.float64)
+    if p.ndim != 3 or p.shape[1:] != (len(skeleton.DESCRIPTION_JOINTS), 3) or len(p) < 2:
+        raise RLAnimateError(f"{name} must be description-joint positions of shape (frames >= 2, "
+                             f"{len(skeleton.DESCRIPTION_JOINTS)}, 3), got {p.shape}.")
+    if not np.all(np.isfinite(p)):
+        raise RLAnimateError(f"{name} contains NaN or infinite positions: regenerate it.")
+    return p
+
+
+def finger_direction(descriptions, arm):
+    """(F, 3) unit index-finger direction (base to tip) of the arm, from descriptions (F, 42)."""
+    effectors = np.asarray(descriptions)[..., spaces.DESCRIPTION_EFFECTORS]
+    row = [name for name, _, _ in skeleton.EFFECTORS].index(f"{_side(arm)}_index")
+    return effectors[..., 3 * row:3 * row + 3]
+
+
+def joint(positions, name):
+    """(F, 3) path of one description joint, e.g. 'right_wrist'."""
+    return _positions(positions)[:, _JOINT[name]]
+
+
+def shoulder_width(positions):
+    """Distance (m) between the two shoulder joints in the first frame: the scale of the thresholds."""
+    p = _positions(positions)
+    return float(np.linalg.norm(p[0, _JOINT["left_shoulder"]] - p[0, _JOINT["right_shoulder"]]))
+
+
+def arm_length(positions, arm):
+    """Shoulder-elbow plus elbow-wrist length (m) in the first frame."""
+    p, side = _positions(positions), _side(arm)
+    shoulder, elbow, wrist = (p[0, _JOINT[f"{side}_{j}"]] for j in ("shoulder", "elbow", "wrist"))
+    return float(np.linalg.norm(elbow - shoulder) + np.linalg.norm(wrist - elbow))
+
+
+def elevation(positions, arm):
+    """(F,) arm elevation in degrees: the angle of the upper arm (shoulder to elbow) from straight
+    down; 0 hanging, 90 horizontal, 180 straight up."""
+    p, side = _positions(positions), _side(arm)
+    upper = p[:, _JOINT[f"{side}_elbow"]] - p[:, _JOINT[f"{side}_shoulder"]]
+    cosine = -upper[:, 2] / np.linalg.norm(upper, axis=1)
+    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def longest_run(mask):
+    """(first, last) frame of the longest run of True in a (F,) mask, end inclusive; None if none."""
+    mask = np.asarray(mask, dtype=bool)
+    if not mask.any():
+        return None
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    starts, stops = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0]
+    k = int(np.argmax(stops - starts))
+    return int(starts[k]), int(stops[k] - 1)
+
+
+def hand_up_run(positions, arm):
+    """(first, last) frame of the hand-up run (see the module docstring), or None."""
+    p, side = _positions(positions), _side(arm)
+    drop = p[:, _JOINT[f"{side}_shoulder"], 2] - p[:, _JOINT[f"{side}_wrist"], 2]  # (F,) m below shoulder
+    return longest_run(drop <= HAND_UP_DROP * arm_length(p, arm))
+
+
+def turning_points(signal, threshold):
+    """Frame indices of the pivots of a zig-zag through a (F,) signal with hysteresis `threshold`:
+    the start of the first leg, every turning point, and the end of the last leg. Consecutive pivots
+    differ by at least `threshold`; fewer than 2 pivots (an empty list) means no leg that long."""
+    x = np.asarray(signal, dtype=np.float64)
+    low = high = 0
+    direction, extreme, pivots = 0, 0, []
+    for i in range(1, len(x)):
+        if direction == 0:
+            low = i if x[i] < x[low] else low
+            high = i if x[i] > x[high] else high
+            if x[high] - x[low] >= threshold:
+                start, extreme = (low, high) if high > low else (high, low)
+                direction = 1 if high > low else -1
+                pivots = [start]
+        elif direction * (x[i] - x[extreme]) > 0:
+            extreme = i
+        elif direction * (x[extreme] - x[i]) >= threshold:
+            pivots.append(extreme)
+            direction, extreme = -direction, i
+    return pivots + [extreme] if direction else []
+
+
+def _refined(signal, frames):
+    """Sub-frame times of extrema at interior `frames` of a (F,) signal: the vertex of the parabola
+    through each extremum and its two neighbours (the frame itself at the signal's ends)."""
+    times = np.asarray(frames, dtype=np.float64)
+    for k, i in enumerate(frames):
+        if 0 < i < len(signal) - 1:
+            before, at, after = signal[i - 1:i + 2]
+            curvature = before - 2.0 * at + after
+            times[k] += 0.5 * (before - after) / curvature if curvature else 0.0
+    return times
+
+
+def wave_measures(positions, arm, fps=FPS):
+    """What a wave shows, in absolute units:
+    {'hand_up_s', 'strokes', 'cycles', 'swing' (m, median stroke; the run's side-to-side range when
+    there is no stroke), 'frequency' (Hz, 0 with fewer than 2 strokes), 'hand_height' (m, the 90th
+    percentile over all frames of the wrist's height above where a hanging arm's wrist would be)}."""
+    p, side = _positions(positions), _side(arm)
+    wrist, shoulder = p[:, _JOINT[f"{side}_wrist"]], p[:, _JOINT[f"{side}_shoulder"]]
+    length = arm_length(p, arm)
+    hand_height = float(np.percentile(wrist[:, 2] - shoulder[:, 2] + length, 90))
+    run = hand_up_run(p, arm)
+    if run is None:
+        return {"hand_up_s": 0.0, "strokes": 0, "cycles": 0, "swing": 0.0, "frequency": 0.0,
+                "hand_height": hand_height}
+    sideways = (wrist[:, 0] - shoulder[:, 0])[run[0]:run[1] + 1]  # (R,)
+    pivots = turning_points(sideways, STROKE_FRACTION * shoulder_width(p))
+    strokes = max(len(pivots) - 1, 0)
+    legs = np.abs(np.diff(sideways[pivots])) if strokes else np.ptp(sideways, keepdims=True)
+    turns = pivots[1:-1] if strokes >= 3 else pivots  # the run's ends need not be turning points
+    half_period_s = np.median(np.diff(_refined(sideways, turns))) / fps if strokes >= 2 else np.inf
+    return {"hand_up_s": (run[1] - run[0] + 1) / fps, "strokes": strokes, "cycles": strokes // 2,
+            "swing": float(np.median(legs)),
+            "frequency": float(0.5 / half_period_s), "hand_height": hand_height}
+
+
+def ratio(value, reference):
+    """value / reference; NaN when the reference is 0 (nothing to compare with)."""
+    return float(value) / float(reference) if reference else float("nan")
+
+
+def compare_wave(generated, reference, arm, fps=FPS):
+    """Wave measures of both clips and the generated one's ratios to the reference:
+    {'generated': {...}, 'reference': {...}, 'swing_ratio', 'stroke_ratio', 'frequency_ratio',
+    'hand_height_ratio'}."""
+    gen, ref = wave_measures(generated, arm, fps), wave_measures(reference, arm, fps)
+    return {"generated": gen, "reference": ref,
+            "swing_ratio": ratio(gen["swing"], ref["swing"]),
+            "stroke_ratio": ratio(gen["strokes"], ref["strokes"]),
+            "frequency_ratio": ratio(gen["frequency"], ref["frequency"]),
+            "hand_height_ratio": ratio(gen["hand_height"], ref["hand_height"])}
+
+
+def pointing_angles(finger_base, finger_direction, target):
+    """(F,) degrees between the finger line (base (F, 3), direction (F, 3)) and the line from the base
+    to the target (3,) or (F, 3): 0 when the finger points straight at the target."""
+    base = np.asarray(finger_base, dtype=np.float64)
+    direction = np.asarray(finger_direction, dtype=np.float64)
+    to_target = np.asarray(target, dtype=np.float64) - base
+    cosine = np.sum(direction * to_target, axis=-1) / (
+        np.linalg.norm(direction, axis=-1) * np.linalg.norm(to_target, axis=-1))
+    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def hold_run(positions, arm, fps=FPS):
+    """(first, last) frame of the pointing hold (see the module docstring): a still arm holds
+    throughout."""
+    p, side = _positions(positions), _side(arm)
+    base = p[:, _JOINT[f"{side}_index_base"]]  # (F, 3)
+    travel = np.linalg.norm(base - base[0], axis=1)
+    speed = np.linalg.norm(np.gradient(base, axis=0), axis=1) * fps  # (F,) m/s
+    return longest_run((speed <= HOLD_SPEED * shoulder_width(p)) & (travel >= 0.5 * travel.max()))
+
+
+def point_measures(positions, finger_direction, arm, target, fps=FPS):
+    """{'angle' (degrees, median over the hold of `pointing_angles`), 'hold_s'} of a pointing
+    gesture; finger_direction (F, 3): the arm's index-finger direction (base to tip) per frame."""
+    p, side = _positions(positions), _side(arm)
+    first, last = hold_run(p, arm, fps)
+    base = p[first:last + 1, _JOINT[f"{side}_index_base"]]
+    angles = pointing_angles(base, np.asarray(finger_direction)[first:last + 1], target)
+    return {"angle": float(np.median(angles)), "hold_s": (last - first + 1) / fps}
+
+
+def raise_lower(generated, reference, arm):
+    """Arm elevation (degrees) at the first and last frames of both clips, and the generated clip's
+    differences from the reference: {'first', 'last', 'reference_first', 'reference_last',
+    'first_error', 'last_error'} (errors are absolute)."""
+    gen, ref = elevation(generated, arm), elevation(reference, arm)
+    return {"first": float(gen[0]), "last": float(gen[-1]),
+            "reference_first": float(ref[0]), "reference_last": float(ref[-1]),
+            "first_error": float(abs(gen[0] - ref[0])), "last_error": float(abs(gen[-1] - ref[-1]))}
+
+
+def variation(outputs):
+    """Mean distance (m) between outputs for the same request: over all pairs, the mean over frames
+    and joints of the Euclidean distance. outputs: a list of (F, J, 3) of one shape, at least two."""
+    clips = [np.asarray(o, dtype=np.float64) for o in outputs]
+    if len(clips) < 2 or any(c.shape != clips[0].shape for c in clips):
+        raise RLAnimateError("Variation needs at least two outputs of the same length: generate each seed "
+                             "with the same frame count.")
+    distances = [np.linalg.norm(a - b, axis=-1).mean() for k, a in enumerate(clips) for b in clips[k + 1:]]
+    return float(np.mean(distances))
+
+
+def resample(positions, frame_count):
+    """(frame_count, ...) positions linearly interpolated in time over the same span."""
+    p = np.asarray(positions, dtype=np.float64)
+    source = np.linspace(0.0, 1.0, len(p))
+    wanted = np.linspace(0.0, 1.0, int(frame_count))
+    flat = p.reshape(len(p), -1)
+    out = np.stack([np.interp(wanted, source, flat[:, k]) for k in range(flat.shape[1])], axis=1)
+    return out.reshape((int(frame_count),) + p.shape[1:])
+
+
+def score_at_length(generated, reference):
+    """The paper's score of a clip generated at its own length (e.g. the class-average length) against
+    the reference time-scaled to that length."""
+    return metrics.score(generated, resample(reference, len(generated)))
+
+
+def dtw_path(generated, reference, band=DTW_BAND):
+    """Dynamic time warping of two (F, J, 3) clips under the score's per-frame L1 error -> (P, 2) frame
+    pairs from (0, 0) to (F_g - 1, F_r - 1), within a band of `band` x the longer clip around the
+    diagonal of normalised time."""
+    gen, ref = np.asarray(generated, dtype=np.float64), np.asarray(reference, dtype=np.float64)
+    n, m = len(gen), len(ref)
+    cost = np.abs(gen[:, None] - ref[None]).sum(axis=(2, 3))  # (N, M)
+    rows, cols = np.meshgrid(np.arange(n) / max(n - 1, 1), np.arange(m) / max(m - 1, 1), indexing="ij")
+    width = max(band, 1.0 / min(n, m))  # never narrower than one frame of the shorter clip
+    cost[np.abs(rows - cols) > width] = np.inf
+    total = np.full((n + 1, m + 1), np.inf)
+    total[0, 0] = 0.0
+    for i in range(1, n + 1):
+        for j in range(1, m + 1):
+            total[i, j] = cost[i - 1, j - 1] + min(total[i - 1, j - 1], total[i - 1, j], total[i, j - 1])
+    path, i, j = [], n, m
+    while i > 0 and j > 0:
+        path.append((i - 1, j - 1))
+        step = np.argmin([total[i - 1, j - 1], total[i - 1, j], total[i, j - 1]])
+        i, j = (i - 1, j - 1) if step == 0 else (i - 1, j) if step == 1 else (i, j - 1)
+    return np.array(path[::-1])
+
+
+def aligned_score(generated, reference, band=DTW_BAND):
+    """The paper's score over the DTW-matched frame pairs (its per-frame errors and penalties, divided
+    by the number of pairs): timing differences within the band cost nothing, shape differences do."""
+    gen, ref = _positions(generated, "The generated clip"), _positions(reference, "The reference clip")
+    path = dtw_path(gen, ref, band)
+    errors = metrics.frame_errors(gen[path[:, 0]], ref[path[:, 1]])
+    return float(100.0 - (errors.sum() + metrics.frame_penalties(errors).sum()) / len(errors))
+
+
+#: The issue's acceptance bounds for a wave against its reference: swing ratio, largest frequency
+#: error (share of the reference frequency), fewest full cycles while the hand is up.
+WAVE_SWING_RATIO = (0.75, 1.33)
+WAVE_FREQUENCY_ERROR = 0.2
+WAVE_MIN_CYCLES = 2
+
+
+def wave_accepted(comparison):
+    """Whether a `compare_wave` result waves like its reference (the bounds above)."""
+    low, high = WAVE_SWING_RATIO
+    return bool(low <= comparison["swing_ratio"] <= high
+                and abs(comparison["frequency_ratio"] - 1.0) <= WAVE_FREQUENCY_ERROR
+                and comparison["generated"]["cycles"] >= WAVE_MIN_CYCLES)
+
+
+def compare(generated, reference, behaviour, arm, target=None, fps=FPS):
+    """The behaviour measures of one request, from descriptions (F, 42) of the generated clip and of
+    its reference (lengths may differ): raise and lower, and for WAVE `compare_wave`, for POINT
+    `point_measures` of both (target: (3,) in the character frame). A flat dict of floats."""
+    gen, ref = np.asarray(generated), np.asarray(reference)
+    gen_positions, ref_positions = spaces.description_joint_positions(gen), spaces.description_joint_positions(ref)
+    result = {f"elevation_{k}": v for k, v in raise_lower(gen_positions, ref_positions, arm).items()}
+    if behaviour == "WAVE":
+        waves = compare_wave(gen_positions, ref_positions, arm, fps)
+        result.update({k: v for k, v in waves.items() if k.endswith("_ratio")})
+        result.update({f"{k}": float(v) for k, v in waves["generated"].items()})
+        result.update({f"reference_{k}": float(v) for k, v in waves["reference"].items()})
+        result["wave_accepted"] = float(wave_accepted(waves))
+    elif behaviour == "POINT":
+        if target is None:
+            raise RLAnimateError("Pointing measures need the target position (x, y, z).")
+        point = point_measures(gen_positions, finger_direction(gen, arm), arm, target, fps)
+        reference_point = point_measures(ref_positions, finger_direction(ref, arm), arm, target, fps)
+        result.update({"pointing_angle": point["angle"], "hold_s": point["hold_s"],
+                       "reference_pointing_angle": reference_point["angle"],
+                       "reference_hold_s": reference_point["hold_s"],
+                       "hold_ratio": ratio(point["hold_s"], reference_point["hold_s"])})
+    else:
+        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use POINT or WAVE.")
+    return result
