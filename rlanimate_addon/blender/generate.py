@@ -39,7 +39,8 @@ def generate(context, settings, progress=lambda step: None):
     progress(2)
 
     request = gesture.GestureRequest(settings.behaviour, settings.arm, frame_count, targets=targets,
-                                     exaggeration=settings.exaggeration, seed=settings.seed or None)
+                                     exaggeration=settings.exaggeration, seed=settings.seed or None,
+                                     exact_aim=settings.exact_aim)
     canonical_names, quats = gesture.gesture_rotations(agent, request, rig)
     bones = [names[n] for n in canonical_names]
     armature_io.check_quaternion_bones(obj, bones)
@@ -52,6 +53,8 @@ def generate(context, settings, progress=lambda step: None):
     shortest, longest = gesture.supported_length_range(agent.average_frames[settings.behaviour])
     if not shortest <= frame_count <= longest:
         note = f" (time-scaled: the agent's range is {shortest}-{longest} frames)"
+    if settings.behaviour == "POINT" and not settings.exact_aim:
+        note += " (the agent's own aim: Exact Aim is off)"
     return (f"Baked {label} on {obj.name!r}: {len(bones)} bones, frames {start}-{start + frame_count - 1}, "
             f"action {action.name!r}{note}")
 

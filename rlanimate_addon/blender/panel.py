@@ -33,6 +33,7 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             layout.prop(settings, "target")
             if settings.target is None:
                 layout.prop(settings, "use_cursor")
+            layout.prop(settings, "exact_aim")
         else:
             layout.prop(settings, "exaggeration", slider=True)
 

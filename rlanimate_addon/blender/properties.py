@@ -1,7 +1,7 @@
 """`Scene.rlanimate`: the gesture settings the panel shows and Generate Gesture reads.
 
-The names behaviour, arm, target, exaggeration, frame_count, start_frame and seed are a contract
-that outside tools and checks use: keep them.
+The names behaviour, arm, target, exaggeration, frame_count, start_frame, seed and exact_aim are a
+contract that outside tools and checks use: keep them.
 """
 import bpy
 
@@ -42,6 +42,10 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
         description="Length of the gesture in frames; the agent learned its average from the clips")
     start_frame: bpy.props.IntProperty(
         name="Start Frame", default=1, description="First frame of the gesture")
+    exact_aim: bpy.props.BoolProperty(
+        name="Exact Aim", default=True,
+        description="Turn the arm so the index finger passes exactly through the target; "
+                    "off keys the agent's own aim")
     seed: bpy.props.IntProperty(
         name="Variation Seed", min=0, default=0,
         description="0 gives the agent's most likely gesture; other values give variations")

@@ -5,7 +5,7 @@ target, writing keys):
 
     targets (N, 3) in the rig's armature space --pointing_directions--> objectives (N, 7)
     --agent.rollout--> actions (M, 45) --decode, time_scale--> canonical rotations (N, 15, 3)
-    --aim.aim_at (POINT)--> --retarget--> rig quaternions (N, 15, 4) --blend_from_pose--> keys
+    --aim.aim_at (POINT, exact aim)--> --retarget--> rig quaternions (N, 15, 4) --blend_from_pose--> keys
 
 A rig may differ from the canonical skeleton in three ways, all handled here:
   * scale and units (a Mixamo FBX in centimetres): only directions and rotations are used;
@@ -27,10 +27,6 @@ from .rotations import matrix_to_quat, rotvec_to_matrix
 SUPPORTED_LENGTH = (0.4, 1.5)
 #: Fraction of the gesture spent blending in from, and back out to, the rig's pose at the start frame.
 BLEND_FRACTION = 0.2
-#: Whether Point turns the agent's arm so the index finger passes through the target (core/aim.py);
-#: False keys the agent's raw aim.
-AIM_CORRECTION = True
-
 #: Bones of the pointing hand shape, with their canonical local rotation vectors (radians): the
 #: thumb tucked and the three other fingers curled towards the palm (negative about the local X
 #: axis curls a finger of either hand towards the palm of the T-pose).
@@ -236,7 +232,7 @@ def gesture_rotations(agent, request, rig):
                                   rest_heads=rig.rest_heads, exaggeration=request.exaggeration)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
     names = list(skeleton.ACTION_JOINTS)
-    if request.behaviour == "POINT" and AIM_CORRECTION:
+    if request.behaviour == "POINT" and request.exact_aim:
         targets = canonical_targets(request.arm, request.targets, rig.rest_heads)
         canonical = aim.aim_at(canonical, request.arm, np.broadcast_to(targets, (len(canonical), 3)))
     if request.behaviour == "POINT":
@@ -253,12 +249,16 @@ def gesture_rotations(agent, request, rig):
 
 
 class GestureRequest:
-    """What the user asked for: behaviour, arm, length, seed and the behaviour's attribute."""
+    """What the user asked for: behaviour, arm, length, seed and the behaviour's attribute.
 
-    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None):
+    exact_aim: for POINT, turn the agent's arm so the index finger passes through the target
+    (core/aim.py, the final polish); False keys the agent's own aim."""
+
+    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True):
         self.behaviour, self.arm = behaviour, arm
         self.frame_count, self.seed = int(frame_count), seed
         self.targets, self.exaggeration = targets, float(exaggeration)
+        self.exact_aim = bool(exact_aim)
 
 
 class RigPose:

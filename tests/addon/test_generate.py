@@ -245,3 +245,37 @@ def test_cursor_fallback_and_an_animated_target_is_tracked(settings):
     bpy.context.scene.frame_set(5)
     assert helpers.generate(rig, settings, target=target, start_frame=300, frame_count=61) == {"FINISHED"}
     assert bpy.context.scene.frame_current == 5, "the scene frame must be restored"
+
+
+@pytest.mark.parametrize("arm", ["LEFT", "RIGHT"])
+def test_exact_aim_off_bakes_the_agents_own_aim(settings, arm):
+    """Exact Aim on: the finger passes through the target. Off: the baked finger points where the
+    agent alone points (its raw rollout through the numpy FK), and only the pointing Arm bone differs."""
+    from rlanimate_addon.blender import preferences
+    from rlanimate_addon.core import aim, behaviour_metrics, gesture
+
+    rig = helpers.load_sample_rig()
+    helpers.stand_neutral(rig)
+    location = random_target(arm, np.random.default_rng(21 if arm == "LEFT" else 22))
+    target = helpers.add_empty("Target", location)
+    count = settings.frame_count
+    runs = {}
+    for exact, start in ((True, 1), (False, 301)):
+        assert helpers.generate(rig, settings, behaviour="POINT", arm=arm, target=target, start_frame=start,
+                                exact_aim=exact) == {"FINISHED"}
+        frames = np.arange(start, start + count)
+        runs[exact] = finger_angles(rig, arm, location, frames)[0], helpers.bone_heads(
+            rig, [b.name for b in rig.pose.bones], frames)
+    agent = preferences.load_agent(preferences.BUNDLED_AGENT)
+    objectives = gesture.build_objectives("POINT", arm, count, targets=np.tile(location, (count, 1)),
+                                          rest_heads=gesture.canonical_rig_pose().rest_heads)
+    _, base, finger, _ = aim.finger_lines(gesture.run_agent(agent, "POINT", objectives), arm)
+    raw = behaviour_metrics.pointing_angles(base, finger, location)
+    full = gesture.blend_weights(count) >= 1.0  # frames that show the agent's pose unblended
+    np.testing.assert_allclose(runs[False][0][full], raw[full], atol=0.5)
+    assert runs[True][0][apex(base)] <= MAX_APEX_ANGLE_DEG
+    names = [b.name for b in rig.pose.bones]
+    arm_chain = {helpers.rig_bone(rig, skeleton.ARM_PREFIX[arm] + b) for b in ("Arm", "ForeArm", "Hand")}
+    others = [k for k, n in enumerate(names) if n not in arm_chain and not skeleton.strip_prefix(n).startswith(
+        skeleton.ARM_PREFIX[arm] + "Hand")]
+    np.testing.assert_allclose(runs[True][1][:, others], runs[False][1][:, others], atol=1e-6)

@@ -14,6 +14,7 @@ CONTRACT = {
     "frame_count": ("INT", None),
     "start_frame": ("INT", None),
     "seed": ("INT", None),
+    "exact_aim": ("BOOLEAN", None),
 }
 
 
@@ -43,6 +44,7 @@ def test_scene_settings_keep_the_contract(settings):
     assert properties["target"].fixed_type.identifier == "Object"
     assert (properties["exaggeration"].hard_min, properties["exaggeration"].hard_max) == (0.0, 1.0)
     assert settings.frame_count >= 2, "the default length must be a usable gesture"
+    assert settings.exact_aim is True, "aim correction is on by default"
     assert {"REGISTER", "UNDO"} <= set(bpy.types.RLANIMATE_OT_generate_gesture.bl_options)
     export = bpy.ops.rlanimate.export_fbx.get_rna_type()
     assert "filepath" in export.properties
@@ -105,6 +107,7 @@ def test_panel_draw_uses_only_existing_properties_operators_and_icons(settings, 
     assert {"behaviour", "arm", "frame_count", "start_frame", "seed"} <= shown
     assert ("exaggeration" in shown) == (behaviour == "WAVE")
     assert ("target" in shown) == (behaviour == "POINT")
+    assert ("exact_aim" in shown) == (behaviour == "POINT")
     operators = [c[1] for c in calls if c[0] == "operator"]
     assert operators == ["rlanimate.generate_gesture", "rlanimate.export_fbx"]
     labels = " ".join(c[1].get("text", "") for c in calls if c[0] == "label")

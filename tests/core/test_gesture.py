@@ -180,3 +180,23 @@ def test_an_agent_returning_the_wrong_shape_is_reported():
 def test_matrix_quat_helpers_agree():
     m = random_rotations(3)
     assert np.allclose(quat_to_matrix(matrix_to_quat(m)), m)
+
+
+def test_exact_aim_off_keys_the_agents_own_aim():
+    """With exact_aim the pointing arm is turned (aim correction); without it the keys are the
+    agent's own rotations, and nothing else differs."""
+    agent = ReplayAgent(np.random.default_rng(4).uniform(0.3, 0.7, size=(50, spaces.ACTION_SIZE)))
+    rig = gesture.canonical_rig_pose()
+    targets = np.tile([-1.0, -2.0, 1.6], (50, 1))
+    names, aimed = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
+    raw_names, raw = gesture.gesture_rotations(
+        agent, _request("POINT", frames=50, targets=targets, exact_aim=False), rig)
+    assert names == raw_names
+    changed = {names[b] for b in range(len(names)) if not np.allclose(np.abs(aimed[:, b]), np.abs(raw[:, b]))}
+    assert changed == {"RightArm"}
+    # on the canonical rig retargeting is the identity: where the blend is full, the raw keys are the
+    # agent's decoded actions
+    expected = rotvec_to_quat(spaces.decode_action(agent.actions))  # (50, 15, 4)
+    full = int(np.argmax(gesture.blend_weights(50)))
+    arm = names.index("RightArm")
+    assert abs(np.sum(raw[full, arm] * expected[full, arm])) == pytest.approx(1.0, abs=1e-9)
