@@ -2,7 +2,7 @@
 
 Run: `nice -n 10 python benchmarks/agent_synthetic_check.py [VARIANT] [EPOCHS] [--no-portrayal-loss]`
 
-It trains the both-behaviour agent of the `default` preset with trainer/algorithm.py, but plays
+It trains the both-behaviour agent of the `default` preset with trainer/agent/algorithm.py, but plays
 actions through the numpy forward kinematics of the canonical skeleton (rlanimate_addon/core/
 kinematics.py) instead of the bpy FK environment, on the synthetic library of the trainer tests
 (20 training clips per behaviour, one held-out clip per behaviour and arm). It prints held-out
@@ -25,10 +25,10 @@ import torch  # noqa: E402
 
 import synthetic_library  # noqa: E402
 from rlanimate_addon.core import kinematics, skeleton, spaces  # noqa: E402
-from trainer import evaluate  # noqa: E402
-from trainer.algorithm import ClipReferences, Trainer  # noqa: E402
-from trainer.config import load_preset  # noqa: E402
-from trainer.models import VARIANTS, RLAnimateAgent  # noqa: E402
+from trainer.evaluation import scoring  # noqa: E402
+from trainer.agent.algorithm import ClipReferences, Trainer  # noqa: E402
+from trainer.agent.config import load_preset  # noqa: E402
+from trainer.agent.models import VARIANTS, RLAnimateAgent  # noqa: E402
 
 
 class NumpyFKEnvironment:
@@ -64,8 +64,8 @@ def main():
     for epoch in range(1, args.epochs + 1):
         metrics = trainer.run_epoch()
         if epoch % 10 == 0 or epoch == args.epochs:
-            unseen = evaluate.evaluate_clips(agent, env, library.test, references)
-            seen = evaluate.evaluate_clips(agent, env, library.train[:10], references)
+            unseen = scoring.evaluate_clips(agent, env, library.test, references)
+            seen = scoring.evaluate_clips(agent, env, library.train[:10], references)
             losses = " ".join(f"{k[5:]} {v:.3g}" for k, v in metrics.items() if k.startswith("loss/"))
             print(f"epoch {epoch} ({time.perf_counter() - start:.0f} s): held-out {unseen['score']:.2f} / "
                   f"{unseen['smoothness']:.2f}, seen {seen['score']:.2f} / {seen['smoothness']:.2f}; {losses}",

@@ -22,7 +22,8 @@ import numpy as np  # noqa: E402
 
 from rlanimate_addon.blender import properties  # noqa: E402
 from rlanimate_addon.core import skeleton  # noqa: E402
-from trainer import bpy_support  # noqa: E402
+from trainer.blender_io import rig_session  # noqa: E402
+from trainer.paths import SAMPLE_RIG_BLEND, SAMPLE_RIG_FBX  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
 COMMAND = "python benchmarks/fbx_round_trip_benchmark.py"
@@ -33,8 +34,8 @@ def load_sample_rig():
     FBX before 5.0 (Blender 4.2 cannot read a .blend saved by 5.0)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon_utils.enable("rlanimate_addon", default_set=True)
-    source = bpy_support.SAMPLE_RIG_BLEND if bpy.app.version >= (5, 0, 0) else bpy_support.SAMPLE_RIG_FBX
-    rig = bpy_support.load_rig(source, with_mesh=True)
+    source = SAMPLE_RIG_BLEND if bpy.app.version >= (5, 0, 0) else SAMPLE_RIG_FBX
+    rig = rig_session.load_rig(source, with_mesh=True)
     bpy.context.view_layer.objects.active = rig
     return rig
 

@@ -19,8 +19,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import numpy as np  # noqa: E402
 
 from rlanimate_addon.core import kinematics, skeleton, spaces  # noqa: E402
-from trainer import bpy_support  # noqa: E402
-from trainer.fk_env import FKEnvironment  # noqa: E402
+from trainer.blender_io import rig_session  # noqa: E402
+from trainer.blender_io.fk_env import FKEnvironment  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
 INSTANCE_COUNTS = (1, 4, 8, 16, 64, 256)
@@ -50,7 +50,7 @@ def measure():
     best = {instances: float("inf") for instances in INSTANCE_COUNTS}
     for _ in range(REPEATS):
         for instances in INSTANCE_COUNTS:
-            bpy_support.new_empty_scene()
+            rig_session.new_empty_scene()
             env = FKEnvironment(instances=instances)
             env.describe_actions(actions[:instances])
             best[instances] = min(best[instances], timed(lambda: env.describe_actions(actions)))
@@ -69,7 +69,7 @@ def section(rows):
     date = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     lines = [
         HEADING, "",
-        f"Poses per second of `trainer/fk_env.py` on the sample rig ({len(skeleton.BONES)} bones): {POSES} random",
+        f"Poses per second of `trainer/blender_io/fk_env.py` on the sample rig ({len(skeleton.BONES)} bones): {POSES} random",
         f"actions decoded and evaluated per call (fastest of {REPEATS} interleaved rounds), each batch of",
         "`instances` poses in one depsgraph update. Pinned to one CPU core.", "",
         f"Regenerate: `{COMMAND}`", "",

@@ -26,7 +26,8 @@ import numpy as np  # noqa: E402
 
 from rlanimate_addon.blender import armature_io, preferences  # noqa: E402
 from rlanimate_addon.core import gesture  # noqa: E402
-from trainer import bpy_support  # noqa: E402
+from trainer.blender_io import rig_session  # noqa: E402
+from trainer.paths import SAMPLE_RIG_BLEND  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
 FRAMES = 120
@@ -36,7 +37,7 @@ SECTION = "## Generate Gesture"
 def fresh_scene():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     addon_utils.enable("rlanimate_addon", default_set=True)
-    rig = bpy_support.load_rig(bpy_support.SAMPLE_RIG_BLEND, with_mesh=True)
+    rig = rig_session.load_rig(SAMPLE_RIG_BLEND, with_mesh=True)
     bpy.context.view_layer.objects.active = rig
     target = bpy.data.objects.new("Target", None)
     target.location = (-1.2, -2.5, 1.7)

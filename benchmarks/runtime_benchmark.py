@@ -26,9 +26,9 @@ import torch  # noqa: E402
 
 from rlanimate_addon.core import spaces  # noqa: E402
 from rlanimate_addon.core.runtime import load_agent  # noqa: E402
-from trainer.config import load_preset  # noqa: E402
-from trainer.export import export_agent  # noqa: E402
-from trainer.models import VARIANTS, RLAnimateAgent  # noqa: E402
+from trainer.agent.config import load_preset  # noqa: E402
+from trainer.agent.agent_export import export_agent  # noqa: E402
+from trainer.agent.models import VARIANTS, RLAnimateAgent  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
 DEFAULT_AGENT = REPO_ROOT / "rlanimate_addon" / "agents" / "default.npz"

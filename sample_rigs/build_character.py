@@ -17,11 +17,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import numpy as np  # noqa: E402
 
 from rlanimate_addon.core import skeleton  # noqa: E402
-from trainer import bpy_support  # noqa: E402
+from trainer.blender_io import rig_session  # noqa: E402
+from trainer.scripts.cli import script_args  # noqa: E402
 
-bpy = bpy_support.import_bpy()
+bpy = rig_session.import_bpy()
 
-RIG_NAME = bpy_support.SAMPLE_RIG_NAME
+RIG_NAME = rig_session.SAMPLE_RIG_NAME
 MESH_NAME = RIG_NAME + "_Body"
 # Half-widths (m) of each bone's prism along the bone's local X and Z axes at its head, and the
 # factor they scale by at its tail. The torso's X is the character's width and Z its depth; a limb's
@@ -159,7 +160,7 @@ def build(out_dir=Path(__file__).resolve().parent):
     """Build the character in a fresh scene and write character.blend and character.fbx to `out_dir`."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    scene = bpy_support.new_empty_scene()
+    scene = rig_session.new_empty_scene()
     bpy.context.preferences.filepaths.save_version = 0  # no character.blend1 backup
     rig = build_armature(scene)
     build_body(scene, rig)
@@ -169,5 +170,5 @@ def build(out_dir=Path(__file__).resolve().parent):
 
 
 if __name__ == "__main__":
-    args = bpy_support.script_args()
+    args = script_args()
     build(*args[:1])

@@ -106,10 +106,10 @@ def _read_arrays(path):
         if "Object arrays cannot be loaded" in str(error):
             raise RLAnimateError(f"The agent file {path} carries a pickled Python object, which is refused "
                                  f"because loading it could run code: use an agent exported by "
-                                 f"trainer/export.py.") from error
+                                 f"trainer/agent/agent_export.py.") from error
         if "pickled data" in str(error):  # neither .npz nor .npy: numpy would have to unpickle it
             raise RLAnimateError(f"{path} is not an RLAnimate agent file (not a numpy archive; pickled "
-                                 f"data is refused): choose a .npz written by trainer/export.py.") from error
+                                 f"data is refused): choose a .npz written by trainer/agent/agent_export.py.") from error
         raise _damaged(path, error) from error
     except (OSError, EOFError, zipfile.BadZipFile, KeyError) as error:
         raise _damaged(path, error) from error
@@ -121,7 +121,7 @@ def _damaged(path, error):
 
 def _not_an_agent(path):
     return RLAnimateError(f"{path} is not an RLAnimate agent file (no {METADATA_KEY} entry): choose a .npz "
-                          f"written by trainer/export.py.")
+                          f"written by trainer/agent/agent_export.py.")
 
 
 def _parse_metadata(path, entry):
@@ -140,7 +140,7 @@ def _parse_metadata(path, entry):
     missing = [key for key in REQUIRED_METADATA if key not in metadata]
     if missing:
         raise RLAnimateError(f"The agent file {path} lacks metadata {', '.join(missing)}: re-export it with "
-                             f"trainer/export.py.")
+                             f"trainer/agent/agent_export.py.")
     return metadata
 
 
@@ -150,7 +150,7 @@ def _check_weights(path, arrays, metadata):
                                            for k in _AGENT_SIZES) \
             or any(not isinstance(config.get(k), (int, float)) or not config[k] > 0 for k in _AGENT_SCALARS):
         raise RLAnimateError(f"The agent file {path} has an invalid agent_config: re-export it with "
-                             f"trainer/export.py.")
+                             f"trainer/agent/agent_export.py.")
     expected = expected_weight_shapes(config, metadata["variant"])
     missing = sorted(set(expected) - set(arrays))
     extra = sorted(set(arrays) - set(expected))
@@ -161,7 +161,7 @@ def _check_weights(path, arrays, metadata):
                    ([f"unexpected {', '.join(extra)}"] if extra else []) + \
                    ([f"wrong shape {'; '.join(wrong)}"] if wrong else [])
         raise RLAnimateError(f"The agent file {path} does not match its own config: {'; '.join(problems)}. "
-                             f"Re-export the agent with trainer/export.py.")
+                             f"Re-export the agent with trainer/agent/agent_export.py.")
     for name, array in arrays.items():
         if array.dtype.kind != "f":
             raise RLAnimateError(f"The agent file {path} holds {name} as {array.dtype}, not floats: re-export it.")
@@ -175,7 +175,7 @@ def _check_metadata_values(path, metadata):
     if bounds.shape != (spaces.ACTION_SIZE, 2) or not np.all(np.isfinite(bounds)) \
             or not np.all(bounds[:, 0] < bounds[:, 1]):
         raise RLAnimateError(f"The agent file {path} has invalid action_bounds (need ({spaces.ACTION_SIZE}, 2) "
-                             f"finite [low, high] pairs): re-export it with trainer/export.py.")
+                             f"finite [low, high] pairs): re-export it with trainer/agent/agent_export.py.")
     frames = metadata["average_frames"]
     if not isinstance(frames, dict) or not frames or any(
             b not in spaces.BEHAVIOURS or not isinstance(n, (int, float)) or not n >= 2 for b, n in frames.items()):

@@ -1,6 +1,6 @@
 """Forward kinematics of the canonical skeleton in numpy, for planning and checks.
 
-The environment the agent learns in is real Blender (trainer/fk_env.py); this mirrors Blender's
+The environment the agent learns in is real Blender (trainer/blender_io/fk_env.py); this mirrors Blender's
 pose evaluation (pose = parent_pose @ parent_rest^-1 @ rest @ basis) so that bpy-free code, such as
 the clip generator's inverse kinematics, can predict what Blender will show.
 """

@@ -1,6 +1,6 @@
 """The agent at inference, in plain numpy: what Generate Gesture runs inside Blender.
 
-It mirrors `trainer/models.py` (whose docstring has the timing diagram) equation for equation, in
+It mirrors `trainer/agent/models.py` (whose docstring has the timing diagram) equation for equation, in
 float64 from the file's float32 weights, so its deterministic rollout reproduces the torch agent's
 within 1e-5. Work that does not depend on the recurrence (the portrayal model, the task state and
 their contributions to each layer) is done for all frames at once before the per-frame loop, and

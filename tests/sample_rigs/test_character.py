@@ -3,7 +3,8 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import skeleton
-from trainer import bpy_support
+from trainer.blender_io import rig_session
+from trainer.paths import SAMPLE_RIG_BLEND, SAMPLE_RIG_FBX
 
 bpy = pytest.importorskip("bpy")
 
@@ -12,7 +13,7 @@ MAX_FILE_BYTES = 1_000_000
 
 @pytest.fixture
 def scene():
-    return bpy_support.new_empty_scene()
+    return rig_session.new_empty_scene()
 
 
 def _load_blend(path):
@@ -36,7 +37,7 @@ def _rest_errors(rig):
 
 
 def test_rig_has_every_bone_with_the_spec_geometry(scene):
-    rig = _load_blend(bpy_support.SAMPLE_RIG_BLEND)[bpy_support.SAMPLE_RIG_NAME]
+    rig = _load_blend(SAMPLE_RIG_BLEND)[rig_session.SAMPLE_RIG_NAME]
     bones = rig.data.bones
     assert sorted(b.name for b in bones) == sorted(skeleton.PREFIX + b.name for b in skeleton.BONES)
     for spec in skeleton.BONES:
@@ -52,8 +53,8 @@ def test_rig_has_every_bone_with_the_spec_geometry(scene):
 
 
 def test_body_mesh_is_skinned_to_the_rig(scene):
-    objects = _load_blend(bpy_support.SAMPLE_RIG_BLEND)
-    rig = objects[bpy_support.SAMPLE_RIG_NAME]
+    objects = _load_blend(SAMPLE_RIG_BLEND)
+    rig = objects[rig_session.SAMPLE_RIG_NAME]
     body = next(o for o in objects.values() if o.type == "MESH")
     assert body.parent is rig
     assert [(m.type, m.object) for m in body.modifiers] == [("ARMATURE", rig)]
@@ -70,9 +71,9 @@ def test_body_mesh_is_skinned_to_the_rig(scene):
 
 def test_fbx_reimports_every_bone_with_the_same_rest_pose(scene):
     before = set(bpy.data.objects)
-    bpy.ops.import_scene.fbx(filepath=str(bpy_support.SAMPLE_RIG_FBX))
+    bpy.ops.import_scene.fbx(filepath=str(SAMPLE_RIG_FBX))
     imported = [o for o in bpy.data.objects if o not in before]
-    rig = bpy_support.find_armature(imported)
+    rig = rig_session.find_armature(imported)
     assert sorted(b.name for b in rig.data.bones) == sorted(skeleton.PREFIX + b.name for b in skeleton.BONES)
     assert np.allclose(rig.matrix_world.to_scale(), 1.0, atol=1e-6), "re-import must be in metres"
     position_error, frame_error = _rest_errors(rig)
@@ -84,7 +85,7 @@ def test_committed_blend_is_readable_by_blender_4_2():
     """Blender 5.0's .blend header cannot be read by 4.2 LTS, so the committed file is saved by 4.2."""
     import zstandard  # a dependency of the bpy wheel; Blender compresses .blend files with zstd
 
-    with open(bpy_support.SAMPLE_RIG_BLEND, "rb") as handle:
+    with open(SAMPLE_RIG_BLEND, "rb") as handle:
         header = zstandard.ZstdDecompressor().stream_reader(handle).read(12)
     # The pre-5.0 header: "BLENDER", pointer size "-" or "_", endianness "v" or "V", 3-digit version.
     assert header[:7] == b"BLENDER" and header[7:8] in b"-_" and header[8:9] in b"vV", header
@@ -97,12 +98,12 @@ def test_build_script_reproduces_the_committed_character(scene, tmp_path):
     build_character.build(tmp_path)
     for name in ("character.blend", "character.fbx"):
         assert (tmp_path / name).stat().st_size < MAX_FILE_BYTES
-        assert (bpy_support.SAMPLE_RIG_BLEND.parent / name).stat().st_size < MAX_FILE_BYTES
+        assert (SAMPLE_RIG_BLEND.parent / name).stat().st_size < MAX_FILE_BYTES
 
     def snapshot(path):
-        bpy_support.new_empty_scene()
+        rig_session.new_empty_scene()
         objects = _load_blend(path)
-        rig = objects[bpy_support.SAMPLE_RIG_NAME]
+        rig = objects[rig_session.SAMPLE_RIG_NAME]
         body = next(o for o in objects.values() if o.type == "MESH")
         bones = [(b.name, tuple(np.round(np.array(b.matrix_local).ravel(), 6))) for b in rig.data.bones]
         verts = np.array([tuple(v.co) for v in body.data.vertices])
@@ -110,7 +111,7 @@ def test_build_script_reproduces_the_committed_character(scene, tmp_path):
         groups = [tuple((g.group, g.weight) for g in v.groups) for v in body.data.vertices]
         return bones, verts, faces, groups
 
-    built, committed = snapshot(tmp_path / "character.blend"), snapshot(bpy_support.SAMPLE_RIG_BLEND)
+    built, committed = snapshot(tmp_path / "character.blend"), snapshot(SAMPLE_RIG_BLEND)
     assert built[0] == committed[0]
     assert np.array_equal(built[1], committed[1])
     assert built[2:] == committed[2:]

@@ -1,0 +1,111 @@
+"""Algorithm 1: the episode buffer's chunks, one iteration's collection, and a debug run whose loss falls."""
+import numpy as np
+import pytest
+import torch
+
+from rlanimate_addon.core import spaces
+from tests.trainer.synthetic_library import make_library
+from trainer.agent.algorithm import ClipReferences, Trainer, clip_objective, clips_for_behaviour
+from trainer.agent.buffer import EPISODE_KEYS, EpisodeBuffer
+from trainer.agent.config import load_preset
+from trainer.blender_io.fk_env import FKEnvironment
+from trainer.agent.models import RLAnimateAgent
+
+torch.set_num_threads(1)
+
+
+def _episode(frames, offset):
+    """Episode whose every value encodes its frame index + offset, so chunks reveal where they came from."""
+    stamp = (np.arange(frames) + offset).astype(np.float64)[:, None]
+    sizes = {"objective": 7, "action": 45, "description": 42, "motion": 45, "motion_description": 42}
+    return {key: np.repeat(stamp, sizes[key], axis=1) for key in EPISODE_KEYS}
+
+
+def test_chunks_are_contiguous_slices_of_one_episode_and_reproducible():
+    buffer = EpisodeBuffer()
+    buffer.add(_episode(30, 0))
+    buffer.add(_episode(40, 1000))
+    chunks = buffer.sample_chunks(16, 10, np.random.default_rng(7))
+    assert chunks["action"].shape == (16, 10, 45) and chunks["description"].shape == (16, 10, 42)
+    stamps = chunks["objective"][:, :, 0].numpy()  # (C, L)
+    assert np.all(np.diff(stamps, axis=1) == 1)  # consecutive frames of one episode
+    assert all(np.all(chunks[key][:, :, 0].numpy() == stamps) for key in EPISODE_KEYS)  # keys stay aligned
+    assert {bool(s[0] >= 1000) for s in stamps} == {False, True}  # both episodes drawn
+    again = buffer.sample_chunks(16, 10, np.random.default_rng(7))
+    assert torch.equal(again["objective"], chunks["objective"])
+
+
+def test_chunk_length_is_capped_at_the_shortest_episode():
+    buffer = EpisodeBuffer()
+    buffer.add(_episode(12, 0))
+    buffer.add(_episode(50, 100))
+    assert buffer.sample_chunks(3, 40, np.random.default_rng(0))["motion"].shape == (3, 12, 45)
+
+
+def test_episodes_with_mismatched_lengths_are_rejected():
+    episode = _episode(10, 0)
+    episode["action"] = episode["action"][:9]
+    with pytest.raises(ValueError, match="frame count"):
+        EpisodeBuffer().add(episode)
+
+
+@pytest.fixture(scope="module")
+def env():
+    return FKEnvironment(instances=16)
+
+
+@pytest.fixture(scope="module")
+def library():
+    return make_library(seed=3)
+
+
+def test_training_both_draws_one_clip_per_behaviour(library):
+    groups = clips_for_behaviour(library.train, "both")
+    assert [{c.behaviour for c in g} for g in groups] == [{"POINT"}, {"WAVE"}]
+    assert len(clips_for_behaviour(library.train, "wave")) == 1
+
+
+def test_collect_stores_real_descriptions_and_clip_motion(env, library):
+    agent_config, train_config = load_preset("debug")
+    torch.manual_seed(0)
+    trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "both", seed=1)
+    drawn = trainer.collect()
+    assert len(trainer.buffer) == 2 and [c.behaviour for c in drawn] == ["POINT", "WAVE"]
+    for clip, episode in zip(drawn, trainer.buffer.episodes):
+        np.testing.assert_allclose(episode["objective"], clip_objective(clip), atol=1e-6)
+        np.testing.assert_allclose(episode["motion"], spaces.encode_action(clip.rotvecs), atol=1e-6)
+        real = env.evaluate(spaces.decode_action(episode["action"].astype(np.float64))).descriptions
+        np.testing.assert_allclose(episode["description"], real, atol=1e-4)
+        reference = env.evaluate(clip.rotvecs).descriptions
+        np.testing.assert_allclose(episode["motion_description"], reference, atol=1e-5)
+        assert np.all((episode["action"] >= 0) & (episode["action"] <= 1))
+
+
+def test_debug_preset_trains_end_to_end_and_its_loss_falls(env, library):
+    agent_config, train_config = load_preset("debug")
+    torch.manual_seed(0)
+    agent = RLAnimateAgent(agent_config, "rlanimate")
+    trainer = Trainer(agent, env, library.train, train_config, "both", seed=0, references=ClipReferences(env))
+    trainer.collect()
+    probe = trainer.buffer.sample_chunks(8, train_config.chunk_length, np.random.default_rng(5))
+
+    def probe_loss():
+        torch.manual_seed(11)  # the same posterior samples before and after training
+        with torch.no_grad():
+            return float(agent.losses(probe, train_config)["total"])
+
+    before = probe_loss()
+    for _ in range(15):
+        metrics = trainer.run_epoch()
+    assert metrics["epoch"] == 15 and metrics["episodes"] == 2 + 15 * 2
+    assert all(np.isfinite(v) for k, v in metrics.items() if k.startswith("loss/"))
+    assert probe_loss() < 0.8 * before
+
+
+def test_clips_are_drawn_in_passes_without_replacement(env, library):
+    agent_config, train_config = load_preset("debug")
+    trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "wave", seed=4)
+    waves = trainer.clip_groups[0]
+    drawn = [id(trainer.draw(0)) for _ in range(2 * len(waves))]
+    assert sorted(drawn[:len(waves)]) == sorted(id(clip) for clip in waves)  # each clip once per pass
+    assert sorted(drawn[len(waves):]) == sorted(drawn[:len(waves)]) and drawn[len(waves):] != drawn[:len(waves)]

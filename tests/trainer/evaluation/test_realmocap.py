@@ -1,0 +1,71 @@
+"""Real motion capture: labels on import, and the experiment pipeline end to end."""
+import numpy as np
+import pytest
+
+from rlanimate_addon.core import skeleton
+from trainer.agent.algorithm import ClipReferences
+from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.procedural_ik import ProceduralIK
+from trainer.blender_io.rig_session import new_empty_scene
+from trainer.evaluation import baselines, realmocap
+from trainer.motion import autolabel
+from trainer.motion.realmocap_takes import RELAXED_HAND, wave_split
+from trainer.paths import REALMOCAP_DIR
+from trainer.reporting.realmocap_report import frames_figure
+
+needs_data = pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
+                                reason=f"real motion capture not found at {REALMOCAP_DIR} "
+                                       "(../shared/realmocap/ beside the repository)")
+
+
+@needs_data
+def test_imported_clips_are_labelled_from_their_motion(tmp_path):
+    wave = realmocap.import_real_clip(REALMOCAP_DIR / "wave" / "dataset-2_wave-right-hand_normal_003.bvh",
+                                      tmp_path)
+    assert (wave.behaviour, wave.arm, wave.named_arm, wave.style, wave.take) == ("WAVE", "RIGHT", "RIGHT", "normal", "003")
+    assert 0.0 <= wave.exaggeration <= 1.0 and wave.attributes == wave.exaggeration
+    assert np.allclose(wave.rotvecs[:, skeleton.ACTION_JOINTS.index("RightHandIndex1")],
+                       (RELAXED_HAND["Index"], 0.0, 0.0))
+    guide = realmocap.import_real_clip(REALMOCAP_DIR / "guide" / "dataset-1_guide_normal_001.bvh", tmp_path)
+    assert guide.behaviour == "POINT" and guide.arm == "RIGHT"
+    assert abs(np.linalg.norm(guide.attributes) - 1.0) < 1e-9
+    assert 0 < guide.label.hold_frame < guide.frames - 1
+
+
+@needs_data
+def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
+    new_empty_scene()
+    folder = REALMOCAP_DIR / "wave"
+    clips = [realmocap.import_real_clip(folder / name, tmp_path / "cache") for name in
+             ("dataset-2_wave-left-hand_feminine_001.bvh", "dataset-2_wave-left-hand_active_002.bvh",
+              "dataset-2_wave-left-hand_normal_009.bvh")]
+    train, test = wave_split(clips)
+    env = FKEnvironment(instances=4)
+    references = ClipReferences(env)
+    session = realmocap.RealSession(env, references, train, test)
+    report, agent = realmocap.train_agent(session, "tiny", "wave", 1, "debug", 0, runs=tmp_path)
+    assert agent.path.is_file() and report["episodes"] == 1
+    exported = baselines.AgentMethod(agent.path).generate("WAVE", "LEFT", 0.4, 40)
+    np.testing.assert_allclose(exported, agent.generate("WAVE", "LEFT", 0.4, 40), atol=1e-4)
+    methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train),
+               "procedural_ik": ProceduralIK(baselines.neutral_pose(train))}
+    comparison = realmocap.compare(methods, test, env, references)
+    for result in comparison.values():
+        assert np.isfinite(result["score"]) and 0.0 <= result["smoothness"] <= 100.0
+        assert 0.0 <= result["label_error"] <= 1.0
+    # The nearest clip to the normal wave (e ~ 0.7) is the active one, not the feminine one.
+    assert methods["nearest_clip"].nearest("WAVE", "LEFT", test[0].exaggeration).style == "active"
+    angles = realmocap.guide_angles(methods["procedural_ik"], [_as_point(test[0])], env)
+    assert 0.0 <= angles["mean_forearm_angle_deg"] <= 180.0
+    picture = tmp_path / "frames.png"
+    generated = methods["rlanimate"].generate("WAVE", "LEFT", test[0].exaggeration, test[0].frames)
+    frames_figure(env, [("t", test[0].rotvecs, generated)], picture, times=(0.5,))
+    assert picture.stat().st_size > 1000
+
+
+def _as_point(clip):
+    import copy
+    label = autolabel.label_point(clip.rotvecs, clip.arm)
+    point = copy.copy(clip)
+    point.behaviour, point.attributes, point.label = "POINT", label.direction, label
+    return point

@@ -1,0 +1,50 @@
+"""Real motion capture as data: names, splits, the relaxed hand, the missing-folder error."""
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from rlanimate_addon.core import kinematics, skeleton
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion import realmocap_takes
+from trainer.motion.clip import MotionClip
+
+WAVE_NAMES = [f"dataset-2_wave-{side}-hand_{style}_{take:03d}.bvh" for side in ("left", "right")
+              for style in realmocap_takes.STYLES for take in range(1, 11)]
+
+
+def test_parse_name_reads_content_arm_style_and_take():
+    assert realmocap_takes.parse_name("x/dataset-2_wave-left-hand_feminine_009.bvh") == {
+        "content": "wave", "arm": "LEFT", "style": "feminine", "take": "009"}
+    assert realmocap_takes.parse_name("dataset-1_guide_not-confident_001.bvh") == {
+        "content": "guide", "arm": None, "style": "not-confident", "take": "001"}
+    with pytest.raises(RLAnimateError, match="Bandai Namco"):
+        realmocap_takes.parse_name("wave_001.bvh")
+
+
+def test_splits_match_the_experiments():
+    clips = [SimpleNamespace(**realmocap_takes.parse_name(name)) for name in WAVE_NAMES]
+    train, test = realmocap_takes.wave_split(clips)
+    assert (len(train), len(test)) == (112, 28)
+    assert {c.take for c in test} == {"009", "010"}
+    train, test = realmocap_takes.style_holdout_split(clips)
+    assert (len(train), len(test)) == (100, 40)
+    assert not {c.style for c in train} & {c.style for c in test}
+
+
+def test_relaxed_hand_curls_the_fingers_towards_the_palm():
+    relaxed = realmocap_takes.relaxed_hand(MotionClip("c", "", 30.0, np.zeros((3, len(skeleton.ACTION_JOINTS), 3))))
+    for side in ("Left", "Right"):
+        index1 = relaxed.rotvecs[:, skeleton.ACTION_JOINTS.index(side + "HandIndex1")]
+        pose = kinematics.pose_matrices({side + "HandIndex1": index1[0], **{k: v[0] for k, v in relaxed.fingers.items()}})
+        heads = kinematics.head_positions(pose)
+        for finger in ("Index", "Pinky"):
+            base = heads[kinematics.bone_index(f"{side}Hand{finger}1")]
+            tip = heads[kinematics.bone_index(f"{side}Hand{finger}4")]
+            assert tip[2] < base[2] - 0.005  # T-pose, palm down: a curl lowers the tip
+        assert np.all(np.isfinite(relaxed.rotvecs))
+
+
+def test_missing_folder_gets_a_clear_error(tmp_path):
+    with pytest.raises(RLAnimateError, match="not at"):
+        realmocap_takes.require_realmocap(tmp_path)

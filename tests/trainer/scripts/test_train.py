@@ -1,0 +1,74 @@
+"""trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its outputs exist and load without torch."""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from rlanimate_addon.core import runtime
+from trainer.agent.algorithm import clip_objective
+from trainer.blender_io import rig_session
+from trainer.blender_io.clip_bake import bake_clip, export_fbx
+from trainer.blender_io.clip_import import load_clip_set
+from trainer.motion.library_plan import manifest_entry, plan_library
+from trainer.motion.synthesis import synthesise
+from trainer.paths import REPO_ROOT, SAMPLE_RIG_BLEND
+from trainer.scripts import cli, train
+
+
+@pytest.fixture(scope="module")
+def tiny_library(tmp_path_factory):
+    """Two training and one held-out clip per behaviour, from the sample library's plan, as FBX + manifest."""
+    folder = tmp_path_factory.mktemp("clips")
+    planned = [p for p in plan_library()]
+    chosen = [p for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
+              for p in [q for q in planned if q.spec.behaviour == behaviour and q.split == split][:count]]
+    bpy = rig_session.import_bpy()
+    rig_session.new_empty_scene()
+    rig = rig_session.load_rig(SAMPLE_RIG_BLEND)
+    entries = []
+    for plan in chosen:
+        clip = synthesise(plan.spec)
+        action = bake_clip(rig, clip, Path(plan.file).stem)
+        export_fbx(bpy, rig, folder / plan.file, clip.frames)
+        rig.animation_data.action = None
+        bpy.data.actions.remove(action)
+        entries.append(manifest_entry(plan, clip.frames))
+    (folder / "manifest.json").write_text(json.dumps({"fps": 30, "clips": entries}))
+    return folder / "manifest.json"
+
+
+def test_blender_style_arguments_are_parsed_after_the_double_dash():
+    argv = ["blender", "-b", "-P", "trainer/train.py", "--", "--preset", "debug", "--behaviour", "wave"]
+    args = train.build_parser().parse_args(cli.script_args(argv))
+    assert (args.preset, args.behaviour, args.variant, args.install) == ("debug", "wave", None, False)
+
+
+def test_train_cli_writes_an_agent_report_and_plots_that_load(tiny_library, tmp_path):
+    output = tmp_path / "run"
+    command = [sys.executable, str(REPO_ROOT / "trainer" / "train.py"), "--preset", "debug", "--output",
+               str(output), "--clips", str(tiny_library), "--epochs", "3", "--eval-every", "2"]
+    result = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr[-3000:]
+    for name in ("agent.npz", "checkpoint.pt", "metrics.jsonl", "report.json", "report.md", "training_curves.png"):
+        assert (output / name).stat().st_size > 0, name
+    metrics = [json.loads(line) for line in (output / "metrics.jsonl").read_text().splitlines()]
+    assert [m["epoch"] for m in metrics] == [1, 2, 3] and "unseen/score" in metrics[1]
+    report = json.loads((output / "report.json").read_text())
+    assert report["episodes"] == 3 * 2 and len(report["held_out"]["clips"]) == 2
+    assert len(report["training"]["clips"]) == 4  # the 10 seen clips, capped at the library's 4
+    assert (output / "training_curves.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+    agent = runtime.load_agent(output / "agent.npz")  # numpy only: no torch, no pickle
+    clip = load_clip_set(tiny_library).test[0]
+    actions = agent.rollout(clip_objective(clip))
+    assert actions.shape == (len(clip.rotvecs), 45) and np.all((actions >= 0) & (actions <= 1))
+
+
+def test_unknown_preset_is_a_clear_error(tiny_library, tmp_path):
+    command = [sys.executable, str(REPO_ROOT / "trainer" / "train.py"), "--preset", "huge",
+               "--output", str(tmp_path / "run"), "--clips", str(tiny_library)]
+    result = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert result.returncode == 2 and "Unknown config preset 'huge'" in result.stderr

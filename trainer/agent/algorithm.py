@@ -1,0 +1,185 @@
+"""Algorithm 1 of the paper: collect a rollout per iteration, then T model updates on buffer chunks.
+
+One iteration (which we count as one epoch, as the paper's Figure 3 does):
+    1. draw one training clip at random, or one per behaviour when training both (without
+       replacement, in passes over each behaviour's clips);
+    2. roll the current agent out on each clip's objectives (from its label and frame count), then
+       play every frame through the bpy FK environment in one batch. The agent's inputs are the
+       objectives only (it self-describes with its portrayal model), so the whole rollout can be
+       computed before the environment is asked for the real descriptions d'_t. Each episode
+       (o, a, d', m, FK of m) is appended to the buffer;
+    3. run T update steps, each on C random chunks of L frames, with Adam on L1 + L2 + L3.
+Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
+that they explore and stay reproducible; evaluation rolls out deterministically.
+"""
+import math
+import time
+
+import numpy as np
+import torch
+
+from rlanimate_addon.core import spaces
+from rlanimate_addon.core.errors import RLAnimateError
+
+from trainer.agent import checkpoint
+from trainer.agent.buffer import EpisodeBuffer
+
+BEHAVIOUR_CHOICES = ("point", "wave", "both")
+
+
+def clips_for_behaviour(clips, behaviour):
+    """Clips grouped as Algorithm 1 draws them: [[point clips], [wave clips]] for 'both', else one group."""
+    wanted = ("POINT", "WAVE") if behaviour == "both" else (behaviour.upper(),)
+    groups = [[clip for clip in clips if clip.behaviour.upper() == name] for name in wanted]
+    for name, group in zip(wanted, groups):
+        if not group:
+            raise RLAnimateError(f"The clip library has no {name.lower()} training clips: add some, "
+                                 f"or train with --behaviour set to a behaviour it has.")
+    return groups
+
+
+def clip_objective(clip, frame_count=None):
+    """(N, 7) objectives for `clip`'s label, over its own length or `frame_count` frames."""
+    return spaces.make_objective(clip.behaviour.upper(), clip.arm.upper(), clip.attributes,
+                                 len(clip.rotvecs) if frame_count is None else frame_count)
+
+
+def rollout_actions(agent, objectives, deterministic=True, generator=None):
+    """(N, 7) numpy objectives -> (N, 45) numpy actions in [0, 1] from one agent rollout."""
+    batch = torch.as_tensor(objectives, dtype=torch.float32)[None]  # (1, N, 7)
+    with torch.no_grad():
+        actions = agent.rollout(batch, deterministic=deterministic, generator=generator)  # (1, N, 45)
+    return actions[0].double().numpy()
+
+
+class ClipReferences:
+    """FK of each clip's own motion (descriptions (F, 42), joint positions (F, 10, 3)), computed once."""
+
+    def __init__(self, env):
+        self.env = env
+        self._cache = {}
+
+    def get(self, clip):
+        key = id(clip)
+        if key not in self._cache:
+            result = self.env.evaluate(np.asarray(clip.rotvecs, dtype=np.float64))
+            self._cache[key] = (clip, np.asarray(result.descriptions), np.asarray(result.joint_positions))
+        return self._cache[key][1:]
+
+
+class Trainer:
+    """Algorithm 1's state (agent, optimiser, buffer, RNGs, epoch, history) and one iteration of it."""
+
+    def __init__(self, agent, env, clips, train_config, behaviour="both", seed=0,
+                 bounds=spaces.DEFAULT_ACTION_BOUNDS, references=None, epochs=None):
+        if behaviour not in BEHAVIOUR_CHOICES:
+            raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use point, wave or both.")
+        self.agent = agent
+        self.env = env
+        self.train_config = train_config
+        self.behaviour = behaviour
+        self.bounds = np.asarray(bounds, dtype=np.float64)
+        self.clip_groups = clips_for_behaviour(clips, behaviour)
+        self.references = references or ClipReferences(env)
+        self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
+        self.buffer = EpisodeBuffer()
+        self.rng = np.random.default_rng(seed)
+        self.decks = [[] for _ in self.clip_groups]  # per group: clip indices still to draw this pass
+        self.rollout_generator = torch.Generator().manual_seed(seed)
+        self.epochs = epochs  # the planned length of the run, for the learning-rate schedule
+        self.epoch = 0
+        self.history = []  # one metrics dict per epoch
+
+    def draw(self, group_index):
+        """The next clip of a group: clips are drawn at random without replacement, in passes over the
+        group, so that every training clip is rolled out once before any is rolled out twice."""
+        deck = self.decks[group_index]
+        if not deck:
+            deck.extend(int(k) for k in self.rng.permutation(len(self.clip_groups[group_index])))
+        return self.clip_groups[group_index][deck.pop()]
+
+    def collect(self):
+        """Steps 1-2: draw a clip per group, roll the agent out, evaluate all frames in one FK batch."""
+        drawn = [self.draw(k) for k in range(len(self.clip_groups))]
+        objectives = [clip_objective(clip) for clip in drawn]
+        self.agent.eval()
+        actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
+                   for o in objectives]
+        rotvecs = spaces.decode_action(np.concatenate(actions), self.bounds)  # (sum F, 15, 3)
+        descriptions = np.asarray(self.env.evaluate(rotvecs).descriptions)  # (sum F, 42)
+        ends = np.cumsum([len(a) for a in actions])[:-1]
+        for clip, objective, action, description in zip(drawn, objectives, actions,
+                                                        np.split(descriptions, ends)):
+            motion_description, _ = self.references.get(clip)
+            self.buffer.add({
+                "objective": objective,
+                "action": action,
+                "description": description,
+                "motion": spaces.encode_action(clip.rotvecs, self.bounds),
+                "motion_description": motion_description,
+            })
+        return drawn
+
+    def learning_rate(self):
+        """This epoch's Adam step size: cosine from learning_rate down to learning_rate_final over the
+        planned epochs, or constant when the config or the trainer gives no final rate or no length."""
+        config = self.train_config
+        final = config.learning_rate_final
+        if final is None or not self.epochs:
+            return config.learning_rate
+        progress = min(self.epoch / self.epochs, 1.0)
+        return final + (config.learning_rate - final) * 0.5 * (1.0 + math.cos(math.pi * progress))
+
+    def update(self):
+        """Step 3: T gradient steps on C chunks of L frames; returns each loss's mean over the steps."""
+        config = self.train_config
+        for group in self.optimizer.param_groups:
+            group["lr"] = self.learning_rate()
+        self.agent.train()
+        totals = {}
+        for _ in range(config.update_steps):
+            batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng)
+            losses = self.agent.losses(batch, config)
+            self.optimizer.zero_grad(set_to_none=True)
+            losses["total"].backward()
+            if getattr(config, "grad_clip", None):
+                torch.nn.utils.clip_grad_norm_(self.agent.parameters(), config.grad_clip)
+            self.optimizer.step()
+            for name, value in losses.items():
+                totals[name] = totals.get(name, 0.0) + float(value.detach())
+        return {name: value / config.update_steps for name, value in totals.items()}
+
+    def run_epoch(self):
+        """One iteration of Algorithm 1; appends and returns its metrics."""
+        start, cpu_start = time.perf_counter(), time.process_time()
+        self.collect()
+        collected = time.perf_counter()
+        losses = self.update()
+        self.epoch += 1
+        metrics = {"epoch": self.epoch, "episodes": len(self.buffer), "frames": self.buffer.frames,
+                   "learning_rate": self.optimizer.param_groups[0]["lr"], "collect_seconds": collected - start,
+                   "update_seconds": time.perf_counter() - collected, "cpu_seconds": time.process_time() - cpu_start,
+                   **{f"loss/{name}": value for name, value in losses.items()}}
+        self.history.append(metrics)
+        return metrics
+
+    def state_dict(self):
+        return {
+            "epoch": self.epoch,
+            "agent": self.agent.state_dict(),
+            "optimizer": self.optimizer.state_dict(),
+            "buffer": self.buffer.state_dict(),
+            "history": self.history,
+            "decks": [list(deck) for deck in self.decks],
+            "rng": checkpoint.capture_rng_states(self.rng, self.rollout_generator),
+        }
+
+    def load_state_dict(self, state):
+        self.epoch = int(state["epoch"])
+        self.agent.load_state_dict(state["agent"])
+        self.optimizer.load_state_dict(state["optimizer"])
+        self.buffer.load_state_dict(state["buffer"])
+        self.history = list(state["history"])
+        # A checkpoint from before the draws were in passes starts a fresh pass.
+        self.decks = [list(deck) for deck in state.get("decks", [[] for _ in self.clip_groups])]
+        checkpoint.restore_rng_states(state["rng"], self.rng, self.rollout_generator)

@@ -1,0 +1,89 @@
+"""Hyperparameters: the agent's sizes (AgentConfig) and Algorithm 1's settings (TrainConfig), with presets.
+
+`load_preset(name)` returns (AgentConfig, TrainConfig) for a name in PRESETS:
+    debug    everything tiny, so the whole training loop runs in a test in seconds;
+    default  sized to train the both-behaviour agent in minutes on 2 CPU cores (the shipped agent);
+    paper    the paper gives no sizes; it follows PlaNet (Hafner et al. 2019), so this preset uses
+             PlaNet's (200 deterministic / 30 stochastic units, 50 chunks of 50 frames, free nats 3,
+             Adam 1e-3, gradient clip 1000). It is slow on a CPU.
+Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
+"""
+from dataclasses import asdict, dataclass, fields
+
+from rlanimate_addon.core.errors import RLAnimateError
+
+
+@dataclass(frozen=True)
+class AgentConfig:
+    task_size: int = 64  # h_t, the deterministic task state
+    behaviour_size: int = 64  # e_t, the deterministic part of the behaviour state
+    stochastic_size: int = 16  # z_t, the stochastic part of the behaviour state
+    hidden_size: int = 64  # hidden width of the prior, posterior, animation and decoder MLPs
+    portrayal_hidden_size: int = 64  # hidden width of the portrayal MLP
+    hidden_layers: int = 2  # hidden layers of every MLP
+    min_std: float = 0.1  # floor of the prior's and posterior's standard deviations
+    concentration_floor: float = 1.0  # floor of the Beta's alpha and beta (>= 1: unimodal)
+    concentration_scale: float = 100.0  # alpha, beta = floor + scale * softplus(output)
+
+    def to_dict(self):
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, values):
+        return cls(**_known_fields(cls, values))
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    epochs_single: int = 50  # iterations of Algorithm 1 for one behaviour (the paper's 50)
+    epochs_both: int = 100  # ... and for both behaviours (the paper's 100)
+    update_steps: int = 20  # T: model updates per iteration
+    chunk_count: int = 16  # C: chunks per update
+    chunk_length: int = 32  # L: frames per chunk
+    learning_rate: float = 1e-3  # Adam
+    learning_rate_final: float = None  # cosine decay to this over the run's epochs (None: constant)
+    grad_clip: float = 100.0  # global gradient-norm clip
+    free_nats: float = 1.0  # L2: KL below this (nats per frame) is not penalised
+    kl_balance: float = 0.8  # L2: weight of the KL's gradient into the prior (1 - it into the posterior)
+    huber_delta: float = 0.05  # L3: Huber threshold, in action units ([0, 1] per channel)
+    l1_scale: float = 1.0  # description reconstruction (MSE, summed over the 42 numbers)
+    l2_scale: float = 0.1  # KL(q || p)
+    l3_scale: float = 100.0  # Huber to the clip's pose, summed over the 45 channels
+    portrayal_direct_loss: bool = True  # also fit the self-description to the clip's description
+    portrayal_scale: float = 1.0  # ... with this scale (MSE, summed over the 42 numbers)
+    policy_scale: float = 0.01  # Beta concentrations fitted by NLL of the clip's pose (mean detached)
+
+    def to_dict(self):
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, values):
+        return cls(**_known_fields(cls, values))
+
+
+def _known_fields(cls, values):
+    names = {f.name for f in fields(cls)}
+    return {key: value for key, value in dict(values).items() if key in names}
+
+
+PRESETS = {
+    "debug": (
+        AgentConfig(task_size=8, behaviour_size=8, stochastic_size=4, hidden_size=8,
+                    portrayal_hidden_size=8, hidden_layers=1),
+        TrainConfig(epochs_single=2, epochs_both=2, update_steps=3, chunk_count=4, chunk_length=8),
+    ),
+    "default": (AgentConfig(), TrainConfig(update_steps=60, chunk_count=32, learning_rate=3e-3,
+                                           learning_rate_final=1e-4)),
+    "paper": (
+        AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
+                    portrayal_hidden_size=200),
+        TrainConfig(update_steps=100, chunk_count=50, chunk_length=50, grad_clip=1000.0, free_nats=3.0),
+    ),
+}
+
+
+def load_preset(name):
+    """(AgentConfig, TrainConfig) of the preset `name`."""
+    if name not in PRESETS:
+        raise RLAnimateError(f"Unknown config preset {name!r}: use one of {', '.join(PRESETS)}.")
+    return PRESETS[name]

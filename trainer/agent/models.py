@@ -1,0 +1,186 @@
+"""The RLAnimate agent (paper Section 3.1): portrayal, behaviour and animation models, and a decoder.
+
+Timing of one rollout step (the environment plays a_t and returns the real description d'_t):
+
+                  frame t-1                  frame t
+    objective     o_{t-1}                    o_t
+    portrayal     d_{t-1}                    d_t = g(o_t)                               self-description
+    task state    h_{t-1} -----------------> h_t = f1(h_{t-1}, o_t)
+    behaviour     e_{t-1} -----------------> e_t = f2(e_{t-1}; h_t, z_{t-1}, a_{t-1})
+                  z_{t-1} ------------------------------------^   |
+                  a_{t-1} ------------------------------------^   v
+                                             z_t ~ q(z_t | e_t, d_t)                    prior p(z_t | e_t)
+    animation                                a_t ~ Beta(h_t, e_t, z_t)                  played at frame t
+    environment   d'_{t-1} = FK(a_{t-1})     d'_t = FK(a_t)           decoder(h_t, e_t, z_t) predicts d'_t
+
+Everything indexed t is computed at frame t from o_t and from the previous frame's z_{t-1} and
+a_{t-1}; a_t is the pose played at frame t and d'_t is the description of that pose. The
+behaviour state b_t of the paper is the pair (e_t, z_t), as in PlaNet's RSSM. A rollout or a
+training chunk starts from h_0 = e_0 = 0, z_0 = 0 and a_0 = agent_file.INITIAL_ACTION.
+
+Variants (the paper's Table 4 ablations; docs/AGENT.md defines them):
+    rlanimate        as above;
+    single_state     no portrayal model: the posterior is conditioned on the real description d'_t
+                     in training, and rollouts use the prior p(z_t | e_t);
+    single_dynamics  no task state: f2 takes o_t in place of h_t, and the heads see (e_t, z_t) only;
+    supervised       rlanimate's networks trained as behaviour cloning (trainer/agent/losses.py).
+Tensors are batch-major: B sequences of T frames.
+"""
+import torch
+import torch.nn.functional as F
+from torch import nn
+from torch.distributions import Beta, Independent, Normal
+
+from rlanimate_addon.core import agent_file, spaces
+from rlanimate_addon.core.errors import RLAnimateError
+
+from trainer.agent import losses as loss_terms
+
+VARIANTS = agent_file.VARIANTS
+
+
+class MLP(nn.Module):
+    """`layers` hidden Linear + tanh layers of width `hidden`, then a Linear output (tanh: smooth, and one
+    cheap call in the numpy runtime)."""
+
+    def __init__(self, inputs, hidden, layers, outputs):
+        super().__init__()
+        widths = [inputs] + [hidden] * layers + [outputs]
+        self.layers = nn.ModuleList(nn.Linear(n_in, n_out) for n_in, n_out in zip(widths[:-1], widths[1:]))
+
+    def forward(self, x):
+        for layer in self.layers[:-1]:
+            x = torch.tanh(layer(x))
+        return self.layers[-1](x)
+
+
+class RLAnimateAgent(nn.Module):
+    def __init__(self, agent_config, variant="rlanimate"):
+        super().__init__()
+        if variant not in VARIANTS:
+            raise RLAnimateError(f"Unknown agent variant {variant!r}: use one of {', '.join(VARIANTS)}.")
+        c = self.config = agent_config
+        self.variant = variant
+        O, D, A = spaces.OBJECTIVE_SIZE, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
+        E, Z, hid, n = c.behaviour_size, c.stochastic_size, c.hidden_size, c.hidden_layers
+        self.uses_portrayal = agent_file.uses_portrayal(variant)
+        self.uses_task_state = agent_file.uses_task_state(variant)
+        if self.uses_portrayal:
+            self.portrayal = MLP(O, c.portrayal_hidden_size, n, D)
+        if self.uses_task_state:
+            self.task_rnn = nn.GRU(O, c.task_size, batch_first=True)
+        task = c.task_size if self.uses_task_state else O
+        head_inputs = (c.task_size if self.uses_task_state else 0) + E + Z
+        self.behaviour_cell = nn.GRUCell(task + Z + A, E)
+        self.prior = MLP(E, hid, n, 2 * Z)
+        self.posterior = MLP(E + D, hid, n, 2 * Z)
+        self.animation = MLP(head_inputs, hid, n, 2 * A)
+        self.decoder = MLP(head_inputs, hid, n, D)
+
+    # --- the models, one frame or a whole sequence at a time -------------------------------------
+
+    def self_description(self, objectives):
+        """Portrayal model: (B, T, 7) -> (B, T, 42) self-descriptions d_t, or None in single_state."""
+        return self.portrayal(objectives) if self.uses_portrayal else None
+
+    def task_features(self, objectives):
+        """(B, T, 7) -> (B, T, K): the task state h_{1:T} (K = task_size), or o_{1:T} in single_dynamics."""
+        if not self.uses_task_state:
+            return objectives
+        states, _ = self.task_rnn(objectives)  # h_0 = 0
+        return states
+
+    def transition(self, e_prev, z_prev, a_prev, task):
+        """f2: e_{t-1} (B, E), z_{t-1} (B, Z), a_{t-1} (B, 45), h_t (B, K) -> e_t (B, E)."""
+        return self.behaviour_cell(torch.cat([task, z_prev, a_prev], -1), e_prev)
+
+    def prior_belief(self, e):
+        """p(z_t | e_t): diagonal Gaussian over (..., Z)."""
+        return self._gaussian(self.prior(e))
+
+    def posterior_belief(self, e, description):
+        """q(z_t | e_t, d_t): diagonal Gaussian over (..., Z)."""
+        return self._gaussian(self.posterior(torch.cat([e, description], -1)))
+
+    def features(self, task, e, z):
+        """What the animation model and the decoder see: (h_t, e_t, z_t), or (e_t, z_t) in single_dynamics."""
+        return torch.cat([task, e, z], -1) if self.uses_task_state else torch.cat([e, z], -1)
+
+    def policy(self, features):
+        """Animation model: features (..., F) -> Beta over the action (..., 45)."""
+        concentrations = self.config.concentration_floor + \
+            self.config.concentration_scale * F.softplus(self.animation(features))  # (..., 90)
+        alpha, beta = concentrations.chunk(2, -1)
+        return Independent(Beta(alpha, beta), 1)
+
+    def decode(self, features):
+        """Description decoder: features (..., F) -> predicted real description (..., 42)."""
+        return self.decoder(features)
+
+    def _gaussian(self, out):
+        mean, raw_std = out.chunk(2, -1)
+        return Independent(Normal(mean, F.softplus(raw_std) + self.config.min_std), 1)
+
+    # --- unrolling -------------------------------------------------------------------------------
+
+    def initial_state(self, batch_size, like):
+        """(e_0, z_0, a_0) for `batch_size` sequences, with `like`'s dtype."""
+        c = self.config
+        return (like.new_zeros(batch_size, c.behaviour_size), like.new_zeros(batch_size, c.stochastic_size),
+                like.new_full((batch_size, spaces.ACTION_SIZE), agent_file.INITIAL_ACTION))
+
+    def rollout(self, objectives, deterministic=True, generator=None):
+        """Play the agent on objectives (B, T, 7) -> actions (B, T, 45) in [0, 1], without gradients.
+
+        Deterministic: z_t is the posterior mean (the prior mean in single_state) and a_t the Beta
+        mean. Otherwise z_t and a_t are sampled; with `generator` (a torch.Generator) the samples
+        come from it alone, so a rollout is reproducible from the generator's state.
+        """
+        with torch.no_grad():
+            if deterministic or generator is None:
+                return self._rollout(objectives, deterministic)
+            seed = int(torch.randint(0, 2 ** 62, (1,), generator=generator))
+            with torch.random.fork_rng(devices=[]):
+                torch.manual_seed(seed)
+                return self._rollout(objectives, deterministic)
+
+    def _rollout(self, objectives, deterministic):
+        task = self.task_features(objectives)  # (B, T, K)
+        described = self.self_description(objectives)  # (B, T, 42) or None
+        e, z, a = self.initial_state(objectives.shape[0], objectives)
+        actions = []
+        for t in range(objectives.shape[1]):
+            e = self.transition(e, z, a, task[:, t])
+            belief = self.prior_belief(e) if described is None else self.posterior_belief(e, described[:, t])
+            z = belief.mean if deterministic else belief.sample()
+            policy = self.policy(self.features(task[:, t], e, z))
+            a = policy.mean if deterministic else policy.sample()
+            actions.append(a)
+        return torch.stack(actions, 1)  # (B, T, 45)
+
+    def observe(self, objectives, previous_actions, conditions):
+        """Unroll over a training chunk with given inputs (teacher forcing), sampling z_t ~ q.
+
+        objectives (B, T, 7); previous_actions (B, T, 45), a_{t-1} for each frame; conditions
+        (B, T, 42), the d_t the posterior sees. Returns {"features" (B, T, F), "prior", "posterior"
+        (Gaussians over (B, T, Z))}.
+        """
+        task = self.task_features(objectives)  # (B, T, K)
+        e, z, _ = self.initial_state(objectives.shape[0], objectives)
+        es, zs, means, stds = [], [], [], []
+        for t in range(objectives.shape[1]):
+            e = self.transition(e, z, previous_actions[:, t], task[:, t])
+            posterior = self.posterior_belief(e, conditions[:, t])
+            z = posterior.rsample()
+            es.append(e)
+            zs.append(z)
+            means.append(posterior.base_dist.loc)
+            stds.append(posterior.base_dist.scale)
+        e, z = torch.stack(es, 1), torch.stack(zs, 1)  # (B, T, E), (B, T, Z)
+        return {"features": self.features(task, e, z),
+                "prior": self.prior_belief(e),
+                "posterior": Independent(Normal(torch.stack(means, 1), torch.stack(stds, 1)), 1)}
+
+    def losses(self, batch, train_config):
+        """Per-term scalar losses and their weighted "total" on a batch of chunks (trainer/agent/losses.py)."""
+        return loss_terms.agent_losses(self, batch, train_config)

@@ -1,0 +1,184 @@
+"""One training run: `train(RunSettings, session)` runs Algorithm 1 (or resumes it) and writes the agent,
+its checkpoint, metrics, report and training curves into the run's output folder.
+
+Outputs in `output`: agent.npz, checkpoint.pt (every `checkpoint_every` epochs, atomically),
+metrics.jsonl, report.json, report.md, training_curves.png, and tensorboard/ when TensorBoard is
+installed. A resumed run takes its settings from its checkpoint and continues bit for bit.
+"""
+import json
+import random
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.agent import checkpoint
+from trainer.agent.agent_export import export_agent
+from trainer.agent.algorithm import Trainer
+from trainer.agent.config import load_preset
+from trainer.agent.models import RLAnimateAgent
+from trainer.evaluation.scoring import evaluate_seen_unseen
+from trainer.motion.manifest import manifest_path
+from trainer.paths import DEFAULT_MANIFEST
+from trainer.reporting import plots
+from trainer.reporting.run_report import write_run_report
+
+#: Settings a resumed run takes from its checkpoint, so that it continues the same experiment.
+RESUMED_SETTINGS = ("behaviour", "clips", "preset", "variant", "seed", "eval_every")
+
+
+@dataclass(frozen=True)
+class RunSettings:
+    """What a run is. None means "not given": a new run takes the default below (`epochs`: the preset's,
+    the paper's 50 for one behaviour and 100 for both), a resumed run its checkpoint's value."""
+    output: str
+    behaviour: str = None  # "point", "wave" or "both"
+    clips: str = None  # the clip library's manifest.json (or its folder), recorded in the report
+    epochs: int = None  # iterations of Algorithm 1
+    seed: int = None
+    preset: str = None  # config preset: debug, default or paper
+    variant: str = None  # ablation variant (Table 4)
+    eval_every: int = None  # evaluate on seen and unseen clips every N epochs (0: only at the end)
+    resume: bool = False  # continue the run in `output` from its checkpoint
+    checkpoint_every: int = 1
+    progress: bool = True  # show a progress bar
+
+
+NEW_RUN_DEFAULTS = {"behaviour": "both", "clips": str(DEFAULT_MANIFEST), "seed": 0, "preset": "default",
+                    "variant": "rlanimate", "eval_every": 10}
+
+
+def resolve(settings):
+    """`settings` with every None filled: from the run's checkpoint when resuming (RLAnimateError when a
+    given value conflicts with the run's own), else from NEW_RUN_DEFAULTS. `epochs` stays None when not
+    given to a new run (the preset decides)."""
+    saved = checkpoint.load(Path(settings.output) / checkpoint.FILENAME) if settings.resume else None
+    return _resolved(settings, saved and saved["arguments"])
+
+
+def _resolved(settings, saved_arguments):
+    if saved_arguments is None:
+        return replace(settings, **{name: value for name, value in NEW_RUN_DEFAULTS.items()
+                                    if getattr(settings, name) is None})
+    conflicts = [f"--{name.replace('_', '-')} {getattr(settings, name)} (the run has {saved_arguments[name]})"
+                 for name in RESUMED_SETTINGS
+                 if getattr(settings, name) is not None and getattr(settings, name) != saved_arguments[name]]
+    if conflicts:
+        raise RLAnimateError(f"Cannot resume the run in {settings.output} with {', '.join(conflicts)}: a resumed "
+                             "run keeps its own settings. Leave those options out, or start a new run elsewhere.")
+    return replace(settings, **{name: saved_arguments[name] for name in RESUMED_SETTINGS},
+                   epochs=settings.epochs or saved_arguments["epochs"])
+
+
+def seed_everything(seed):
+    random.seed(seed)
+    np.random.seed(seed)
+    torch.manual_seed(seed)
+
+
+class MetricsLog:
+    """metrics.jsonl, rewritten from the checkpoint's history on resume, and TensorBoard when installed."""
+
+    def __init__(self, output, history):
+        self.path = Path(output) / "metrics.jsonl"
+        with open(self.path, "w") as handle:
+            handle.writelines(json.dumps(entry) + "\n" for entry in history)
+        try:
+            from torch.utils.tensorboard import SummaryWriter
+            self.tensorboard = SummaryWriter(str(Path(output) / "tensorboard"))
+        except ImportError:
+            self.tensorboard = None
+
+    def write(self, entry):
+        with open(self.path, "a") as handle:
+            handle.write(json.dumps(entry) + "\n")
+        if self.tensorboard is not None:
+            for name, value in entry.items():
+                if name != "epoch":
+                    self.tensorboard.add_scalar(name, value, entry["epoch"])
+            self.tensorboard.flush()
+
+    def close(self):
+        if self.tensorboard is not None:
+            self.tensorboard.close()
+
+
+def train(settings, session):
+    """Train (or resume) the run `settings` describes on `session` (env, references, train_clips, test_clips:
+    trainer.blender_io.clip_session.LibrarySession of `resolve(settings).clips`, or the real-mocap one);
+    returns (report dict, Trainer)."""
+    torch.set_num_threads(1)
+    output = Path(settings.output)
+    output.mkdir(parents=True, exist_ok=True)
+    saved = checkpoint.load(output / checkpoint.FILENAME) if settings.resume else None
+    settings = _resolved(settings, saved and saved["arguments"])
+    agent_config, train_config = load_preset(settings.preset)
+    epochs = settings.epochs or (train_config.epochs_both if settings.behaviour == "both"
+                                 else train_config.epochs_single)
+
+    seed_everything(settings.seed)
+    agent = RLAnimateAgent(agent_config, settings.variant)
+    trainer = Trainer(agent, session.env, session.train_clips, train_config, settings.behaviour, settings.seed,
+                      references=session.references, epochs=epochs)
+    if saved is not None:
+        trainer.load_state_dict(saved["trainer"])
+    arguments = {**{name: getattr(settings, name) for name in RESUMED_SETTINGS}, "epochs": epochs}
+    log = MetricsLog(output, trainer.history)
+    bar = tqdm(range(trainer.epoch, epochs), initial=trainer.epoch, total=epochs, disable=not settings.progress,
+               desc=f"{settings.variant} {settings.behaviour}", unit="epoch", dynamic_ncols=True)
+    final = None
+    for _ in bar:
+        entry = trainer.run_epoch()
+        if trainer.epoch == epochs or (settings.eval_every and trainer.epoch % settings.eval_every == 0):
+            final = evaluate_seen_unseen(trainer, session)
+            entry.update(_flatten(final))
+        log.write(entry)
+        bar.set_postfix({name[5:]: f"{value:.4g}" for name, value in entry.items() if name.startswith("loss/")})
+        if trainer.epoch % settings.checkpoint_every == 0 or trainer.epoch == epochs:
+            checkpoint.save(output / checkpoint.FILENAME, trainer.state_dict(), arguments)
+    bar.close()
+    if final is None:  # resumed a run that had already finished
+        final = evaluate_seen_unseen(trainer, session)
+    log.close()
+    report = _report(settings, trainer, final, epochs)
+    export_agent(agent, output / "agent.npz", _agent_metadata(report, trainer))
+    write_run_report(report, output)
+    plots.training_curves(trainer.history, output / "training_curves.png",
+                          title=f"{settings.variant}, {settings.behaviour}")
+    return report, trainer
+
+
+def _flatten(evaluation):
+    return {f"{split}/{name}": evaluation[split][name] for split in ("seen", "unseen")
+            for name in ("score", "smoothness")}
+
+
+def _report(settings, trainer, final, epochs):
+    seconds = sum(e["collect_seconds"] + e["update_seconds"] for e in trainer.history)
+    cpu_seconds = sum(e["cpu_seconds"] for e in trainer.history)
+    return {
+        "behaviour": settings.behaviour, "variant": settings.variant, "preset": settings.preset,
+        "seed": settings.seed, "clips": str(manifest_path(settings.clips)), "epochs": epochs, "episodes": len(trainer.buffer),
+        "frames": trainer.buffer.frames, "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
+        "torch_threads": torch.get_num_threads(),
+        "held_out": final["unseen"], "training": final["seen"],
+        "final_losses": {k[5:]: v for k, v in trainer.history[-1].items() if k.startswith("loss/")},
+    }
+
+
+def _agent_metadata(report, trainer):
+    lengths = {}
+    for group in trainer.clip_groups:
+        for clip in group:
+            lengths.setdefault(clip.behaviour.upper(), []).append(len(clip.rotvecs))
+    return {"training": {key: report[key] for key in ("behaviour", "variant", "preset", "seed", "clips",
+                                                       "epochs", "episodes", "train_seconds")},
+            "train_config": trainer.train_config,
+            "action_bounds": trainer.bounds,
+            "average_frames": {name: float(np.mean(values)) for name, values in lengths.items()},
+            "evaluation": {"held_out_score": report["held_out"]["score"],
+                           "held_out_smoothness": report["held_out"]["smoothness"]}}
+

@@ -1,0 +1,165 @@
+"""The baselines an animator would try before RLAnimate, producing clips the evaluator scores.
+
+Both answer the agent's request (behaviour, arm, label attributes, frame count) with a clip of
+local rotations (F, 15, 3) of skeleton.ACTION_JOINTS, like MotionClip.rotvecs:
+
+NearestClip      retrieval, as motion matching does: the training clip of the same behaviour and arm
+                 whose label is closest (angle between pointing directions; |difference| of
+                 exaggerations), time-warped uniformly to the requested length (per-joint slerp).
+ProceduralIK     Blender's IK constraint on the sample rig (trainer/blender_io/procedural_ik.py).
+
+Both start from and return to `neutral` (15, 3), the pose the training clips start in.
+AgentMethod (an exported .npz, numpy runtime) and TrainedAgentMethod (a trainer's torch agent) put
+RLAnimate behind the same generate() interface, so all three are scored by one code path.
+"""
+from pathlib import Path
+
+import numpy as np
+
+from rlanimate_addon.core import metrics, rotations, skeleton, spaces
+from rlanimate_addon.core.errors import RLAnimateError
+from rlanimate_addon.core.gesture import slerp
+
+
+
+def neutral_pose(clips):
+    """(15, 3) start pose: the mean first frame of `clips` (they all start standing neutrally)."""
+    if not clips:
+        raise RLAnimateError("No training clips: a baseline needs at least one clip to start from.")
+    quats = rotations.rotvec_to_quat(np.stack([np.asarray(c.rotvecs[0]) for c in clips]))  # (C, 15, 4)
+    quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
+    mean = quats.mean(axis=0)
+    return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
+
+
+def time_warp(rotvecs, frame_count):
+    """(M, 15, 3) -> (frame_count, 15, 3), uniform time scaling with per-joint slerp, ends kept."""
+    quats = rotations.rotvec_to_quat(np.asarray(rotvecs, dtype=np.float64))  # (M, 15, 4)
+    position = np.linspace(0.0, len(quats) - 1, int(frame_count))
+    low = np.floor(position).astype(int)
+    high = np.minimum(low + 1, len(quats) - 1)
+    weight = np.broadcast_to((position - low)[:, None], (len(position), quats.shape[1]))
+    return rotations.quat_to_rotvec(slerp(quats[low], quats[high], weight))
+
+
+def check_request(behaviour, arm, frame_count):
+    if behaviour not in spaces.BEHAVIOURS:
+        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use POINT or WAVE.")
+    if arm not in skeleton.ARMS:
+        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
+    if int(frame_count) < 2:
+        raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}.")
+
+
+class NearestClip:
+    """Motion-matching retrieval over labelled training clips (MotionClip-like: behaviour, arm,
+    attributes, rotvecs)."""
+
+    def __init__(self, clips):
+        self.clips = list(clips)
+
+    def nearest(self, behaviour, arm, attributes):
+        """The training clip of `behaviour` and `arm` whose label is closest to `attributes`."""
+        candidates = [c for c in self.clips if c.behaviour.upper() == behaviour and c.arm.upper() == arm]
+        if not candidates:
+            raise RLAnimateError(f"No {behaviour.lower()} training clip uses the {arm.lower()} arm: "
+                                 "add one to the library to use the nearest-clip baseline.")
+        return min(candidates, key=lambda c: self.label_distance(behaviour, c.attributes, attributes))
+
+    @staticmethod
+    def label_distance(behaviour, a, b):
+        """Angle (rad) between pointing directions, or |difference| of exaggerations."""
+        if behaviour == "POINT":
+            a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+            cos = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
+            return float(np.arccos(np.clip(cos, -1.0, 1.0)))
+        return abs(float(np.ravel(a)[0]) - float(np.ravel(b)[0]))
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        check_request(behaviour, arm, frame_count)
+        return time_warp(self.nearest(behaviour, arm, attributes).rotvecs, frame_count)
+
+
+class TrainedAgentMethod:
+    """A torch RLAnimate agent behind the baselines' generate() interface: the deterministic rollout
+    that trainer.evaluate scores, decoded to rotations with the trainer's bounds."""
+
+    def __init__(self, trainer, path):
+        self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        from trainer.agent.algorithm import rollout_actions
+        self.agent.eval()
+        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count))
+        return spaces.decode_action(actions, self.bounds)
+
+
+class AgentMethod:
+    """An exported RLAnimate agent (.npz) behind the baselines' generate() interface: the deterministic
+    numpy rollout on the request's objectives, decoded to rotations."""
+
+    def __init__(self, path):
+        from rlanimate_addon.core import runtime
+        self.path = Path(path)
+        self.agent = runtime.load_agent(self.path)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        objectives = spaces.make_objective(behaviour, arm, attributes, frame_count)
+        return spaces.decode_action(self.agent.rollout(objectives), np.asarray(self.agent.action_bounds))
+
+
+def evaluate_motions(env, motions, clips, references):
+    """{'score', 'smoothness', 'clips': [{name, behaviour, score, smoothness}]} of generated
+    (F_i, 15, 3) `motions` against `clips` (references: algorithm.ClipReferences), as evaluate.evaluate_clips."""
+    ends = np.cumsum([len(m) for m in motions])[:-1]
+    positions = np.split(np.asarray(env.evaluate(np.concatenate(motions)).joint_positions), ends)
+    rows = []
+    for clip, generated in zip(clips, positions):
+        _, reference = references.get(clip)
+        rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
+                     "score": float(metrics.score(generated, reference)),
+                     "smoothness": float(metrics.smoothness(generated))})
+    return {"score": float(np.mean([r["score"] for r in rows])),
+            "smoothness": float(np.mean([r["smoothness"] for r in rows])), "clips": rows}
+
+
+def generate_for(baseline, clips):
+    """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
+    return [baseline.generate(c.behaviour.upper(), c.arm.upper(), c.attributes, len(c.rotvecs)) for c in clips]
+
+
+METHOD_LABELS = {"rlanimate": "RLAnimate", "nearest_clip": "Nearest clip", "procedural_ik": "Procedural IK"}
+METRIC_LABELS = {"score": "score", "smoothness": "smoothness", "label_error": "label error (autolabel)",
+                 "forearm_angle_deg": "forearm angle at hold (deg)"}
+
+
+def write_results(results_dir, section, description, sets):
+    """Merge one section into results_dir/baselines.json and rewrite baselines.md from the whole file.
+
+    sets: {set name: {method: {metric: value, ...}}}; the other sections are kept as they are, so
+    the sample-library and the real-data runs each update their own.
+    """
+    import json
+    results_dir = Path(results_dir)
+    results_dir.mkdir(parents=True, exist_ok=True)
+    path = results_dir / "baselines.json"
+    table = json.loads(path.read_text()) if path.is_file() else {}
+    table[section] = {"description": description, "sets": sets}
+    path.write_text(json.dumps(table, indent=2) + "\n")
+    lines = ["# RLAnimate against the baselines an animator would try first", "",
+             "Nearest clip: the training clip with the closest label, time-warped to the requested length. "
+             "Procedural IK: Blender's IK constraint with minimum-jerk timing (trainer/evaluation/baselines.py). "
+             "Each method answers the held-out clip's own request (label and length); score and smoothness "
+             "as in docs/METRICS.md. Discussion: docs/REALMOCAP.md.", ""]
+    for name, entry in table.items():
+        lines += [f"## {name}", "", entry["description"], ""]
+        for set_name, methods in entry["sets"].items():
+            metric_names = [m for m in METRIC_LABELS if any(m in row for row in methods.values())]
+            lines += [f"**{set_name}**", "", "| method | " + " | ".join(METRIC_LABELS[m] for m in metric_names) + " |",
+                      "|---|" + "---|" * len(metric_names)]
+            for method, row in methods.items():
+                lines.append(f"| {METHOD_LABELS.get(method, method)} | "
+                             + " | ".join(f"{row[m]:.3g}" if m == "label_error" else f"{row[m]:.2f}"
+                                          for m in metric_names) + " |")
+            lines.append("")
+    (results_dir / "baselines.md").write_text("\n".join(lines))

@@ -1,0 +1,237 @@
+"""Learn from real motion capture (Bandai Namco Research, CC BY-NC 4.0) and compare with the baselines
+(`python -m trainer.scripts.realmocap`).
+
+The clips are read from ../shared/realmocap/ beside the repository (never copied into it; see
+docs/REALMOCAP.md). Each BVH goes through trainer/blender_io/clip_import.py (Blender's BVH importer and
+the canonicalisation); the capture has no fingers, so a relaxed open hand (motion/realmocap_takes.py)
+is put on, and labels come from the motion (trainer/motion/autolabel.py).
+
+Experiments, each trained with trainer.agent.run.train on a session of real clips (runs/realmocap/<name>/):
+    wave      wave agent on takes 001-008 of the 7 styles x 2 arms (112 clips), tested on takes
+              009-010 (28) and on the 14 goodbye waves of dataset 1 (other actor takes, other styles)
+    holdout   the same on all takes of 5 styles (100 clips), tested on the 2 unseen styles (40 clips)
+    guide     the right-arm directing gestures as pointing: the pointing agent is given the direction
+              in which the actor held the arm, and we report the angle between the generated and the
+              real forearm (elbow -> wrist) at each one's hold
+Both baselines (trainer/evaluation/baselines.py) answer the same requests. Writes docs/results/realmocap.json and
+.md, the real-data section of docs/results/baselines.json and .md, and
+docs/results/realmocap_frames.png (generated and real frames side by side).
+"""
+import sys
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from rlanimate_addon.core import skeleton
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.agent import checkpoint
+from trainer.agent.algorithm import ClipReferences
+from trainer.agent.run import RunSettings, train
+from trainer.blender_io.clip_import import import_clip
+from trainer.blender_io.clip_session import LibrarySession
+from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.procedural_ik import ProceduralIK
+from trainer.blender_io.rig_session import new_empty_scene
+from trainer.evaluation import baselines
+from trainer.motion import autolabel
+from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
+                                            style_holdout_split, wave_split)
+from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, shown
+from trainer.reporting.realmocap_report import frames_figure
+
+
+def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache"):
+    """A real clip on the canonical rig with a relaxed hand and labels derived from its motion.
+
+    wave/ and bye/ clips are WAVE (arm and exaggeration from autolabel.label_wave); guide/ clips are
+    POINT (arm and held direction from autolabel.label_point). `.style` and `.take` come from the name.
+    """
+    info = parse_name(path)
+    clip = relaxed_hand(import_clip(path, cache_dir=cache_dir))
+    autolabel.label_clip(clip, "POINT" if info["content"] == "guide" else "WAVE")
+    clip.content, clip.style, clip.take, clip.named_arm = info["content"], info["style"], info["take"], info["arm"]
+    return clip
+
+
+def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_cache"):
+    """Every clip of root/folder ('wave', 'bye' or 'guide'), sorted by name."""
+    paths = sorted((require_realmocap(root) / folder).glob("*.bvh"))
+    return [import_real_clip(p, cache_dir) for p in paths]
+
+
+class RealSession:
+    """What train.run needs (env, references, train_clips, test_clips), over real clips."""
+
+    def __init__(self, env, references, train_clips, test_clips):
+        self.env, self.references = env, references
+        for split, clips in (("train", train_clips), ("test", test_clips)):
+            for clip in clips:
+                clip.split = split
+        self.train_clips, self.test_clips = list(train_clips), list(test_clips)
+
+
+def forearm_direction(bone_heads, bone_names, arm):
+    """(F, 3) unit elbow -> wrist vectors from FKResult.bone_heads."""
+    side = skeleton.ARM_PREFIX[arm]
+    elbow = bone_heads[:, bone_names.index(side + "ForeArm")]
+    wrist = bone_heads[:, bone_names.index(side + "Hand")]
+    vectors = wrist - elbow
+    return vectors / np.linalg.norm(vectors, axis=-1, keepdims=True)
+
+
+def angle_degrees(a, b):
+    return float(np.degrees(np.arccos(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b), -1.0, 1.0))))
+
+
+def guide_angles(method, clips, env):
+    """Per guide clip: the angle (deg) between generated and real forearm directions at their holds."""
+    rows = []
+    motions = baselines.generate_for(method, clips)
+    for clip, motion in zip(clips, motions):
+        real = env.evaluate(clip.rotvecs)
+        generated = env.evaluate(motion)
+        hold = autolabel.label_point(motion, clip.arm).hold_frame
+        real_forearm = forearm_direction(real.bone_heads, env.bone_names, clip.arm)[clip.label.hold_frame]
+        generated_forearm = forearm_direction(generated.bone_heads, env.bone_names, clip.arm)[hold]
+        rows.append({"name": clip.name, "style": clip.style, "arm": clip.arm,
+                     "direction": [round(float(v), 4) for v in clip.attributes],
+                     "forearm_angle_deg": angle_degrees(real_forearm, generated_forearm)})
+    return {"mean_forearm_angle_deg": float(np.mean([r["forearm_angle_deg"] for r in rows])),
+            "median_forearm_angle_deg": float(np.median([r["forearm_angle_deg"] for r in rows])), "clips": rows}
+
+
+def train_agent(session, name, behaviour, epochs, preset, seed, runs=REALMOCAP_RUNS):
+    """Train on `session` into runs/<name>/ (resumed when a checkpoint is there); (report, method)."""
+    output = Path(runs) / name
+    settings = RunSettings(output=str(output), behaviour=behaviour, clips=f"realmocap:{name}", epochs=epochs,
+                           seed=seed, preset=preset, variant="rlanimate", eval_every=0,
+                           resume=(output / checkpoint.FILENAME).is_file(), progress=False)
+    report, trainer = train(settings, session)
+    return report, baselines.TrainedAgentMethod(trainer, output / "agent.npz")
+
+
+def compare(methods, clips, env, references):
+    """{method: evaluate_motions result} on `clips`; for waves also `label_error`, the mean
+    |autolabel exaggeration of the generated wave - requested exaggeration| (does it portray the label?)."""
+    results = {}
+    for name, method in methods.items():
+        motions = baselines.generate_for(method, clips)
+        result = baselines.evaluate_motions(env, motions, clips, references)
+        if all(c.behaviour == "WAVE" for c in clips):
+            result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
+                                                   for m, c in zip(motions, clips)]))
+        results[name] = result
+    return results
+
+
+def label_table(clips):
+    """{style: {arm: mean exaggeration}} and per-style elevation/stroke means, for the report."""
+    table = {}
+    for clip in clips:
+        entry = table.setdefault(clip.style, {"exaggeration": [], "elevation": [], "stroke": [], "arm_correct": []})
+        entry["exaggeration"].append(clip.exaggeration)
+        entry["elevation"].append(clip.label.elevation)
+        entry["stroke"].append(clip.label.stroke)
+        entry["arm_correct"].append(clip.named_arm is None or clip.named_arm == clip.arm)
+    return {style: {"clips": len(v["exaggeration"]), "exaggeration": float(np.mean(v["exaggeration"])),
+                    "exaggeration_sd": float(np.std(v["exaggeration"])), "elevation_deg": float(np.mean(v["elevation"])),
+                    "stroke_arm_lengths": float(np.mean(v["stroke"])), "arm_correct": int(np.sum(v["arm_correct"]))}
+            for style, v in sorted(table.items(), key=lambda item: np.mean(item[1]["exaggeration"]))}
+
+
+def point_agent_and_library(point_agent, runs, epochs, seed):
+    """(AgentMethod, sample-library point training clips) for the guide experiment.
+
+    `point_agent` None: the add-on's installed default agent when it is trained, else a point agent
+    trained here on the sample library (runs/realmocap/sample_point/)."""
+    library = LibrarySession(DEFAULT_MANIFEST)
+    clips = [c for c in library.train_clips if c.behaviour == "POINT"]
+    if point_agent is None:
+        try:
+            installed = baselines.AgentMethod(INSTALLED_AGENT)
+            training = installed.agent.metadata.get("training", {})
+            if not training.get("untrained") and training.get("behaviour") in ("point", "both"):
+                return installed, clips
+        except RLAnimateError as error:
+            print(f"realmocap: not using the installed agent: {error}", file=sys.stderr)
+        return train_agent(library, "sample_point", "point", epochs, "default", seed, runs)[1], clips
+    return baselines.AgentMethod(point_agent), clips
+
+
+def _summary(result):
+    return {"clips": len(result["clips"]),
+            **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result}}
+
+
+def run_experiments(options):
+    """All experiments; returns the realmocap results dict (also written to options.results)."""
+    torch.set_num_threads(1)
+    new_empty_scene()
+
+    root = require_realmocap(options.realmocap)
+    Path(options.results).mkdir(parents=True, exist_ok=True)
+    cache = Path(options.runs) / "import_cache"
+    waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
+    env = FKEnvironment()
+    references = ClipReferences(env)
+    command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {options.epochs} --preset {options.preset} "
+               f"--seed {options.seed}")
+    if options.point_agent:
+        command += f" --point-agent {options.point_agent}"
+    results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
+               "command": command,
+               "epochs": options.epochs, "preset": options.preset, "seed": options.seed,
+               "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
+
+    experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
+    for name, (train_clips, test_clips) in experiments.items():
+        session = RealSession(env, references, train_clips, test_clips)
+        report, agent = train_agent(session, name, "wave", options.epochs, options.preset, options.seed, options.runs)
+        methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
+                   "procedural_ik": ProceduralIK(baselines.neutral_pose(train_clips))}
+        sets = {"test": test_clips} if name == "holdout" else {"test": test_clips, "bye": byes}
+        entry = {"train_clips": len(train_clips), "episodes": report["episodes"],
+                 "train_seconds": report["train_seconds"], "seen": _summary(report["training"])}
+        if name == "holdout":
+            entry["held_out_styles"] = list(HOLDOUT_STYLES)
+        for set_name, clips in sets.items():
+            entry[set_name] = compare(methods, clips, env, references)
+        results[name] = entry
+        if name == "wave":
+            chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
+            generated = baselines.generate_for(methods["rlanimate"], chosen)
+            frames_figure(env, [(f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
+                                for c, g in zip(chosen, generated)], Path(options.results) / "realmocap_frames.png")
+
+    try:
+        point_method, point_clips = point_agent_and_library(options.point_agent, options.runs, options.epochs,
+                                                            options.seed)
+    except RLAnimateError as error:  # no pointing agent and no sample library to train one on
+        results["guide"] = {"skipped": str(error)}
+        return results
+    guide_methods = {"rlanimate": point_method, "nearest_clip": baselines.NearestClip(point_clips),
+                     "procedural_ik": ProceduralIK(baselines.neutral_pose(point_clips))}
+    agent_path = point_method.path.resolve()
+    results["guide"] = {"point_agent": str(shown(agent_path)),
+                        **{name: guide_angles(method, guides, env) for name, method in guide_methods.items()}}
+    return results
+
+
+def _method_rows(comparison):
+    return {method: _summary(result) for method, result in comparison.items()}
+
+
+def baseline_sets(results):
+    """The real-data section of baselines.json: {set: {method: {score, smoothness, clips}}}."""
+    sets = {"waves, takes 009-010 (28)": _method_rows(results["wave"]["test"]),
+            "goodbye waves, dataset 1 (14)": _method_rows(results["wave"]["bye"]),
+            f"waves, unseen styles {' + '.join(HOLDOUT_STYLES)} (40)": _method_rows(results["holdout"]["test"])}
+    if "skipped" in results["guide"]:
+        return sets
+    sets["guide clips as pointing (14)"] = {
+        method: {"forearm_angle_deg": entry["mean_forearm_angle_deg"]}
+        for method, entry in results["guide"].items() if isinstance(entry, dict)}
+    return sets
+
+

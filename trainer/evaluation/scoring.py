@@ -1,0 +1,85 @@
+"""Evaluation as in the paper's Section 4: score and smoothness of deterministic rollouts.
+
+For each clip the agent is rolled out deterministically on the clip's objectives, its actions are
+played through the bpy FK environment (all clips in one batch), and the 10 description joints are
+compared with the FK of the clip's own motion: `metrics.score(generated, reference)` and
+`metrics.smoothness(generated)`. A clip set's figures are the means over its clips.
+"""
+import numpy as np
+
+from rlanimate_addon.core import metrics, spaces
+
+from trainer.agent.algorithm import clip_objective, rollout_actions
+
+SEEN_CLIP_COUNT = 10
+
+
+def select_clips(clips, behaviour, count=None):
+    """The clips of `behaviour` ('point', 'wave' or 'both'); with `count`, that many spread evenly
+    over them (the paper's 10 training clips), balanced between behaviours for 'both'."""
+    wanted = ("POINT", "WAVE") if behaviour == "both" else (behaviour.upper(),)
+    groups = [[c for c in clips if c.behaviour.upper() == name] for name in wanted]
+    if count is None:
+        return [c for group in groups for c in group]
+    chosen = []
+    for k, group in enumerate(groups):
+        share = count // len(groups) + (1 if k < count % len(groups) else 0)
+        picks = np.unique(np.linspace(0, len(group) - 1, min(share, len(group))).round().astype(int))
+        chosen += [group[i] for i in picks]
+    return chosen
+
+
+def generate_positions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUNDS):
+    """Deterministic rollouts for a list of (N_i, 7) objectives -> list of (N_i, 10, 3) joint positions."""
+    actions = [rollout_actions(agent, objective, deterministic=True) for objective in objectives]
+    rotvecs = spaces.decode_action(np.concatenate(actions), bounds)  # (sum N, 15, 3)
+    positions = np.asarray(env.evaluate(rotvecs).joint_positions)  # (sum N, 10, 3)
+    return np.split(positions, np.cumsum([len(a) for a in actions])[:-1])
+
+
+def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS):
+    """{'score', 'smoothness', 'by_behaviour': {behaviour: {score, smoothness}},
+    'clips': [{name, behaviour, score, smoothness}]}: means over `clips`, per behaviour, and per clip."""
+    agent.eval()
+    generated = generate_positions(agent, env, [clip_objective(clip) for clip in clips], bounds)
+    rows = []
+    for clip, positions in zip(clips, generated):
+        _, reference = references.get(clip)
+        rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
+                     "score": float(metrics.score(positions, reference)),
+                     "smoothness": float(metrics.smoothness(positions))})
+    by_behaviour = {}
+    for behaviour in sorted({r["behaviour"] for r in rows}):
+        group = [r for r in rows if r["behaviour"] == behaviour]
+        by_behaviour[behaviour] = {"score": float(np.mean([r["score"] for r in group])),
+                                   "smoothness": float(np.mean([r["smoothness"] for r in group]))}
+    return {"score": float(np.mean([r["score"] for r in rows])),
+            "smoothness": float(np.mean([r["smoothness"] for r in rows])),
+            "by_behaviour": by_behaviour, "clips": rows}
+
+
+def evaluate_seen_unseen(trainer, session):
+    """Held-out (unseen) and SEEN_CLIP_COUNT training (seen) clips of the trainer's behaviour(s)."""
+    unseen = select_clips(session.test_clips, trainer.behaviour)
+    seen = select_clips(session.train_clips, trainer.behaviour, SEEN_CLIP_COUNT)
+    return {"unseen": evaluate_clips(trainer.agent, session.env, unseen, session.references, trainer.bounds),
+            "seen": evaluate_clips(trainer.agent, session.env, seen, session.references, trainer.bounds)}
+
+
+def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.DEFAULT_ACTION_BOUNDS):
+    """Section 4.4: mean smoothness of each clip's gesture time-scaled to `scale` x the average
+    length of its behaviour's training clips -> {behaviour: {scale: smoothness}} for each scale."""
+    agent.eval()
+    average = {}
+    for clip in training_clips:
+        average.setdefault(clip.behaviour.lower(), []).append(len(clip.rotvecs))
+    result = {}
+    for behaviour in sorted({c.behaviour.lower() for c in clips}):
+        group = [c for c in clips if c.behaviour.lower() == behaviour]
+        mean_length = float(np.mean(average[behaviour]))
+        result[behaviour] = {}
+        for scale in scales:
+            frames = max(2, int(round(scale * mean_length)))
+            generated = generate_positions(agent, env, [clip_objective(c, frames) for c in group], bounds)
+            result[behaviour][f"{scale:g}"] = float(np.mean([metrics.smoothness(p) for p in generated]))
+    return result

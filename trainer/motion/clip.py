@@ -1,0 +1,44 @@
+"""The motion-clip type: one clip on the canonical rig with its declared labels, and a labelled clip set."""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class MotionClip:
+    """One imported clip on the canonical rig, with its labels when a manifest gives them."""
+    name: str
+    source: str
+    fps: float
+    rotvecs: np.ndarray  # (F, 15, 3) local rotation vectors of skeleton.ACTION_JOINTS
+    fingers: dict = field(default_factory=dict)  # {canonical finger bone: (F, 3)}; empty without fingers
+    behaviour: str = None  # "POINT" or "WAVE"
+    arm: str = None  # "LEFT" or "RIGHT"
+    attributes: object = None  # POINT: unit vector (3,) from the arm's shoulder; WAVE: exaggeration
+    target: tuple = None
+    exaggeration: float = None
+    split: str = None  # "train" or "test"
+    label: object = None  # autolabel's WaveLabel or PointLabel, when labelled from the motion
+    content: str = None  # real mocap: what the take shows ("wave", "bye", "guide")
+    style: str = None  # real mocap: the actor's style ("normal", "elderly", ...)
+    take: str = None  # real mocap: the take number ("001")
+    named_arm: str = None  # real mocap: the arm the file name gives ("LEFT", "RIGHT" or None)
+
+    @property
+    def frames(self):
+        return len(self.rotvecs)
+
+
+@dataclass
+class ClipSet:
+    """Labelled clips of a manifest, and the problems of the files that could not be used."""
+    clips: list
+    problems: list
+
+    @property
+    def train(self):
+        return [c for c in self.clips if c.split == "train"]
+
+    @property
+    def test(self):
+        return [c for c in self.clips if c.split == "test"]

@@ -1,0 +1,72 @@
+"""The Bandai Namco real motion capture as data: file names, styles and takes, splits, and the relaxed hand
+put on a capture without fingers (numpy; the clips are read in place from ../shared/realmocap/, CC BY-NC)."""
+import re
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from rlanimate_addon.core import skeleton
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.paths import REALMOCAP_DIR
+
+STYLES = ("active", "elderly", "exhausted", "feminine", "masculine", "normal", "youthful")
+TRAIN_TAKES = tuple(f"{k:03d}" for k in range(1, 9))
+TEST_TAKES = ("009", "010")
+#: Styles the hold-out agent never sees: the two whose labels fall between the trained ones
+#: (exaggeration ~0.3 and ~0.55 against 0.1 feminine and 0.75-1 for the rest), as the paper's unseen
+#: waves are exaggerations between the training ones.
+HOLDOUT_STYLES = ("elderly", "exhausted")
+#: Relaxed open hand for a capture without fingers: {finger bone: local rotation vector (rad)}.
+#: Fingers curl about their local X axis (negative: towards the palm), a little more towards the
+#: pinky; the thumb rests slightly in. Index1 is an action joint; the rest only show in pictures.
+RELAXED_HAND = {"Index": -0.12, "Middle": -0.18, "Ring": -0.24, "Pinky": -0.3}
+RELAXED_THUMB = (0.0, 0.0, 0.15)
+
+_NAME = re.compile(r"dataset-(?P<dataset>\d)_(?P<content>[a-z]+)(?:-(?P<side>left|right)-hand)?"
+                   r"_(?P<style>[a-z-]+)_(?P<take>\d{3})$")
+
+
+def require_realmocap(root=REALMOCAP_DIR):
+    """The real-mocap folder, or RLAnimateError saying where it is expected."""
+    root = Path(root)
+    if not (root / "wave").is_dir():
+        raise RLAnimateError(f"The real motion capture is not at {root}: put the Bandai Namco clips "
+                             "(wave/, bye/, guide/) there, as ../shared/realmocap/README.md describes.")
+    return root
+
+
+def parse_name(path):
+    """{'content', 'arm' (LEFT/RIGHT or None), 'style', 'take'} of a real-mocap file name."""
+    match = _NAME.match(Path(path).stem)
+    if match is None:
+        raise RLAnimateError(f"{path}: not a Bandai Namco file name (dataset-N_content_style_take.bvh).")
+    side = match["side"]
+    return {"content": match["content"], "arm": side.upper() if side else None,
+            "style": match["style"], "take": match["take"]}
+
+
+def relaxed_hand(clip):
+    """`clip` with a relaxed open hand on both sides: Index1 in its rotvecs, the other fingers in .fingers."""
+    rotvecs = np.array(clip.rotvecs, dtype=np.float64)
+    frames = len(rotvecs)
+    fingers = dict(clip.fingers)
+    for side in ("Left", "Right"):
+        rotvecs[:, skeleton.ACTION_JOINTS.index(side + "HandIndex1")] = (RELAXED_HAND["Index"], 0.0, 0.0)
+        for finger, curl in RELAXED_HAND.items():
+            for k in (1, 2, 3):
+                name = f"{side}Hand{finger}{k}"
+                if name not in skeleton.ACTION_JOINTS:
+                    fingers[name] = np.tile((curl, 0.0, 0.0), (frames, 1))
+        fingers[f"{side}HandThumb1"] = np.tile(RELAXED_THUMB, (frames, 1))
+    return replace(clip, rotvecs=rotvecs, fingers=fingers)
+
+
+def wave_split(clips):
+    """(train, test): takes 001-008 and 009-010 of the one-arm waves."""
+    return [c for c in clips if c.take in TRAIN_TAKES], [c for c in clips if c.take in TEST_TAKES]
+
+
+def style_holdout_split(clips, held_out=HOLDOUT_STYLES):
+    """(train, test): every take of the other styles, and of the held-out ones."""
+    return [c for c in clips if c.style not in held_out], [c for c in clips if c.style in held_out]

@@ -1,0 +1,1 @@
+"""Figures and tables from results: training curves, Figure 3, contact sheets, markdown tables."""

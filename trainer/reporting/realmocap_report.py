@@ -1,0 +1,88 @@
+"""The real-mocap results as a page (docs/results/realmocap.md) and a figure of real and generated frames."""
+import matplotlib
+
+from rlanimate_addon.core import skeleton
+from trainer.evaluation.baselines import METHOD_LABELS
+from trainer.motion.realmocap_takes import HOLDOUT_STYLES
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
+    """Front views of real (grey) and generated (red) frames side by side; one row per (title, real
+    (F, 15, 3), generated (F, 15, 3)) in `rows`, one column per fraction of the clip in `times`."""
+    names = env.bone_names
+    links = [(names.index(b.name), names.index(b.parent)) for b in skeleton.BONES
+             if b.parent and b.name in names and b.parent in names
+             and not any(part in b.name for part in ("Eye", "Thumb", "Middle", "Ring", "Pinky", "Toe", "_End"))]
+    figure, axes = plt.subplots(len(rows), len(times), figsize=(2.2 * len(times), 2.6 * len(rows)), squeeze=False)
+    for r, (title, real, generated) in enumerate(rows):
+        heads = {"real": env.evaluate(real).bone_heads, "generated": env.evaluate(generated).bone_heads}
+        for c, fraction in enumerate(times):
+            ax = axes[r, c]
+            frame = int(round(fraction * (len(real) - 1)))
+            for key, offset, colour in (("real", -0.45, "0.35"), ("generated", 0.45, "tab:red")):
+                # The character faces -Y: seen from the front, its left (+X) is on the viewer's right.
+                points = heads[key][frame]
+                for child, parent in links:
+                    ax.plot([points[child, 0] + offset, points[parent, 0] + offset],
+                            [points[child, 2], points[parent, 2]], color=colour, lw=1.5)
+            ax.set_xlim(-1.4, 1.4)
+            ax.set_ylim(0.0, 2.4)
+            ax.set_aspect("equal")
+            ax.set_xticks([])
+            ax.set_yticks([])
+            if r == 0:
+                ax.set_title(f"t = {fraction:.2f} N", fontsize=8)
+            if c == 0:
+                ax.set_ylabel(title, fontsize=7)
+    figure.suptitle("Real capture, retargeted (grey, left) and RLAnimate (red, right), front view", fontsize=9)
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def realmocap_markdown(results):
+    lines = ["# Learning from real motion capture", "",
+             f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), retargeted onto the "
+             f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
+             f"Preset `{results['preset']}`, {results['epochs']} epochs, seed {results['seed']}. "
+             f"Regenerate: `{results['command']}`.", "",
+             "## Auto-labels per style (one-arm waves, 20 clips each)", "",
+             "| style | exaggeration (mean ± sd) | elevation (deg) | stroke (arm lengths) | arm detected |",
+             "|---|---|---|---|---|"]
+    for style, row in results["labels"]["wave"].items():
+        lines.append(f"| {style} | {row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f} | {row['elevation_deg']:.0f} | "
+                     f"{row['stroke_arm_lengths']:.2f} | {row['arm_correct']}/{row['clips']} |")
+    bye = results["labels"]["bye"].items()
+    lines += ["", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), ""]
+    lines += ["## Score and smoothness", "",
+              "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
+              "| experiment | test set | method | score | smoothness | label error |", "|---|---|---|---|---|---|"]
+    for name, label in (("wave", "wave agent, takes 001-008 (112 clips)"),
+                        ("holdout", f"wave agent, 5 styles (100 clips; unseen: {', '.join(HOLDOUT_STYLES)})")):
+        entry = results[name]
+        for set_name in ("test", "bye"):
+            for method, result in entry.get(set_name, {}).items():
+                lines.append(f"| {label} | {set_name} ({len(result['clips'])}) | {METHOD_LABELS[method]} | "
+                             f"{result['score']:.2f} | {result['smoothness']:.2f} | {result['label_error']:.3f} |")
+        lines.append(f"| {label} | seen (10 training clips) | RLAnimate | {entry['seen']['score']:.2f} | "
+                     f"{entry['seen']['smoothness']:.2f} | |")
+    lines += ["", f"Training: wave agent {results['wave']['episodes']} episodes, {results['wave']['train_seconds']:.0f} s; "
+              f"hold-out agent {results['holdout']['episodes']} episodes, {results['holdout']['train_seconds']:.0f} s "
+              "(1 torch thread).", "",
+              "## Guide clips as pointing", ""]
+    if "skipped" in results["guide"]:
+        return "\n".join(lines + [f"Not run: {results['guide']['skipped']}", "",
+                                   "![real and generated frames](realmocap_frames.png)", ""])
+    lines += [f"Pointing agent `{results['guide']['point_agent']}`, given the direction in which the actor held the arm "
+              "(rest shoulder to the index base at the hold). Angle between the generated and the real forearm "
+              "(elbow to wrist), each at its own hold:", "",
+              "| method | mean (deg) | median (deg) |", "|---|---|---|"]
+    for method, entry in results["guide"].items():
+        if isinstance(entry, dict):
+            lines.append(f"| {METHOD_LABELS[method]} | {entry['mean_forearm_angle_deg']:.1f} | "
+                         f"{entry['median_forearm_angle_deg']:.1f} |")
+    lines += ["", "![real and generated frames](realmocap_frames.png)", ""]
+    return "\n".join(lines)

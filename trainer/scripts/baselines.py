@@ -1,0 +1,70 @@
+"""Score RLAnimate and the baselines on the sample library's held-out clips: the sample-library section of
+docs/results/baselines.json and .md.
+
+    nice -n 10 python -m trainer.scripts.baselines [--agent PATH] [--clips MANIFEST] [--results DIR]
+"""
+import argparse
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from trainer.agent.algorithm import ClipReferences
+from trainer.blender_io.clip_session import LibrarySession
+from trainer.blender_io.procedural_ik import ProceduralIK
+from trainer.blender_io.rig_session import new_empty_scene
+from trainer.evaluation.baselines import (AgentMethod, NearestClip, evaluate_motions, generate_for, neutral_pose,
+                                          write_results)
+from trainer.evaluation.scoring import select_clips
+from trainer.motion import autolabel
+from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
+from trainer.scripts.cli import run_main, script_args
+
+
+def sample_library_comparison(agent_path, manifest):
+    """{set: {method: {score, smoothness[, label_error]}}} on the sample library's held-out clips, per
+    behaviour; for waves the label error compares the auto-labels of the generated and the real clip
+    (the library's own exaggeration scale is the generator's, not autolabel's)."""
+    session = LibrarySession(manifest)
+    train_clips = session.train_clips
+    methods = {"rlanimate": AgentMethod(agent_path), "nearest_clip": NearestClip(train_clips),
+               "procedural_ik": ProceduralIK(neutral_pose(train_clips))}
+    references = ClipReferences(session.env)
+    sets = {}
+    for behaviour in ("point", "wave"):
+        clips = select_clips(session.test_clips, behaviour)
+        rows = {}
+        for name, method in methods.items():
+            motions = generate_for(method, clips)
+            result = evaluate_motions(session.env, motions, clips, references)
+            rows[name] = {key: result[key] for key in ("score", "smoothness")}
+            if behaviour == "wave":
+                rows[name]["label_error"] = float(np.mean([
+                    abs(autolabel.label_wave(m).exaggeration - autolabel.label_wave(c.rotvecs).exaggeration)
+                    for m, c in zip(motions, clips)]))
+        sets[f"{behaviour}, held-out clips ({len(clips)})"] = rows
+    return sets, methods["rlanimate"].agent.metadata.get("training", {})
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.baselines", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--agent", default=str(INSTALLED_AGENT), help="exported RLAnimate agent (.npz)")
+    parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
+    parser.add_argument("--results", default=str(RESULTS_DIR))
+    options = parser.parse_args(script_args(argv))
+    torch.set_num_threads(1)
+    new_empty_scene()
+    sets, training = sample_library_comparison(options.agent, options.clips)
+    agent = shown(options.agent)
+    provenance = "untrained" if training.get("untrained") else ", ".join(
+        f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
+    write_results(options.results, "sample library",
+                  f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
+                  f"RLAnimate: `{agent}` ({provenance}). "
+                  f"Regenerate: `nice -n 10 python -m trainer.scripts.baselines --agent {agent}`.", sets)
+    print((Path(options.results) / "baselines.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))

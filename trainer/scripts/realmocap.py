@@ -1,0 +1,46 @@
+"""Train on real motion capture and compare with the baselines: docs/results/realmocap.json and .md, the
+real-data section of docs/results/baselines.json and .md, docs/results/realmocap_frames.png.
+
+    nice -n 15 python -m trainer.scripts.realmocap [--epochs 50] [--point-agent PATH]   (finished runs are reused)
+"""
+import argparse
+import json
+from pathlib import Path
+
+from trainer.evaluation.baselines import write_results
+from trainer.evaluation.realmocap import baseline_sets, run_experiments
+from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
+from trainer.reporting.realmocap_report import realmocap_markdown
+from trainer.scripts.cli import run_main, script_args
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.realmocap", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--realmocap", default=str(REALMOCAP_DIR))
+    parser.add_argument("--epochs", type=int, default=50, help="iterations of Algorithm 1 per agent (paper: 50)")
+    parser.add_argument("--preset", default="default")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--point-agent", default=None,
+                        help="exported pointing agent (.npz) for the guide clips (default: the installed "
+                             "agent when trained, else one trained here on the sample library)")
+    parser.add_argument("--runs", default=str(REALMOCAP_RUNS))
+    parser.add_argument("--results", default=str(RESULTS_DIR))
+    return parser
+
+
+def main(argv=None):
+    options = build_parser().parse_args(script_args(argv))
+    results = run_experiments(options)
+    out = Path(options.results)
+    (out / "realmocap.json").write_text(json.dumps(results, indent=2) + "\n")
+    (out / "realmocap.md").write_text(realmocap_markdown(results))
+    write_results(out, "real motion capture",
+                  "Agents trained on the real waves (takes 001-008, or 5 styles); pointing agent from "
+                  f"the sample library for the guide clips. Regenerate: `{results['command']}`.",
+                  baseline_sets(results))
+    print(realmocap_markdown(results))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))

@@ -1,0 +1,78 @@
+"""Train an RLAnimate agent (Algorithm 1) and write the agent, its report and plots.
+
+    python -m trainer.scripts.train [ARGS]        (or python trainer/train.py [ARGS])
+    blender -b -P trainer/train.py -- [ARGS]      (Blender's Python finds torch through a venv of
+                                                   the same minor version on PYTHONPATH; see README)
+
+With no arguments it trains the both-behaviour RLAnimate agent on the sample clip library into
+runs/default/. `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
+report to docs/results/. Outputs: see trainer/agent/run.py. `--resume` continues the run in --output
+from its checkpoint with the run's own settings; the continuation equals the uninterrupted run.
+"""
+import argparse
+from pathlib import Path
+
+from trainer.agent.algorithm import BEHAVIOUR_CHOICES
+from trainer.agent.models import VARIANTS
+from trainer.agent.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
+from trainer.blender_io.clip_session import LibrarySession
+from trainer.files import atomic_copy
+from trainer.paths import DEFAULT_MANIFEST, DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR
+from trainer.scripts.cli import run_main, script_args
+
+
+def build_parser():
+    """The command line. Run settings default to None ("not given"): a new run takes NEW_RUN_DEFAULTS, a
+    resumed run its checkpoint's values."""
+    defaults = NEW_RUN_DEFAULTS
+    parser = argparse.ArgumentParser(prog="trainer/train.py", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--behaviour", choices=BEHAVIOUR_CHOICES, help=f"default {defaults['behaviour']}")
+    parser.add_argument("--clips", help=f"clip library: a manifest.json or the folder that holds one "
+                                        f"(default {DEFAULT_MANIFEST.parent.parent.name}/{DEFAULT_MANIFEST.parent.name})")
+    parser.add_argument("--epochs", type=int,
+                        help="iterations of Algorithm 1 (default: the preset's, the paper's 50 for one behaviour "
+                             "and 100 for both; on --resume, the run's own)")
+    parser.add_argument("--seed", type=int, help=f"default {defaults['seed']}")
+    parser.add_argument("--output", default=str(DEFAULT_OUTPUT))
+    parser.add_argument("--preset", help="config preset: debug, default or paper (default default)")
+    parser.add_argument("--variant", choices=VARIANTS, help="ablation variant (Table 4; default rlanimate)")
+    parser.add_argument("--resume", action="store_true",
+                        help="continue the run in --output from its checkpoint, with the run's own settings")
+    parser.add_argument("--install", action="store_true",
+                        help="install the agent as the add-on's default and its report into docs/results/")
+    parser.add_argument("--eval-every", type=int,
+                        help=f"evaluate on seen and unseen clips every N epochs (0: only at the end; default "
+                             f"{defaults['eval_every']})")
+    parser.add_argument("--checkpoint-every", type=int, default=1)
+    parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    return parser
+
+
+def run_settings(args):
+    """RunSettings from parsed arguments."""
+    return RunSettings(output=args.output, behaviour=args.behaviour, clips=args.clips, epochs=args.epochs,
+                       seed=args.seed, preset=args.preset, variant=args.variant, eval_every=args.eval_every,
+                       resume=args.resume, checkpoint_every=args.checkpoint_every, progress=not args.quiet)
+
+
+def install(output):
+    """Copy a run's agent into the add-on (atomically) and its report and curves into docs/results/."""
+    atomic_copy(output / "agent.npz", INSTALLED_AGENT)
+    for source, target in (("report.json", "default_agent.json"), ("report.md", "default_agent.md"),
+                           ("training_curves.png", "default_agent_curves.png")):
+        atomic_copy(output / source, RESULTS_DIR / target)
+
+
+def main(argv=None):
+    args = build_parser().parse_args(script_args(argv))
+    settings = resolve(run_settings(args))
+    report, _ = train(settings, LibrarySession(settings.clips))
+    if args.install:
+        install(Path(settings.output))
+    print(f"held-out score {report['held_out']['score']:.2f}, smoothness {report['held_out']['smoothness']:.2f}; "
+          f"outputs in {args.output}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))
