@@ -51,7 +51,7 @@ def main():
     parser.add_argument("--agent", default=str(ROOT / "rlanimate_addon" / "agents" / "default.npz"))
     args = parser.parse_args()
     agent = runtime.load_agent(args.agent)
-    rest_heads = gesture.canonical_rig_pose().rest_heads
+    rest_heads = gesture.canonical_rig().rest_heads
     rng = np.random.default_rng(args.seed)
     rows = []  # (raw angle, aimed angle, raw smoothness, aimed smoothness)
     for k in range(args.targets):

@@ -1,56 +1,87 @@
-"""Reading a rig, its pose and a target out of Blender, and writing a gesture's keys back in.
+"""Reading a rig, its animation and a target out of Blender, and writing a gesture's keys back in.
 
-Bones are matched by their Mixamo name with any `prefix:` stripped, so 'mixamorig:LeftArm',
-'mixamorig1:LeftArm' and 'LeftArm' all serve as LeftArm. Positions are in the rig's armature space,
-in the rig's own units; the bpy-free gesture code only uses directions and rotations from them.
+Bones are matched to roles by core.rig_roles (Mixamo names with any prefix, Rigify, Unreal, Auto-Rig
+Pro, VRoid/VRM, Character Creator, Blender's metarig) or by a bone-map file. Positions are in the
+rig's armature space, in the rig's own units; the bpy-free gesture code only uses directions and
+rotations from them.
 """
+from pathlib import Path
+
 import bpy
 import numpy as np
 
-from ..core import skeleton
+from ..core import rig_roles
 from ..core.errors import RLAnimateError
-from ..core.gesture import RigPose
+from ..core.gesture import RigState
+from ..core.rig import RigSkeleton
 from . import action_adapter
 
-
-def rig_bone_names(obj):
-    """Mapping canonical bone name -> the rig's bone name (the first one, if several prefixes match)."""
-    names = {}
-    for bone in obj.data.bones:
-        names.setdefault(skeleton.strip_prefix(bone.name), bone.name)
-    return names
+#: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
+ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
 
 
-def check_rig(obj):
-    """The rig's bone-name map; RLAnimateError when obj is not an armature with every required bone."""
+def rotation_path(mode):
+    return ROTATION_PATHS.get(mode, "rotation_euler")
+
+
+def rig_roles_of(obj, bone_map_path=""):
+    """(family name, {role: bone name}) of an armature: from the bone-map file when one is given,
+    else detected from its bone names. RLAnimateError when obj is not an armature."""
     if obj is None or obj.type != "ARMATURE":
         raise RLAnimateError("The active object is not an armature: select the character's armature.")
-    names = rig_bone_names(obj)
-    missing = sorted(set(skeleton.REQUIRED_BONES) - set(names))
-    if missing:
-        raise RLAnimateError(f"Armature {obj.name!r} lacks the bones {', '.join(missing)}: "
-                             "use a rig with Mixamo bone names.")
-    return names
+    names = [bone.name for bone in obj.data.bones]
+    if bone_map_path:
+        path = Path(bpy.path.abspath(bone_map_path))
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError as error:
+            raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({error.strerror}): pick an "
+                                 "existing file, or clear the Bone Map field to detect the bones.") from None
+        return rig_roles.read_bone_map(text, names)
+    family, roles = rig_roles.detect(names)
+    return family.name, roles
 
 
-def check_quaternion_bones(obj, bone_names):
-    """RLAnimateError naming the bones that would ignore quaternion keys (Euler or axis-angle mode)."""
-    others = [name for name in bone_names if obj.pose.bones[name].rotation_mode != "QUATERNION"]
-    if others:
-        raise RLAnimateError(f"Bones {', '.join(others)} do not use quaternion rotation: set their "
-                             "Rotation Mode to Quaternion (WXYZ) in the Bone properties.")
+def read_skeleton(obj):
+    """The armature's bones as a RigSkeleton (rest matrices in armature space, its units)."""
+    bones = obj.data.bones
+    return RigSkeleton([b.name for b in bones], [b.parent.name if b.parent else None for b in bones],
+                       np.array([b.matrix_local for b in bones], dtype=np.float64),
+                       [b.length for b in bones])
 
 
-def read_rig_pose(obj, names):
-    """RigPose of the rig as it is posed now (evaluate the start frame first when it is animated)."""
-    heads, frames, starts = {}, {}, {}
-    for canonical, name in names.items():
-        bone = obj.data.bones[name]
-        heads[canonical] = np.array(bone.head_local, dtype=np.float64)
-        rotation = np.array(bone.matrix_local, dtype=np.float64)[:3, :3]
-        frames[canonical] = rotation / np.linalg.norm(rotation, axis=0, keepdims=True)
-        starts[canonical] = np.array(obj.pose.bones[name].matrix_basis.to_quaternion(), dtype=np.float64)
-    return RigPose(heads, frames, starts)
+def _rotation_values(pose_bone):
+    return tuple(getattr(pose_bone, rotation_path(pose_bone.rotation_mode)))
+
+
+def sample_rig(context, obj, roles, family, frames, target=None, target_bone=""):
+    """(RigState, {bone: (N, C) rotation channel values underneath}, targets (N, 3)).
+
+    An animated rig is read at every frame (scene.frame_set), as its action, NLA and drivers play it;
+    a still one once. The target (an object, a bone of an armature when target_bone names one, or the
+    3D cursor when target is None) is read in the rig's armature space at each frame where anything
+    can move it. The caller restores the scene's frame.
+    """
+    scene = context.scene
+    animated = action_adapter.is_animated(obj)
+    target_moves = target is not None and (may_move(target) or (target_bone and action_adapter.is_animated(target)))
+    moving = animated or may_move(obj) or target_moves
+    skeleton = read_skeleton(obj)
+    pose_bones = [obj.pose.bones[name] for name in skeleton.names]
+    role_bones = sorted(set(roles.values()))
+    under, values, targets = [], {b: [] for b in role_bones}, []
+    for frame in (frames if moving else frames[:1]):
+        if moving:
+            scene.frame_set(int(frame))
+        under.append(np.array([pb.matrix_basis for pb in pose_bones], dtype=np.float64))
+        for bone in role_bones:
+            values[bone].append(_rotation_values(obj.pose.bones[bone]))
+        targets.append(_to_armature(obj, _world_point(target, target_bone, scene)))
+    count = len(frames)
+    under = np.broadcast_to(np.array(under), (count,) + np.shape(under)[1:])
+    values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
+    rig = RigState(obj.name, skeleton, roles, family, under, animated)
+    return rig, values, np.broadcast_to(np.array(targets), (count, 3))
 
 
 def may_move(obj):
@@ -71,47 +102,38 @@ def may_move(obj):
     return any(not fcurve.data_path.startswith("pose.") for t in targets for fcurve in t.fcurves())
 
 
-def _world_point(target, scene):
-    """World position (3,) of the target object, or of the 3D cursor when target is None."""
-    location = scene.cursor.location if target is None else target.matrix_world.translation
-    return np.array(location, dtype=np.float64)
+def _world_point(target, target_bone, scene):
+    """World position (3,) of the target object (or its bone's head), or of the 3D cursor when target is None."""
+    if target is None:
+        return np.array(scene.cursor.location, dtype=np.float64)
+    if target_bone and target.type == "ARMATURE":
+        head = target.pose.bones[target_bone].head
+        return np.array(target.matrix_world @ head, dtype=np.float64)
+    return np.array(target.matrix_world.translation, dtype=np.float64)
 
 
 def _to_armature(obj, point):
     return (np.array(obj.matrix_world.inverted(), dtype=np.float64) @ np.append(point, 1.0))[:3]
 
 
-def target_positions(scene, obj, target, frames):
-    """(N, 3) target positions in the armature's space at each frame (the 3D cursor when target is None).
+def write_gesture(obj, name, start_frame, keys, blend_type="REPLACE"):
+    """Key a gesture from start_frame into a new action called `name`; returns the new action.
 
-    A target or armature that can move is read at every frame with scene.frame_set; a still one once.
-    The caller restores the scene's frame.
-    """
-    if (target is not None and may_move(target)) or may_move(obj):
-        points = []
-        for frame in frames:
-            scene.frame_set(int(frame))
-            points.append(_to_armature(obj, _world_point(target, scene)))
-        return np.array(points)
-    return np.tile(_to_armature(obj, _world_point(target, scene)), (len(frames), 1))
-
-
-def write_gesture(obj, name, bone_names, start_frame, quats):
-    """Key the (N, B, 4) local quaternions of bone_names from start_frame into a new action called `name`.
-
-    On a rig with no animation the action becomes the active action. Otherwise the active action
-    (if any) is pushed down to the NLA, as Blender's Push Down does, and the gesture goes on a new
-    NLA track above it, with no effect outside its frames. Returns the new action.
+    keys: {bone name: (rotation mode, (N, C) channel values)}. On a rig with no animation the action
+    becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
+    Blender's Push Down does, and the gesture goes on a new NLA track above it with the blend type
+    ('REPLACE' or 'COMBINE') and no effect outside its frames.
     """
     target = action_adapter.new_action(name, obj)
-    frames = start_frame + np.arange(len(quats))
-    for b, bone in enumerate(bone_names):
-        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].rotation_quaternion'
-        for channel in range(4):
-            action_adapter.write_keys(target.new_fcurve(path, channel, bone), frames, quats[:, b, channel])
+    for bone, (mode, values) in keys.items():
+        frames = start_frame + np.arange(len(values))
+        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
+        for channel in range(values.shape[1]):
+            action_adapter.write_keys(target.new_fcurve(path, channel, bone), frames, values[:, channel])
     if action_adapter.is_animated(obj):
         action_adapter.push_down(obj)
-        action_adapter.add_strip(obj, target, start_frame, target.action.name)
+        strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
+        strip.blend_type = blend_type
     else:
         action_adapter.assign(obj, target)
     return target.action

@@ -33,6 +33,8 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             layout.prop(settings, "target")
             if settings.target is None:
                 layout.prop(settings, "use_cursor")
+            elif settings.target.type == "ARMATURE":
+                layout.prop_search(settings, "target_bone", settings.target.data, "bones")
             layout.prop(settings, "exact_aim")
         else:
             layout.prop(settings, "exaggeration", slider=True)
@@ -41,6 +43,11 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
         column.prop(settings, "frame_count")
         column.prop(settings, "start_frame")
         column.prop(settings, "seed")
+
+        layout.prop(settings, "blend_type", expand=True)
+        row = layout.row(align=True)
+        row.prop(settings, "bone_map_file")
+        row.operator("rlanimate.save_bone_map", text="", icon="FILE_TICK")
 
         label, error = _agent_summary(context, settings.behaviour)
         box = layout.box()

@@ -42,10 +42,22 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
         description="Length of the gesture in frames; the agent learned its average from the clips")
     start_frame: bpy.props.IntProperty(
         name="Start Frame", default=1, description="First frame of the gesture")
+    target_bone: bpy.props.StringProperty(
+        name="Target Bone", default="",
+        description="When the target is an armature, point at this bone's head (another character's head)")
     exact_aim: bpy.props.BoolProperty(
         name="Exact Aim", default=True,
         description="Turn the arm so the index finger passes exactly through the target; "
                     "off keys the agent's own aim")
+    blend_type: bpy.props.EnumProperty(
+        name="Layer", default="REPLACE",
+        items=[("REPLACE", "Replace", "Over existing animation, the gesture replaces the bones it drives "
+                                      "(NLA Replace)"),
+               ("COMBINE", "Combine", "Over existing animation, the gesture is added to the bones it drives "
+                                      "(NLA Combine)")])
+    bone_map_file: bpy.props.StringProperty(
+        name="Bone Map", default="", subtype="FILE_PATH",
+        description="A bone-map file (JSON) naming the rig's bone for each role; empty detects the bones")
     seed: bpy.props.IntProperty(
         name="Variation Seed", min=0, default=0,
         description="0 gives the agent's most likely gesture; other values give variations")

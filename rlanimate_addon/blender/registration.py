@@ -1,7 +1,7 @@
 """Registration in one place: the ordered class list and the one Scene property namespace."""
 import bpy
 
-from . import export, generate, panel, preferences, properties
+from . import bone_map, export, generate, panel, preferences, properties
 
 #: Registered in this order, unregistered in reverse (property groups before what points at them).
 CLASSES = (
@@ -9,6 +9,7 @@ CLASSES = (
     properties.RLANIMATE_PG_settings,
     generate.RLANIMATE_OT_generate_gesture,
     export.RLANIMATE_OT_export_fbx,
+    bone_map.RLANIMATE_OT_save_bone_map,
     panel.VIEW3D_PT_rlanimate,
 )
 

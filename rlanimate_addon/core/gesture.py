@@ -1,13 +1,16 @@
 """From a gesture request to per-frame local bone rotations on a user's rig, in plain numpy.
 
-The pipeline Generate Gesture runs, with Blender only at its two ends (reading the rig and the
-target, writing keys):
+The pipeline Generate Gesture runs, with Blender only at its two ends (reading the rig, its animation
+and the target, writing keys):
 
     targets (N, 3) in the rig's armature space --pointing_directions--> objectives (N, 7)
     --agent.rollout--> actions (M, 45) --decode, time_scale--> canonical rotations (N, 15, 3)
-    --aim.aim_at (POINT, exact aim)--> --retarget--> rig quaternions (N, 15, 4) --blend_from_pose--> keys
+    --fold_spine, retarget--> rig quaternions (N, D, 4) --blend with the pose underneath-->
+    --aim_rig (POINT, exact aim)--> keys
 
-A rig may differ from the canonical skeleton in three ways, all handled here:
+A rig may differ from the canonical skeleton in many ways, all handled here:
+  * bone names: core.rig_roles maps roles (canonical names) to its bones; a role it lacks is left
+    out (the other arm, fingers, eyes), or, for the spine, folded into the spine bones it has;
   * scale and units (a Mixamo FBX in centimetres): only directions and rotations are used;
   * the orientation of its armature space (an FBX whose armature space is Y-up): `character_frame`
     finds the rotation from the rig's armature space to the character frame (+X left, -Y forward,
@@ -15,18 +18,23 @@ A rig may differ from the canonical skeleton in three ways, all handled here:
   * its bones' rest frames (rolls, directions): `retarget_matrices` gives C per bone with
     C = F_can^-1 A F_rig (F: armature-space rest rotations, A: armature -> character frame), and
     the rig's local rotation is R_rig = C^-1 R_can C, which gives every bone the same armature-space
-    rotation from rest as on the canonical skeleton.
+    rotation from rest as on the canonical skeleton;
+  * its own animation: the gesture blends in from and out to the pose underneath, frame by frame,
+    and Point's aim is solved on the rig's own bones against that pose (`aim_rig`), so the finger
+    line passes through the target whatever the rig's proportions and whatever moves underneath.
 """
 import numpy as np
 
-from . import aim, skeleton, spaces
+from . import aim, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
-from .rotations import matrix_to_quat, rotvec_to_matrix
+from .rig import RigSkeleton
+from .rotations import matrix_to_quat, matrix_to_rotvec, quat_to_matrix, rotvec_to_matrix
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
 SUPPORTED_LENGTH = (0.4, 1.5)
 #: Fraction of the gesture spent blending in from, and back out to, the rig's pose at the start frame.
 BLEND_FRACTION = 0.2
+
 #: Bones of the pointing hand shape, with their canonical local rotation vectors (radians): the
 #: thumb tucked and the three other fingers curled towards the palm (negative about the local X
 #: axis curls a finger of either hand towards the palm of the T-pose).
@@ -44,7 +52,7 @@ def supported_length_range(average_frames):
     return max(2, int(round(low * average_frames))), max(2, int(round(high * average_frames)))
 
 
-#: Rest joints that fix a rig's orientation: the torso and the shoulders (present on every Mixamo rig).
+#: Rest joints that fix a rig's orientation: the torso and the shoulders (those the rig has).
 _ORIENTATION_BONES = ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
                       "LeftShoulder", "RightShoulder", "LeftArm", "RightArm")
 
@@ -52,12 +60,13 @@ _ORIENTATION_BONES = ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
 def character_frame(rest_heads):
     """(3, 3) rotation A taking vectors in a rig's armature space to the character frame.
 
-    rest_heads: mapping of canonical bone name -> rest head (3,) in the rig's armature space. A is
-    the rotation that best lays the rig's torso and shoulder joints onto the canonical ones (Kabsch),
-    so it ignores the rig's units and proportions; the character frame has +X left, -Y forward, +Z up.
+    rest_heads: mapping of role -> rest head (3,) in the rig's armature space. A is the rotation that
+    best lays the rig's torso and shoulder joints onto the canonical ones (Kabsch), so it ignores the
+    rig's units and proportions; the character frame has +X left, -Y forward, +Z up.
     """
-    rig = np.array([rest_heads[name] for name in _ORIENTATION_BONES], dtype=np.float64)  # (J, 3)
-    canonical = np.array([skeleton.BONE_BY_NAME[name].head for name in _ORIENTATION_BONES])
+    names = [name for name in _ORIENTATION_BONES if name in rest_heads]
+    rig = np.array([rest_heads[name] for name in names], dtype=np.float64)  # (J, 3)
+    canonical = np.array([skeleton.BONE_BY_NAME[name].head for name in names])
     rig, canonical = rig - rig.mean(axis=0), canonical - canonical.mean(axis=0)
     u, _, vt = np.linalg.svd(canonical.T @ rig)
     sign = np.sign(np.linalg.det(u @ vt))
@@ -72,24 +81,10 @@ def pointing_directions(arm, targets, rest_heads):
     shoulder = np.asarray(rest_heads[skeleton.ARM_PREFIX[arm] + "Arm"], dtype=np.float64)
     offsets = np.atleast_2d(np.asarray(targets, dtype=np.float64)) - shoulder  # (N, 3)
     norms = np.linalg.norm(offsets, axis=1)
-    scale = np.linalg.norm(np.subtract(rest_heads["Head"], rest_heads["Hips"]))
+    scale = np.linalg.norm(np.subtract(rest_heads["Head"], shoulder))
     if not np.all(np.isfinite(norms)) or np.any(norms < 1e-3 * scale):
         raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
     return (offsets / norms[:, None]) @ character_frame(rest_heads).T
-
-
-def canonical_targets(arm, targets, rest_heads):
-    """(N, 3) targets placed on the canonical skeleton as they sit relative to the rig.
-
-    The direction from the rig's rest shoulder is kept (`pointing_directions`), and the distance is
-    scaled by the canonical over the rig's Hips-to-Head length, so units and proportions drop out.
-    """
-    shoulder = np.asarray(rest_heads[skeleton.ARM_PREFIX[arm] + "Arm"], dtype=np.float64)
-    distances = np.linalg.norm(np.atleast_2d(np.asarray(targets, dtype=np.float64)) - shoulder, axis=1)
-    head, hips = skeleton.BONE_BY_NAME["Head"].head, skeleton.BONE_BY_NAME["Hips"].head
-    scale = np.linalg.norm(np.subtract(head, hips)) / np.linalg.norm(np.subtract(rest_heads["Head"], rest_heads["Hips"]))
-    directions = pointing_directions(arm, targets, rest_heads)  # (N, 3)
-    return skeleton.shoulder_rest_position(arm) + directions * (distances * scale)[:, None]
 
 
 def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5):
@@ -164,8 +159,32 @@ def retarget(canonical_rotvecs, conversions):
     return matrix_to_quat(np.swapaxes(conversions, -1, -2) @ rotations @ conversions)
 
 
+def fold_spine(rotvecs, joints, present):
+    """Canonical rotations (N, J, 3) of `joints` with each spine joint the rig lacks folded into one it has.
+
+    A missing spine joint goes to the nearest present one below it (above it when none is below); a
+    present joint then turns by the product of its group's armature-space turns, so the neck and
+    everything above it end up turned as on the canonical skeleton. Returns (joints kept, rotations).
+    """
+    spine = [j for j in rig_roles.SPINE if j in present]
+    groups = {j: [] for j in spine}
+    for j in rig_roles.SPINE:
+        below = [p for p in spine if rig_roles.SPINE.index(p) <= rig_roles.SPINE.index(j)]
+        groups[below[-1] if below else spine[0]].append(j)
+    out = rotvecs.copy()
+    for keeper, members in groups.items():
+        turn = np.eye(3)
+        for j in members:  # SPINE order: parents first
+            frame = _CANONICAL_FRAMES[j]
+            turn = turn @ frame @ rotvec_to_matrix(rotvecs[:, joints.index(j)]) @ frame.T
+        frame = _CANONICAL_FRAMES[keeper]
+        out[:, joints.index(keeper)] = matrix_to_rotvec(frame.T @ turn @ frame)
+    kept = [i for i, j in enumerate(joints) if j in present]
+    return [joints[i] for i in kept], out[:, kept]
+
+
 def blend_weights(count, fraction=BLEND_FRACTION):
-    """(count,) weights of the gesture against the start pose: 0 at both ends, 1 in the middle.
+    """(count,) weights of the gesture against the pose underneath: 0 at both ends, 1 in the middle.
 
     Smoothstep ramps over `fraction` of the frames at each end keep velocity continuous.
     """
@@ -193,10 +212,10 @@ def slerp(q0, q1, weight):
     return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
-def blend_from_pose(start_quats, gesture_quats, weights):
-    """Blend (N, B, 4) gesture quaternions with the (B, 4) start pose by (N,) weights."""
-    start = np.broadcast_to(start_quats, np.shape(gesture_quats))
-    return slerp(start, gesture_quats, np.broadcast_to(np.asarray(weights)[:, None], np.shape(gesture_quats)[:2]))
+def blend_from_pose(under_quats, gesture_quats, weights):
+    """Blend (N, B, 4) gesture quaternions with the pose underneath ((B, 4) or (N, B, 4)) by (N,) weights."""
+    under = np.broadcast_to(under_quats, np.shape(gesture_quats))
+    return slerp(under, gesture_quats, np.broadcast_to(np.asarray(weights)[:, None], np.shape(gesture_quats)[:2]))
 
 
 def continuous(quats):
@@ -219,40 +238,99 @@ def pointing_hand_rotations(arm, count):
     return names, rotvecs
 
 
-def gesture_rotations(agent, request, rig):
-    """Per-frame local quaternions to key on the rig: (bone names, (N, B, 4)).
+def _standing_pose():
+    """Canonical local rotation vectors of a natural standing pose: arms hanging 75 degrees down from the
+    T-pose, elbows bent 17 degrees forward. Rigs with no animation start and end here, not in their
+    bind pose."""
+    pose = {}
+    for side, sign in (("Left", 1.0), ("Right", -1.0)):
+        for bone, world in ((side + "Arm", (0.0, sign * 1.3, 0.0)), (side + "ForeArm", (0.0, 0.0, -sign * 0.3))):
+            frame = _CANONICAL_FRAMES[bone]
+            pose[bone] = matrix_to_rotvec(frame.T @ rotvec_to_matrix(np.array(world)) @ frame)
+    return pose
 
-    request: a GestureRequest. rig: a RigPose (the rig's rest data and its pose at the start frame).
-    Every RLAnimateError is raised before anything is returned, so callers can write all or nothing.
+
+#: Canonical local rotation vectors (3,) of the standing pose, by bone (others stay at rest).
+STANDING_POSE = _standing_pose()
+
+
+def finger_line_bones(roles, arm):
+    """(start bone, start at head?, end bone) of the rig's pointing line: the index finger from
+    Index1's head to the tail of the last of Index1-3 the rig has, or the hand's own axis without one."""
+    prefix = skeleton.ARM_PREFIX[arm] + "Hand"
+    index = [roles[prefix + f"Index{k}"] for k in (1, 2, 3) if prefix + f"Index{k}" in roles]
+    if prefix + "Index1" in roles:
+        return index[0], index[-1]
+    return roles[prefix], roles[prefix]
+
+
+def aim_rig(rig, basis, arm, targets, weights):
+    """(N, 4, 4) basis matrices of the pointing Arm bone turned so the rig's finger line passes
+    through targets (N, 3) by `weights` (N,) of the turn, solved against the posed rig.
+
+    basis: (N, B, 4, 4) every bone's basis as it will play (the gesture over the pose underneath).
     """
-    missing = sorted(set(skeleton.REQUIRED_BONES) - set(rig.rest_heads))
-    if missing:
-        raise RLAnimateError(f"The rig lacks the bones {', '.join(missing)}: use a rig with Mixamo bone names.")
+    arm_bone = rig.roles[skeleton.ARM_PREFIX[arm] + "Arm"]
+    start, end = finger_line_bones(rig.roles, arm)
+    pose = rig.skeleton.pose_matrices(basis, only=(end,))
+    i = rig.skeleton.index[arm_bone]
+    base = pose[:, rig.skeleton.index[start], :3, 3]
+    finger = rig.skeleton.tails(pose, end) - base
+    finger /= np.linalg.norm(finger, axis=1, keepdims=True)
+    correction = aim.shoulder_corrections(pose[:, i, :3, 3], base, finger, targets)  # (N, 3)
+    turn = rotvec_to_matrix(correction * np.asarray(weights)[:, None])
+    world = pose[:, i, :3, :3] / np.linalg.norm(pose[:, i, :3, :3], axis=1, keepdims=True)  # (N, 3, 3)
+    aimed = basis[:, i].copy()
+    aimed[:, :3, :3] = basis[:, i, :3, :3] @ np.swapaxes(world, -1, -2) @ turn @ world
+    return aimed
+
+
+def gesture_rotations(agent, request, rig):
+    """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
+
+    request: a GestureRequest. rig: a RigState (the rig's bones, roles and the pose underneath).
+    `underneath` is the rotation each bone would have without the gesture (its animation, else its
+    pose), which a Combine layer needs. Every RLAnimateError is raised before anything is returned,
+    so callers can write all or nothing.
+    """
+    rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
+    rest_heads = rig.rest_heads
     objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=request.targets,
-                                  rest_heads=rig.rest_heads, exaggeration=request.exaggeration)
+                                  rest_heads=rest_heads, exaggeration=request.exaggeration)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
-    names = list(skeleton.ACTION_JOINTS)
-    if request.behaviour == "POINT" and request.exact_aim:
-        targets = canonical_targets(request.arm, request.targets, rig.rest_heads)
-        canonical = aim.aim_at(canonical, request.arm, np.broadcast_to(targets, (len(canonical), 3)))
+    phase_base = aim.finger_lines(canonical, request.arm)[1] if request.behaviour == "POINT" else None
+    names, canonical = fold_spine(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
     if request.behaviour == "POINT":
         hand_names, hand = pointing_hand_rotations(request.arm, request.frame_count)
-        present = [i for i, name in enumerate(hand_names) if name in rig.rest_frames]
+        present = [i for i, name in enumerate(hand_names) if name in rig.roles]
         names += [hand_names[i] for i in present]
         canonical = np.concatenate([canonical, hand[:, present]], axis=1)
-    to_character = character_frame(rig.rest_heads)
-    conversions = retarget_matrices(names, [rig.rest_frames[n] for n in names], to_character)
-    quats = retarget(canonical, conversions)  # (N, B, 4)
-    start = np.array([rig.start_quats[n] for n in names])  # (B, 4)
-    keyed = blend_from_pose(start, quats, blend_weights(request.frame_count))
-    return tuple(names), continuous(keyed)
+    bones = [rig.roles[n] for n in names]
+    columns = [rig.skeleton.index[b] for b in bones]
+    conversions = retarget_matrices(names, [rig.skeleton.rest_frame(b) for b in bones], character_frame(rest_heads))
+    under_basis = np.broadcast_to(rig.under, (request.frame_count,) + np.shape(rig.under)[-3:]).copy()
+    under = matrix_to_quat(under_basis[:, columns, :3, :3])  # (N, D, 4)
+    start = under
+    if not rig.animated:  # bones at rest start from the standing pose, not the bind pose
+        standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions)  # (D, 4)
+        at_rest = np.abs(under[..., 0]) > 1.0 - 1e-9
+        start = np.where(at_rest[..., None], standing, under)
+    keyed = blend_from_pose(start, retarget(canonical, conversions), blend_weights(request.frame_count))
+    if request.behaviour == "POINT" and request.exact_aim:
+        basis = under_basis
+        basis[:, columns, :3, :3] = quat_to_matrix(keyed) * np.linalg.norm(basis[:, columns, :3, :3], axis=-2,
+                                                                          keepdims=True)
+        arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
+        aimed = aim_rig(rig, basis, request.arm, np.broadcast_to(request.targets, (request.frame_count, 3)),
+                        aim.pointing_phase(phase_base))
+        keyed[:, arm_column] = matrix_to_quat(aimed[:, :3, :3] / np.linalg.norm(aimed[:, :3, :3], axis=-2,
+                                                                                  keepdims=True))
+    return tuple(bones), continuous(keyed), continuous(under)
 
 
 class GestureRequest:
-    """What the user asked for: behaviour, arm, length, seed and the behaviour's attribute.
-
-    exact_aim: for POINT, turn the agent's arm so the index finger passes through the target
-    (core/aim.py, the final polish); False keys the agent's own aim."""
+    """What the user asked for: behaviour, arm, length, seed, the behaviour's attribute, and whether
+    Point solves its aim exactly on the rig (else it keys the agent's own aim)."""
 
     def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True):
         self.behaviour, self.arm = behaviour, arm
@@ -261,21 +339,29 @@ class GestureRequest:
         self.exact_aim = bool(exact_aim)
 
 
-class RigPose:
-    """The rig as the pipeline needs it, keyed by canonical bone name (prefix stripped).
+class RigState:
+    """The rig as the pipeline needs it.
 
-    rest_heads: name -> (3,) rest head in armature space; rest_frames: name -> (3, 3) rest rotation
-    in armature space; start_quats: name -> (4,) local rotation at the start frame.
+    skeleton: a core.rig.RigSkeleton; roles: {role: bone name} (core.rig_roles); family: the naming
+    it was matched by (for messages); under: (B, 4, 4) or (N, B, 4, 4) every bone's basis matrix as
+    the rig plays without the gesture, at each gesture frame; animated: whether `under` is animation
+    (when it is not, bones at rest start and end in the standing pose).
     """
 
-    def __init__(self, rest_heads, rest_frames, start_quats):
-        self.rest_heads, self.rest_frames, self.start_quats = rest_heads, rest_frames, start_quats
+    def __init__(self, name, skeleton_, roles, family, under, animated):
+        self.name, self.skeleton, self.roles, self.family = name, skeleton_, dict(roles), family
+        self.under, self.animated = np.asarray(under, dtype=np.float64), animated
+
+    @property
+    def rest_heads(self):
+        """{role: (3,) rest head in armature space}."""
+        return {role: self.skeleton.rest_head(bone) for role, bone in self.roles.items()}
 
 
-def canonical_rig_pose():
-    """The canonical skeleton at rest as a RigPose: for tests and for checking an agent without Blender."""
-    heads = {b.name: np.asarray(b.head, dtype=np.float64) for b in skeleton.BONES}
-    frames = {b.name: skeleton.rest_frame(b) for b in skeleton.BONES}
-    identity = {b.name: np.array([1.0, 0.0, 0.0, 0.0]) for b in skeleton.BONES}
-    return RigPose(heads, frames, identity)
-
+def canonical_rig():
+    """The canonical skeleton at rest, unanimated, as a RigState: for tests and checks without Blender."""
+    bones = skeleton.BONES
+    rigged = RigSkeleton([b.name for b in bones], [b.parent for b in bones], skeleton.rest_matrices(),
+                         [np.linalg.norm(np.subtract(b.tail, b.head)) for b in bones])
+    return RigState("Canonical", rigged, {b.name: b.name for b in bones}, "Mixamo",
+                    np.tile(np.eye(4), (len(bones), 1, 1)), animated=False)

@@ -88,3 +88,62 @@ def rotvec_to_matrix(rotvec):
 def matrix_to_rotvec(matrix):
     """(..., 3, 3) rotation matrices -> (..., 3) rotation vectors."""
     return quat_to_rotvec(matrix_to_quat(matrix))
+
+
+_AXES = {"X": 0, "Y": 1, "Z": 2}
+
+
+def _axis_matrix(axis, angle):
+    """(..., 3, 3) rotations by angle (...) about coordinate axis 0, 1 or 2."""
+    rotvec = np.zeros(np.shape(angle) + (3,))
+    rotvec[..., axis] = angle
+    return rotvec_to_matrix(rotvec)
+
+
+def euler_to_matrix(euler, order="XYZ"):
+    """(..., 3) Euler angles in Blender's convention -> (..., 3, 3): order 'XYZ' applies X first (Rz Ry Rx)."""
+    e = np.asarray(euler, dtype=np.float64)
+    m = np.broadcast_to(np.eye(3), e.shape[:-1] + (3, 3))
+    for axis in order:
+        m = _axis_matrix(_AXES[axis], e[..., _AXES[axis]]) @ m
+    return m
+
+
+def matrix_to_euler(matrix, order="XYZ", previous=None):
+    """(N, 3, 3) rotations -> (N, 3) Euler angles (Blender's order convention, channels X, Y, Z).
+
+    Each frame takes, of the two Euler triples of its rotation and their 2 pi turns, the one nearest
+    the frame before (the first frame: nearest `previous` (3,), when given), as Blender's
+    `Matrix.to_euler(order, euler_compat)` does, so keys interpolate without flips.
+    """
+    m = np.asarray(matrix, dtype=np.float64)
+    i, j, k = (_AXES[a] for a in order)
+    sign = 1.0 if (j - i) % 3 == 1 else -1.0  # an even permutation of X, Y, Z
+    first = np.arctan2(sign * m[:, k, j], m[:, k, k])
+    middle = np.arcsin(np.clip(-sign * m[:, k, i], -1.0, 1.0))
+    last = np.arctan2(sign * m[:, j, i], m[:, i, i])
+    angles = np.zeros((len(m), 3))
+    angles[:, i], angles[:, j], angles[:, k] = first, middle, last
+    other = angles.copy()
+    other[:, i], other[:, j], other[:, k] = first + np.pi, np.pi - middle, last + np.pi
+    out = np.empty_like(angles)
+    reference = None if previous is None else np.asarray(previous, dtype=np.float64)
+    for t in range(len(m)):
+        options = [angles[t], other[t]]
+        if reference is not None:
+            options = [o + 2.0 * np.pi * np.round((reference - o) / (2.0 * np.pi)) for o in options]
+            out[t] = min(options, key=lambda o: np.abs(o - reference).sum())
+        else:
+            out[t] = options[0]
+        reference = out[t]
+    return out
+
+
+def quat_to_axis_angle(quat):
+    """(..., 4) quaternions -> (..., 4) Blender axis-angle (angle, x, y, z); continuous quaternions give
+    continuous values (the angle runs up to 2 pi rather than flipping the axis)."""
+    q = np.asarray(quat, dtype=np.float64)
+    sin_half = np.linalg.norm(q[..., 1:], axis=-1)
+    angle = 2.0 * np.arctan2(sin_half, q[..., 0])
+    axis = np.where(sin_half[..., None] > _SMALL, q[..., 1:] / np.maximum(sin_half, _SMALL)[..., None], [0.0, 1.0, 0.0])
+    return np.concatenate([angle[..., None], axis], axis=-1)

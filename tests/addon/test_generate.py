@@ -227,7 +227,11 @@ def test_every_bad_input_is_refused_with_its_message_and_changes_nothing(setting
 
     partial = helpers.build_rig("Partial", skip=("LeftHandIndex4", "LeftHandIndex3", "Neck", "Head"))
     helpers.activate(partial)
-    _assert_refused(partial, "Head, LeftHandIndex4, Neck")
+    _assert_refused(partial, r"roles Neck, Head \(closest bone naming: Mixamo\)")
+    helpers.activate(rig)
+    settings.target_bone = "NoSuchBone"
+    _assert_refused(rig, "has no bone 'NoSuchBone'")
+    settings.target_bone = ""
 
     helpers.activate(rig)
     assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}, "valid settings must work after refusals"

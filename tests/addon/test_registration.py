@@ -109,7 +109,7 @@ def test_panel_draw_uses_only_existing_properties_operators_and_icons(settings, 
     assert ("target" in shown) == (behaviour == "POINT")
     assert ("exact_aim" in shown) == (behaviour == "POINT")
     operators = [c[1] for c in calls if c[0] == "operator"]
-    assert operators == ["rlanimate.generate_gesture", "rlanimate.export_fbx"]
+    assert operators == ["rlanimate.save_bone_map", "rlanimate.generate_gesture", "rlanimate.export_fbx"]
     labels = " ".join(c[1].get("text", "") for c in calls if c[0] == "label")
     assert "supported" in labels, "the panel must show the supported length range"
 

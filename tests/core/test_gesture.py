@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from rlanimate_addon.core import gesture, skeleton, spaces
+from rlanimate_addon.core import aim, gesture, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import (matrix_to_quat, quat_to_matrix, rotvec_to_matrix,
                                             rotvec_to_quat)
@@ -29,7 +29,7 @@ class ReplayAgent:
 
 
 def test_character_frame_is_identity_on_the_canonical_rig_and_undoes_a_rotated_armature_space():
-    heads = gesture.canonical_rig_pose().rest_heads
+    heads = gesture.canonical_rig().rest_heads
     assert np.allclose(gesture.character_frame(heads), np.eye(3))
     rotation = random_rotations(1)[0]
     rotated = {name: 37.0 * rotation @ head for name, head in heads.items()}  # other units, other axes
@@ -37,7 +37,7 @@ def test_character_frame_is_identity_on_the_canonical_rig_and_undoes_a_rotated_a
 
 
 def test_pointing_directions_match_the_spaces_definition_whatever_the_rig_scale_and_axes():
-    heads = gesture.canonical_rig_pose().rest_heads
+    heads = gesture.canonical_rig().rest_heads
     targets = RNG.uniform(-3, 3, size=(5, 3)) + [0, -2, 1.5]
     expected = np.array([spaces.pointing_direction("LEFT", t) for t in targets])
     assert np.allclose(gesture.pointing_directions("LEFT", targets, heads), expected)
@@ -110,11 +110,11 @@ def _request(behaviour="WAVE", arm="RIGHT", frames=60, **kwargs):
 def test_lengths_outside_the_supported_range_are_time_scaled_from_the_nearest_supported_length():
     actions = RNG.uniform(0.3, 0.7, size=(80, spaces.ACTION_SIZE))
     agent = ReplayAgent(actions)
-    rig = gesture.canonical_rig_pose()
+    rig = gesture.canonical_rig()
     shortest, longest = gesture.supported_length_range(agent.average_frames["WAVE"])
     assert (shortest, longest) == (32, 120)
     for frames, steps in ((10, shortest), (60, 60), (400, longest)):
-        names, quats = gesture.gesture_rotations(agent, _request(frames=frames, seed=3), rig)
+        names, quats, _ = gesture.gesture_rotations(agent, _request(frames=frames, seed=3), rig)
         objectives, seed = agent.calls[-1]
         assert len(objectives) == steps and seed == 3
         assert np.allclose(objectives[[0, -1], spaces.OBJECTIVE_TIME], [0.0, 1.0])
@@ -122,21 +122,79 @@ def test_lengths_outside_the_supported_range_are_time_scaled_from_the_nearest_su
     assert names == skeleton.ACTION_JOINTS
 
 
-def test_pointing_adds_the_hand_shape_and_the_gesture_starts_and_ends_at_the_start_pose():
+def _animated(rig, frames, scale=0.3):
+    """The rig with a random pose underneath at every frame (as its own animation would play)."""
+    under = np.tile(np.eye(4), (frames, len(skeleton.BONES), 1, 1))
+    under[..., :3, :3] = rotvec_to_matrix(RNG.normal(scale=scale, size=(frames, len(skeleton.BONES), 3)))
+    rig.under, rig.animated = under, True
+    return rig
+
+
+def test_pointing_adds_the_hand_shape_and_the_gesture_blends_from_and_to_the_pose_underneath():
     agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(50, spaces.ACTION_SIZE)))
-    rig = gesture.canonical_rig_pose()
-    start = rotvec_to_quat(RNG.normal(scale=0.3, size=(len(skeleton.BONES), 3)))
-    rig.start_quats = dict(zip(skeleton.BONE_NAMES, start))
+    rig = _animated(gesture.canonical_rig(), 50)
     targets = np.tile([-1.0, -2.0, 1.6], (50, 1))
-    names, quats = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
+    names, quats, under = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
     assert names[:15] == skeleton.ACTION_JOINTS
     assert {"RightHandMiddle2", "RightHandPinky1", "RightHandThumb1"} <= set(names[15:])
     assert not any(n.startswith("Left") for n in names[15:])
-    expected = np.array([rig.start_quats[n] for n in names])
+    columns = [skeleton.BONE_NAMES.index(n) for n in names]
+    expected = matrix_to_quat(rig.under[:, columns, :3, :3])
+    assert np.allclose(np.abs(np.sum(under * expected, axis=-1)), 1.0)
     for frame in (0, -1):
-        assert np.allclose(np.abs(np.sum(quats[frame] * expected, axis=-1)), 1.0)
+        assert np.allclose(np.abs(np.sum(quats[frame] * expected[frame], axis=-1)), 1.0)
     objectives, _ = agent.calls[-1]
     assert np.allclose(objectives[:, spaces.OBJECTIVE_ATTRIBUTES], spaces.pointing_direction("RIGHT", targets[0]))
+
+
+def test_a_still_rig_at_rest_starts_and_ends_in_the_standing_pose_not_its_bind_pose():
+    agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(40, spaces.ACTION_SIZE)))
+    names, quats, _ = gesture.gesture_rotations(agent, _request(frames=40), gesture.canonical_rig())
+    hanging = {n: rotvec_to_quat(gesture.STANDING_POSE.get(n, np.zeros(3))) for n in names}
+    for frame in (0, -1):
+        assert np.allclose([abs(np.dot(quats[frame, k], hanging[n])) for k, n in enumerate(names)], 1.0)
+    from rlanimate_addon.core import kinematics
+
+    pose = kinematics.pose_matrices({n: gesture.STANDING_POSE[n] for n in gesture.STANDING_POSE})
+    heads = kinematics.head_positions(pose)
+    for side in ("Left", "Right"):
+        wrist, shoulder = heads[kinematics.bone_index(side + "Hand")], heads[kinematics.bone_index(side + "Arm")]
+        assert wrist[2] < shoulder[2] - 0.4, f"the {side} arm must hang down"
+        assert wrist[1] < shoulder[1], f"the {side} forearm must bend forward"
+
+
+@pytest.mark.parametrize("arm", skeleton.ARMS)
+def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underneath(arm):
+    frames = 60
+    agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(frames, spaces.ACTION_SIZE)))
+    rig = _animated(gesture.canonical_rig(), frames, scale=0.1)
+    target = np.array([-1.0 if arm == "RIGHT" else 1.0, -2.5, 1.7])
+    names, quats, _ = gesture.gesture_rotations(agent, _request("POINT", arm, frames, targets=np.tile(target, (frames, 1))), rig)
+    basis = rig.under.copy()
+    columns = [rig.skeleton.index[n] for n in names]
+    basis[:, columns, :3, :3] = quat_to_matrix(quats)
+    start, end = gesture.finger_line_bones(rig.roles, arm)
+    pose = rig.skeleton.pose_matrices(basis, only=(end,))
+    base = pose[:, rig.skeleton.index[start], :3, 3]
+    finger, to_target = rig.skeleton.tails(pose, end) - base, target - base
+    cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(finger, axis=1) / np.linalg.norm(to_target, axis=1)
+    angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
+    phase = aim.pointing_phase(aim.finger_lines(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm)[1])
+    assert angles[phase == 1.0].max() < 0.01, "at full weight the finger line must pass through the target"
+
+
+def test_a_missing_spine_bone_is_folded_into_the_one_below_and_the_neck_turns_the_same():
+    rotvecs = RNG.normal(scale=0.2, size=(5, len(skeleton.ACTION_JOINTS), 3))
+    joints = list(skeleton.ACTION_JOINTS)
+    present = set(joints) - {"Spine2"}
+    kept, folded = gesture.fold_spine(rotvecs, joints, present)
+    assert "Spine2" not in kept and len(kept) == len(joints) - 1
+    from rlanimate_addon.core import kinematics
+
+    full = kinematics.pose_matrices(dict(zip(joints, np.moveaxis(rotvecs, 1, 0))))
+    merged = kinematics.pose_matrices(dict(zip(kept, np.moveaxis(folded, 1, 0))))
+    neck = kinematics.bone_index("Neck")
+    assert np.allclose(full[:, neck, :3, :3], merged[:, neck, :3, :3], atol=1e-9)
 
 
 def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
@@ -160,21 +218,29 @@ def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
 def test_bad_requests_raise_before_the_agent_runs(request_kwargs, message):
     agent = ReplayAgent(RNG.uniform(size=(10, spaces.ACTION_SIZE)))
     with pytest.raises(RLAnimateError, match=message):
-        gesture.gesture_rotations(agent, _request(**request_kwargs), gesture.canonical_rig_pose())
+        gesture.gesture_rotations(agent, _request(**request_kwargs), gesture.canonical_rig())
     assert agent.calls == []
 
 
-def test_a_rig_without_required_bones_is_named_in_the_error():
-    rig = gesture.canonical_rig_pose()
-    del rig.rest_heads["LeftHandIndex4"], rig.rest_heads["Neck"]
-    with pytest.raises(RLAnimateError, match="LeftHandIndex4, Neck"):
-        gesture.gesture_rotations(ReplayAgent(np.zeros((5, 45))), _request(), rig)
+def test_a_rig_needs_only_the_bones_the_gesture_drives_and_names_the_missing_roles():
+    agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(30, spaces.ACTION_SIZE)))
+    rig = gesture.canonical_rig()
+    optional = {"LeftEye", "RightEye", "Hips", "Spine1"} | {n for n in rig.roles if "Index" in n and n[-1] != "1"} \
+        | {n for n in rig.roles if n.startswith("LeftHand") and n != "LeftHand"}
+    for name in optional:
+        del rig.roles[name]
+    targets = np.tile([-1.0, -2.0, 1.6], (30, 1))
+    names, _, _ = gesture.gesture_rotations(agent, _request("POINT", "RIGHT", 30, targets=targets), rig)
+    assert "Spine1" not in names and "RightHandIndex1" in names
+    del rig.roles["Neck"], rig.roles["RightForeArm"]
+    with pytest.raises(RLAnimateError, match="roles Neck, RightForeArm"):
+        gesture.gesture_rotations(agent, _request(), rig)
 
 
 def test_an_agent_returning_the_wrong_shape_is_reported():
     agent = ReplayAgent(np.full((60, 44), 0.5))
     with pytest.raises(RLAnimateError, match="shape"):
-        gesture.gesture_rotations(agent, _request(), gesture.canonical_rig_pose())
+        gesture.gesture_rotations(agent, _request(), gesture.canonical_rig())
 
 
 def test_matrix_quat_helpers_agree():

@@ -1,0 +1,198 @@
+"""Which bone of a user's armature plays which canonical role (core.skeleton names), and which are needed.
+
+A role is a canonical bone name ('Spine1', 'LeftArm', 'RightHandIndex1'). A rig family names its bones
+for the roles with left-side templates in which `{s}` stands for the family's side token; the right
+side swaps the token. Names are compared case-insensitively, after dropping any namespace
+('mixamorig1:', 'Armature|') and a Mixamo prefix, glued ('mixamorigLeftArm') or joined by '_'.
+
+A bone map ({role: bone name}) comes from the family that matches the most roles, or from a bone-map
+file the user loads in the panel (JSON: {"family": name, "bones": {role: bone name}}).
+"""
+import json
+import re
+from collections import namedtuple
+
+from .errors import RLAnimateError
+
+Family = namedtuple("Family", "name sides templates")
+
+SPINE = ("Spine", "Spine1", "Spine2")
+_CENTRE = ("Hips",) + SPINE + ("Neck", "Head")
+_FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")
+#: Side roles in their left form (canonical names).
+_SIDE = ("LeftEye", "LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand") + tuple(
+    f"LeftHand{finger}{k}" for finger in _FINGERS for k in range(1, 5))
+ROLES = _CENTRE + _SIDE + tuple(r.replace("Left", "Right", 1) for r in _SIDE)
+
+
+def _fingers(pattern, names=None, counts=(1, 2, 3)):
+    """Finger templates: pattern.format(finger=..., k=...) per canonical finger and phalanx."""
+    names = names or {f: f.lower() for f in _FINGERS}
+    return {f"LeftHand{f}{k}": (pattern.format(finger=names[f], k=k),) for f in _FINGERS for k in counts}
+
+
+def _family(name, sides, centre, side, fingers):
+    return Family(name, sides, {**centre, **side, **fingers})
+
+
+MIXAMO = _family(
+    "Mixamo", ("Left", "Right"),
+    {r: (r,) for r in _CENTRE},
+    {r: ("{s}" + r[len("Left"):],) for r in _SIDE[:5]},
+    {f"LeftHand{f}{k}": (f"{{s}}Hand{f}{k}",) for f in _FINGERS for k in range(1, 5)})
+
+_RIGIFY_FINGERS = _fingers("{finger}.0{k}{{s}}", {f: ("thumb" if f == "Thumb" else "f_" + f.lower()) for f in _FINGERS})
+
+RIGIFY = _family(
+    "Rigify", (".L", ".R"),
+    {"Spine": ("spine_fk.001",), "Spine1": ("spine_fk.002",), "Spine2": ("spine_fk.003",),
+     "Neck": ("neck",), "Head": ("head",)},
+    {"LeftShoulder": ("shoulder{s}",), "LeftArm": ("upper_arm_fk{s}",), "LeftForeArm": ("forearm_fk{s}",),
+     "LeftHand": ("hand_fk{s}",)},
+    _RIGIFY_FINGERS)
+
+METARIG = _family(
+    "Blender human metarig", (".L", ".R"),
+    {"Hips": ("spine",), "Spine": ("spine.001",), "Spine1": ("spine.002",), "Spine2": ("spine.003",),
+     "Neck": ("spine.004",), "Head": ("spine.006",)},
+    {"LeftEye": ("eye{s}",), "LeftShoulder": ("shoulder{s}",), "LeftArm": ("upper_arm{s}",),
+     "LeftForeArm": ("forearm{s}",), "LeftHand": ("hand{s}",)},
+    _RIGIFY_FINGERS)
+
+UNREAL = _family(
+    "Unreal Engine mannequin", ("_l", "_r"),
+    {"Hips": ("pelvis",), "Spine": ("spine_01",), "Spine1": ("spine_02",), "Spine2": ("spine_05", "spine_03"),
+     "Neck": ("neck_01",), "Head": ("head",)},
+    {"LeftShoulder": ("clavicle{s}",), "LeftArm": ("upperarm{s}",), "LeftForeArm": ("lowerarm{s}",),
+     "LeftHand": ("hand{s}",)},
+    _fingers("{finger}_0{k}{{s}}"))
+
+AUTO_RIG_PRO = _family(
+    "Auto-Rig Pro", (".l", ".r"),
+    {"Hips": ("c_root.x", "root.x"), "Spine": ("c_spine_01.x", "spine_01.x"),
+     "Spine1": ("c_spine_02.x", "spine_02.x"), "Spine2": ("c_spine_03.x", "spine_03.x"),
+     "Neck": ("c_neck.x", "neck.x"), "Head": ("c_head.x", "head.x")},
+    {"LeftEye": ("c_eye{s}",), "LeftShoulder": ("c_shoulder{s}", "shoulder{s}"),
+     "LeftArm": ("c_arm_fk{s}", "arm_stretch{s}", "arm{s}"),
+     "LeftForeArm": ("c_forearm_fk{s}", "forearm_stretch{s}", "forearm{s}"),
+     "LeftHand": ("c_hand_fk{s}", "hand{s}")},
+    {role: ("c_" + names[0], names[0]) for role, names in _fingers("{finger}{k}{{s}}").items()})
+
+_VRM_FINGERS = {"Thumb": "Thumb", "Index": "Index", "Middle": "Middle", "Ring": "Ring", "Pinky": "Little"}
+VROID = _family(
+    "VRoid", ("L", "R"),
+    {"Hips": ("J_Bip_C_Hips",), "Spine": ("J_Bip_C_Spine",), "Spine1": ("J_Bip_C_Chest",),
+     "Spine2": ("J_Bip_C_UpperChest",), "Neck": ("J_Bip_C_Neck",), "Head": ("J_Bip_C_Head",)},
+    {"LeftEye": ("J_Adj_{s}_FaceEye",), "LeftShoulder": ("J_Bip_{s}_Shoulder",), "LeftArm": ("J_Bip_{s}_UpperArm",),
+     "LeftForeArm": ("J_Bip_{s}_LowerArm",), "LeftHand": ("J_Bip_{s}_Hand",)},
+    _fingers("J_Bip_{{s}}_{finger}{k}", _VRM_FINGERS))
+
+#: VRM humanoid bone names, as the VRM add-on can name an imported rig's bones; thumbs are
+#: Proximal/Intermediate/Distal in VRM 0.x and Metacarpal/Proximal/Distal in 1.0.
+_VRM_PHALANGES = ("Proximal", "Intermediate", "Distal")
+_VRM_THUMB = (("Metacarpal", "Proximal"), ("Intermediate", "Proximal"), ("Distal",))
+VRM_HUMANOID = _family(
+    "VRM humanoid", ("left", "right"),
+    {"Hips": ("hips",), "Spine": ("spine",), "Spine1": ("chest",), "Spine2": ("upperChest",),
+     "Neck": ("neck",), "Head": ("head",)},
+    {"LeftEye": ("{s}Eye",), "LeftShoulder": ("{s}Shoulder",), "LeftArm": ("{s}UpperArm",),
+     "LeftForeArm": ("{s}LowerArm",), "LeftHand": ("{s}Hand",)},
+    {f"LeftHand{f}{k}": tuple(f"{{s}}{_VRM_FINGERS[f]}{p}"
+                              for p in (_VRM_THUMB[k - 1] if f == "Thumb" else (_VRM_PHALANGES[k - 1],)))
+     for f in _FINGERS for k in (1, 2, 3)})
+
+CHARACTER_CREATOR = _family(
+    "Character Creator", ("L", "R"),
+    {"Hips": ("CC_Base_Hip",), "Spine": ("CC_Base_Waist",), "Spine1": ("CC_Base_Spine01",),
+     "Spine2": ("CC_Base_Spine02",), "Neck": ("CC_Base_NeckTwist01",), "Head": ("CC_Base_Head",)},
+    {"LeftEye": ("CC_Base_{s}_Eye",), "LeftShoulder": ("CC_Base_{s}_Clavicle",),
+     "LeftArm": ("CC_Base_{s}_Upperarm",), "LeftForeArm": ("CC_Base_{s}_Forearm",), "LeftHand": ("CC_Base_{s}_Hand",)},
+    _fingers("CC_Base_{{s}}_{finger}{k}", {f: "Mid" if f == "Middle" else f for f in _FINGERS}))
+
+#: Every family, in the order that wins a tie.
+FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, CHARACTER_CREATOR, METARIG)
+
+_MIXAMO_PREFIX = re.compile(r"^mixamorig\d*_?")
+
+
+def name_key(name):
+    """A bone name as matching compares it: namespace and Mixamo prefix dropped, lower case."""
+    return _MIXAMO_PREFIX.sub("", re.split(r"[:|]", name)[-1].lower())
+
+
+def _side_templates(family, role):
+    """The family's candidate names for a role, with the side token filled in."""
+    if role.startswith("Right"):
+        left = "Left" + role[len("Right"):]
+        if left not in family.templates:
+            return ()
+        return tuple(t.format(s=family.sides[1]) for t in family.templates[left])
+    return tuple(t.format(s=family.sides[0]) for t in family.templates.get(role, ()))
+
+
+def family_roles(bone_names, family):
+    """{role: bone name} for the roles the family finds among bone_names (first candidate present wins)."""
+    by_key = {}
+    for name in bone_names:
+        by_key.setdefault(name_key(name), name)
+    found = {}
+    for role in ROLES:
+        for template in _side_templates(family, role):
+            bone = by_key.get(name_key(template))
+            if bone is not None:
+                found[role] = bone
+                break
+    return found
+
+
+def detect(bone_names):
+    """(family, {role: bone name}) of the family that recognises the most roles (ties: FAMILIES order)."""
+    scored = [(len(family_roles(bone_names, f)), -i, f) for i, f in enumerate(FAMILIES)]
+    _, _, family = max(scored, key=lambda s: s[:2])
+    return family, family_roles(bone_names, family)
+
+
+def required_roles(arm):
+    """Roles a gesture of `arm` cannot do without: a spine bone, the neck, the head and that arm."""
+    side = "Left" if arm == "LEFT" else "Right"
+    return ("Neck", "Head") + tuple(side + part for part in ("Shoulder", "Arm", "ForeArm", "Hand"))
+
+
+def check_roles(rig_name, roles, arm, family_name):
+    """RLAnimateError listing the roles the gesture needs that `roles` lacks, and how to map them."""
+    missing = [r for r in required_roles(arm) if r not in roles]
+    if not any(r in roles for r in SPINE):
+        missing.insert(0, "Spine")
+    if missing:
+        raise RLAnimateError(
+            f"Armature {rig_name!r} has no bone for the roles {', '.join(missing)} (closest bone naming: "
+            f"{family_name}). Rename those bones to Mixamo names, or map them: in the RLAnimate panel, "
+            "'Save Bone Map' writes the detected map as a JSON file; add the missing roles with your "
+            "bone names and pick the file as Bone Map.")
+
+
+def bone_map_json(family_name, roles):
+    """The text of a bone-map file for {role: bone name}."""
+    return json.dumps({"family": family_name, "bones": {r: roles[r] for r in ROLES if r in roles}}, indent=2)
+
+
+def read_bone_map(text, bone_names):
+    """(family name, {role: bone name}) from a bone-map file's text, checked against the rig's bone names."""
+    try:
+        data = json.loads(text)
+        bones = data["bones"]
+        family_name = str(data.get("family", "Bone-map file"))
+    except (ValueError, KeyError, TypeError, AttributeError):
+        raise RLAnimateError('The bone-map file is not valid: it must be JSON like {"family": "...", '
+                             '"bones": {"Spine": "my_spine", ...}}; save one from the panel to start.') from None
+    if not isinstance(bones, dict):
+        raise RLAnimateError('The bone-map file\'s "bones" must map role names to bone names.')
+    unknown = sorted(set(bones) - set(ROLES))
+    if unknown:
+        raise RLAnimateError(f"The bone-map file names unknown roles {', '.join(unknown)}: use roles among "
+                             f"{', '.join(ROLES[:12])}, ... (Mixamo bone names without prefix).")
+    absent = sorted(str(b) for b in bones.values() if b not in set(bone_names))
+    if absent:
+        raise RLAnimateError(f"The bone-map file names bones the armature lacks: {', '.join(absent)}: "
+                             "correct their names in the file or pick the matching armature.")
+    return family_name, dict(bones)

@@ -1,0 +1,66 @@
+"""Bone roles: Mixamo names with any prefix, the other rig families, required roles, bone-map files."""
+import json
+
+import pytest
+
+from rlanimate_addon.core import rig_roles, skeleton
+from rlanimate_addon.core.errors import RLAnimateError
+
+MIXAMO = list(skeleton.BONE_NAMES)
+
+
+@pytest.mark.parametrize("rename", [
+    lambda n: "mixamorig:" + n, lambda n: "mixamorig1:" + n, lambda n: "mixamorig_" + n,
+    lambda n: "mixamorig" + n, lambda n: ("MIXAMORIG:" + n).upper(), lambda n: "Armature|" + n.lower(),
+])
+def test_mixamo_names_match_with_any_prefix_in_any_case(rename):
+    family, roles = rig_roles.detect([rename(n) for n in MIXAMO])
+    assert family is rig_roles.MIXAMO
+    assert roles["LeftArm"] == rename("LeftArm") and roles["RightHandIndex4"] == rename("RightHandIndex4")
+    assert len(roles) == len(rig_roles.ROLES)
+
+
+def _family_names(family):
+    """Every bone name the family's first templates give, both sides."""
+    return [rig_roles._side_templates(family, role)[0] for role in rig_roles.ROLES
+            if rig_roles._side_templates(family, role)]
+
+
+@pytest.mark.parametrize("family", rig_roles.FAMILIES, ids=lambda f: f.name)
+def test_each_family_is_detected_from_its_own_names_with_every_gesture_role(family):
+    names = _family_names(family) + ["DEF-upper_arm.L", "ORG-spine", "MCH-forearm_ik.L", "root", "ik_hand_gun"]
+    detected, roles = rig_roles.detect(names)
+    assert detected is family
+    for arm in skeleton.ARMS:
+        rig_roles.check_roles("Rig", roles, arm, family.name)
+    assert not any(bone.startswith(("DEF-", "ORG-", "MCH-")) for bone in roles.values())
+
+
+def test_rigify_keys_the_fk_controls():
+    _, roles = rig_roles.detect(_family_names(rig_roles.RIGIFY))
+    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == ("upper_arm_fk.L", "forearm_fk.R", "spine_fk.001")
+
+
+def test_unreal_5_spine_keys_its_top_spine_bone():
+    names = _family_names(rig_roles.UNREAL) + ["spine_04", "spine_05"]
+    assert rig_roles.detect(names)[1]["Spine2"] == "spine_05"
+
+
+def test_missing_roles_are_listed_with_how_to_map_them():
+    names = [n for n in MIXAMO if n not in ("Neck", "RightHand", "Spine", "Spine1", "Spine2")]
+    family, roles = rig_roles.detect(names)
+    with pytest.raises(RLAnimateError, match=r"roles Spine, Neck, RightHand \(closest bone naming: Mixamo\).*Bone Map"):
+        rig_roles.check_roles("Hero", roles, "RIGHT", family.name)
+    rig_roles.check_roles("Hero", {**roles, "Neck": "n", "Spine": "s"}, "LEFT", family.name)  # the left arm is whole
+
+
+def test_a_bone_map_file_round_trips_and_bad_files_are_refused():
+    bones = ["a", "b", "c"]
+    text = rig_roles.bone_map_json("Custom", {"Spine": "a", "Neck": "b", "Head": "c"})
+    assert rig_roles.read_bone_map(text, bones) == ("Custom", {"Spine": "a", "Neck": "b", "Head": "c"})
+    with pytest.raises(RLAnimateError, match="not valid"):
+        rig_roles.read_bone_map("{", bones)
+    with pytest.raises(RLAnimateError, match="unknown roles Elbow"):
+        rig_roles.read_bone_map(json.dumps({"bones": {"Elbow": "a"}}), bones)
+    with pytest.raises(RLAnimateError, match="lacks: z"):
+        rig_roles.read_bone_map(json.dumps({"bones": {"Neck": "z"}}), bones)
