@@ -272,7 +272,7 @@ def test_exact_aim_off_bakes_the_agents_own_aim(settings, arm):
             rig, [b.name for b in rig.pose.bones], frames)
     agent = preferences.load_agent(preferences.BUNDLED_AGENT)
     objectives = gesture.build_objectives("POINT", arm, count, targets=np.tile(location, (count, 1)),
-                                          rest_heads=gesture.canonical_rig_pose().rest_heads)
+                                          rest_heads=gesture.canonical_rig().rest_heads)
     _, base, finger, _ = aim.finger_lines(gesture.run_agent(agent, "POINT", objectives), arm)
     raw = behaviour_metrics.pointing_angles(base, finger, location)
     full = gesture.blend_weights(count) >= 1.0  # frames that show the agent's pose unblended

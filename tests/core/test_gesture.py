@@ -252,10 +252,10 @@ def test_exact_aim_off_keys_the_agents_own_aim():
     """With exact_aim the pointing arm is turned (aim correction); without it the keys are the
     agent's own rotations, and nothing else differs."""
     agent = ReplayAgent(np.random.default_rng(4).uniform(0.3, 0.7, size=(50, spaces.ACTION_SIZE)))
-    rig = gesture.canonical_rig_pose()
+    rig = gesture.canonical_rig()
     targets = np.tile([-1.0, -2.0, 1.6], (50, 1))
-    names, aimed = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
-    raw_names, raw = gesture.gesture_rotations(
+    names, aimed, _ = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
+    raw_names, raw, _ = gesture.gesture_rotations(
         agent, _request("POINT", frames=50, targets=targets, exact_aim=False), rig)
     assert names == raw_names
     changed = {names[b] for b in range(len(names)) if not np.allclose(np.abs(aimed[:, b]), np.abs(raw[:, b]))}
