@@ -2,7 +2,7 @@
 import bpy
 import numpy as np
 
-from ..core import channels, gesture, key_reduction, rig_roles
+from ..core import channels, gesture, rig_roles
 from ..core.errors import RLAnimateError
 from . import action_adapter, armature_io, preferences
 
@@ -53,16 +53,11 @@ def generate(context, settings, progress=lambda step: None):
                                      exact_aim=settings.exact_aim)
     bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
     blend_type = settings.blend_type if rig.animated else "REPLACE"
-    keys, worst = {}, 0.0
+    keys = {}
     for column, bone in enumerate(bones):
         mode = obj.pose.bones[bone].rotation_mode
-        values = channels.rotation_keys(mode, keyed[:, column], below[:, column], below_values[bone], blend_type)
-        kept = None
-        if settings.editable_keys:
-            added = below_values[bone] if blend_type == "COMBINE" and mode != "QUATERNION" else None
-            kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
-            worst = max(worst, deviation)
-        keys[bone] = (mode, values, kept)
+        keys[bone] = (mode, channels.rotation_keys(mode, keyed[:, column], below[:, column],
+                                                   below_values[bone], blend_type))
     progress(3)
 
     label = f"{settings.behaviour.title()} {settings.arm.title()}"
@@ -75,9 +70,6 @@ def generate(context, settings, progress=lambda step: None):
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     layer = f", {blend_type.title()} layer over its animation" if rig.animated else ""
-    if settings.editable_keys:
-        count = sum(len(kept) * values.shape[1] for _, values, kept in keys.values())
-        note += f"; editable: {count} Bezier keys, worst deviation {worst:.2f} deg"
     return (f"Baked {label} on {obj.name!r} ({family} bones): {len(bones)} bones, frames {start}-"
             f"{start + frame_count - 1}, action {action.name!r}{layer}{note}")
 

@@ -137,8 +137,8 @@ def _refined(signal, frames):
 
 def wave_measures(positions, arm, fps=FPS):
     """What a wave shows, in absolute units:
-    {'hand_up_s', 'strokes', 'cycles', 'swing' (m, median stroke; the run's side-to-side range when
-    there is no stroke), 'frequency' (Hz, 0 with fewer than 2 strokes), 'hand_height' (m, the 90th
+    {'hand_up_s', 'strokes', 'cycles', 'swing' (m, the median stroke between two turning points, of
+    any stroke with fewer than 3; the run's side-to-side range when there is no stroke), 'frequency' (Hz, 0 with fewer than 2 strokes), 'hand_height' (m, the 90th
     percentile over all frames of the wrist's height above where a hanging arm's wrist would be)}."""
     p, side = _positions(positions), _side(arm)
     wrist, shoulder = p[:, _JOINT[f"{side}_wrist"]], p[:, _JOINT[f"{side}_shoulder"]]
@@ -151,8 +151,8 @@ def wave_measures(positions, arm, fps=FPS):
     sideways = (wrist[:, 0] - shoulder[:, 0])[run[0]:run[1] + 1]  # (R,)
     pivots = turning_points(sideways, STROKE_FRACTION * shoulder_width(p))
     strokes = max(len(pivots) - 1, 0)
-    legs = np.abs(np.diff(sideways[pivots])) if strokes else np.ptp(sideways, keepdims=True)
     turns = pivots[1:-1] if strokes >= 3 else pivots  # the run's ends need not be turning points
+    legs = np.abs(np.diff(sideways[turns])) if strokes else np.ptp(sideways, keepdims=True)
     half_period_s = np.median(np.diff(_refined(sideways, turns))) / fps if strokes >= 2 else np.inf
     return {"hand_up_s": (run[1] - run[0] + 1) / fps, "strokes": strokes, "cycles": strokes // 2,
             "swing": float(np.median(legs)),

@@ -8,6 +8,7 @@ It is written atomically (trainer/files.py), so a run killed mid-write leaves th
 import random
 from pathlib import Path
 
+import numpy as np
 import torch
 
 from rlanimate_addon.core.errors import RLAnimateError

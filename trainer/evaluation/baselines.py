@@ -1,16 +1,19 @@
 """The baselines an animator would try before RLAnimate, producing clips the evaluator scores.
 
-Both answer the agent's request (behaviour, arm, label attributes, frame count) with a clip of
+Each answers the agent's request (behaviour, arm, label attributes, frame count) with a clip of
 local rotations (F, 15, 3) of skeleton.ACTION_JOINTS, like MotionClip.rotvecs:
 
+NoMotion         the start pose held: a still arm.
+ClassMean        the per-frame mean of the training clips of the same behaviour and arm, label ignored.
 NearestClip      retrieval, as motion matching does: the training clip of the same behaviour and arm
                  whose label is closest (angle between pointing directions; |difference| of
                  exaggerations), time-warped uniformly to the requested length (per-joint slerp).
 ProceduralIK     Blender's IK constraint on the sample rig (trainer/blender_io/procedural_ik.py).
 
-Both start from and return to `neutral` (15, 3), the pose the training clips start in.
+Nearest clip and procedural IK start from and return to `neutral` (15, 3), the pose the training
+clips start in.
 AgentMethod (an exported .npz, numpy runtime) and TrainedAgentMethod (a trainer's torch agent) put
-RLAnimate behind the same generate() interface, so all three are scored by one code path.
+RLAnimate behind the same generate() interface, so all are scored by one code path.
 """
 from pathlib import Path
 
@@ -80,6 +83,37 @@ class NearestClip:
         return time_warp(self.nearest(behaviour, arm, attributes).rotvecs, frame_count)
 
 
+class NoMotion:
+    """The start pose held for the whole request: what a still arm scores."""
+
+    def __init__(self, neutral):
+        self.neutral = np.asarray(neutral, dtype=np.float64)  # (15, 3)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        check_request(behaviour, arm, frame_count)
+        return np.repeat(self.neutral[None], int(frame_count), axis=0)
+
+
+class ClassMean:
+    """The per-frame mean of the training clips of the request's behaviour and arm, each time-warped
+    to the requested length (per-joint normalised quaternion mean): it ignores the label, and the mean
+    of waves whose phases differ is a nearly still raised arm."""
+
+    def __init__(self, clips):
+        self.clips = list(clips)
+
+    def generate(self, behaviour, arm, attributes, frame_count):
+        check_request(behaviour, arm, frame_count)
+        group = [c for c in self.clips if c.behaviour.upper() == behaviour and c.arm.upper() == arm]
+        if not group:
+            raise RLAnimateError(f"No {behaviour.lower()} training clip uses the {arm.lower()} arm: "
+                                 "add one to the library to use the class-mean baseline.")
+        quats = rotations.rotvec_to_quat(np.stack([time_warp(c.rotvecs, frame_count) for c in group]))  # (C, F, 15, 4)
+        quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
+        mean = quats.mean(axis=0)
+        return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
+
+
 class TrainedAgentMethod:
     """A torch RLAnimate agent behind the baselines' generate() interface: the deterministic rollout
     that trainer.evaluate scores, decoded to rotations with the trainer's bounds."""
@@ -87,10 +121,15 @@ class TrainedAgentMethod:
     def __init__(self, trainer, path):
         self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, seed=None):
+        """Deterministic without `seed`; with one, a sampled rollout from a generator seeded with it."""
+        import torch
+
         from trainer.agent.algorithm import rollout_actions
         self.agent.eval()
-        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count))
+        generator = None if seed is None else torch.Generator().manual_seed(int(seed))
+        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count),
+                                  deterministic=seed is None, generator=generator)
         return spaces.decode_action(actions, self.bounds)
 
 
@@ -103,9 +142,10 @@ class AgentMethod:
         self.path = Path(path)
         self.agent = runtime.load_agent(self.path)
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, seed=None):
+        """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed)."""
         objectives = spaces.make_objective(behaviour, arm, attributes, frame_count)
-        return spaces.decode_action(self.agent.rollout(objectives), np.asarray(self.agent.action_bounds))
+        return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
 
 
 def evaluate_motions(env, motions, clips, references):
@@ -128,7 +168,8 @@ def generate_for(baseline, clips):
     return [baseline.generate(c.behaviour.upper(), c.arm.upper(), c.attributes, len(c.rotvecs)) for c in clips]
 
 
-METHOD_LABELS = {"rlanimate": "RLAnimate", "nearest_clip": "Nearest clip", "procedural_ik": "Procedural IK"}
+METHOD_LABELS = {"rlanimate": "RLAnimate", "no_motion": "No motion", "class_mean": "Class mean",
+                 "nearest_clip": "Nearest clip", "procedural_ik": "Procedural IK"}
 METRIC_LABELS = {"score": "score", "smoothness": "smoothness", "label_error": "label error (autolabel)",
                  "forearm_angle_deg": "forearm angle at hold (deg)"}
 

@@ -4,7 +4,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-VARIANT_LABELS = {"rlanimate": "RLAnimate", "single_state": "single state",
+METHOD_LABELS = {"rlanimate": "RLAnimate", "single_state": "single state",
                  "single_dynamics": "single dynamics space", "supervised": "supervised loss"}
 COLUMN_LABELS = {"wave": "Wave", "point": "Point", "both": "Wave and Point"}
 
@@ -41,11 +41,11 @@ def training_curves(history, path, title=""):
 
 def figure3(histories, path, split):
     """The paper's Figure 3 row for `split` ('seen' or 'unseen'): score over epochs, one panel per
-    column (wave, point, both), one line per variant. `histories[variant][column]` is a run's history."""
+    column (wave, point, both), one line per method. `histories[method][column]` is a run's history."""
     figure, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     for axis, column in zip(axes, COLUMN_LABELS):
-        for variant, label in VARIANT_LABELS.items():
-            history = histories.get(variant, {}).get(column)
+        for method, label in METHOD_LABELS.items():
+            history = histories.get(method, {}).get(column)
             if history:
                 epochs, values = _series(history, f"{split}/score")
                 axis.plot(epochs, values, "-o", markersize=3, label=label)
@@ -75,4 +75,35 @@ def length_flexibility(results, path, threshold):
     axis.legend(fontsize=8)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def wave_hand_paths(panels, path):
+    """Generated against reference hand paths of waves, one row per request: the wrist's side-to-side
+    position relative to its shoulder over time, and its path in the frontal plane.
+
+    panels: [(title, arm, {label: (F, 10, 3) description-joint positions})], the reference first."""
+    from rlanimate_addon.core import behaviour_metrics as bm
+
+    figure, axes = plt.subplots(len(panels), 2, figsize=(11, 2.6 * len(panels)), squeeze=False)
+    for (title, arm, clips), (over_time, frontal) in zip(panels, axes):
+        for k, (label, positions) in enumerate(clips.items()):
+            wrist = bm.joint(positions, f"{arm.lower()}_wrist")
+            shoulder = bm.joint(positions, f"{arm.lower()}_shoulder")
+            style = {"color": "black", "linewidth": 2.0} if k == 0 else {"linewidth": 1.2}
+            over_time.plot(100 * (wrist[:, 0] - shoulder[:, 0]), label=label, **style)
+            frontal.plot(100 * (wrist[:, 0] - shoulder[:, 0]), 100 * (wrist[:, 2] - shoulder[:, 2]), label=label, **style)
+            run = bm.hand_up_run(positions, arm)
+            if k == 0 and run is not None:
+                over_time.axvspan(run[0], run[1], color="0.9", zorder=0)
+        over_time.set_title(f"{title}: wrist side to side (grey: reference hand up)", fontsize=9)
+        over_time.set_xlabel("frame")
+        over_time.set_ylabel("cm from shoulder")
+        frontal.set_title(f"{title}: wrist path, front view", fontsize=9)
+        frontal.set_xlabel("side (cm)")
+        frontal.set_ylabel("up (cm)")
+        frontal.set_aspect("equal", adjustable="datalim")
+        over_time.legend(fontsize=7, loc="upper left")
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
     plt.close(figure)

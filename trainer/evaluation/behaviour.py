@@ -1,0 +1,153 @@
+"""Behaviour metrics of a method on a set of requests: does it wave, point, raise and lower the arm
+like the reference clip of the same request? (core/behaviour_metrics.py; definitions in docs/METRICS.md)
+
+A method answers generate(behaviour, arm, attributes, frame_count) -> (F, 15, 3) local rotations (the
+baselines' protocol, trainer/evaluation/baselines.py); an agent's generate also takes `seed`.
+`describe` turns rotations (F, 15, 3) into descriptions (F, 42): the bpy FK environment's
+(`env.evaluate(r).descriptions`) or `core.kinematics.describe`, which agree to 1e-5.
+
+Per request, the method's answer at the clip's own length gives the paper's score and smoothness and
+the behaviour measures (`behaviour_metrics.compare`); its answer at the class-average length gives the
+score against the time-scaled reference and the DTW time-aligned score. POINT is measured with the
+method's own aim, or after aim correction (`aim.aim_at`) with exact_aim.
+"""
+import numpy as np
+
+from rlanimate_addon.core import aim, metrics, skeleton, spaces
+from rlanimate_addon.core import behaviour_metrics as bm
+
+#: Pointing targets as the sample library draws them (trainer/motion/library_plan.py): azimuth from
+#: across the body to out to the arm's side, elevation from the horizontal, distance from the shoulder.
+AZIMUTH_DEG = (-60.0, 95.0)
+ELEVATION_DEG = (-40.0, 55.0)
+DISTANCE_M = (1.5, 4.0)
+LOWEST_TARGET_M = 0.05
+EXAGGERATIONS = (0.0, 0.25, 0.5, 0.75, 1.0)
+
+
+def class_lengths(training_clips):
+    """{behaviour: mean frame count} of the training clips ('POINT', 'WAVE')."""
+    lengths = {}
+    for clip in training_clips:
+        lengths.setdefault(clip.behaviour.upper(), []).append(len(clip.rotvecs))
+    return {b: int(round(np.mean(v))) for b, v in lengths.items()}
+
+
+def clip_target(clip):
+    """(3,) the pointing target of a POINT clip in the character frame (None for a wave)."""
+    return None if clip.target is None else np.asarray(clip.target, dtype=np.float64)
+
+
+def _answer(method, behaviour, arm, attributes, frames, target, exact_aim, seed=None):
+    rotvecs = (method.generate(behaviour, arm, attributes, frames) if seed is None
+               else method.generate(behaviour, arm, attributes, frames, seed=seed))
+    if exact_aim and behaviour == "POINT":
+        rotvecs = aim.aim_at(rotvecs, arm, target)
+    return rotvecs
+
+
+def request_rows(method, clips, references, describe, lengths, exact_aim=False):
+    """One row per clip: name, behaviour, arm, score, smoothness, score_class_length, aligned_score and
+    every measure of `behaviour_metrics.compare`. references: .get(clip) -> (descriptions, positions)."""
+    rows = []
+    for clip in clips:
+        behaviour, arm, target = clip.behaviour.upper(), clip.arm.upper(), clip_target(clip)
+        own = describe(_answer(method, behaviour, arm, clip.attributes, len(clip.rotvecs), target, exact_aim))
+        at_class = describe(_answer(method, behaviour, arm, clip.attributes, lengths[behaviour], target, exact_aim))
+        reference, reference_positions = references.get(clip)
+        positions = spaces.description_joint_positions(own)
+        class_positions = spaces.description_joint_positions(at_class)
+        row = {"name": clip.name, "behaviour": behaviour.lower(), "arm": arm.lower(),
+               "score": metrics.score(positions, reference_positions),
+               "smoothness": metrics.smoothness(positions),
+               "score_class_length": bm.score_at_length(class_positions, reference_positions),
+               "aligned_score": bm.aligned_score(class_positions, reference_positions)}
+        row.update(bm.compare(own, reference, behaviour, arm, target))
+        rows.append(row)
+    return rows
+
+
+def seed_variation(method, clips, describe, seeds):
+    """Per clip: the mean distance (m) between the outputs of `seeds` at the clip's length, and whether
+    the deterministic answer (no seed) repeats exactly. -> [{name, variation, deterministic}]"""
+    rows = []
+    for clip in clips:
+        behaviour, arm, frames = clip.behaviour.upper(), clip.arm.upper(), len(clip.rotvecs)
+        outputs = [spaces.description_joint_positions(describe(method.generate(behaviour, arm, clip.attributes,
+                                                                               frames, seed=seed)))
+                   for seed in seeds]
+        first, again = (method.generate(behaviour, arm, clip.attributes, frames) for _ in range(2))
+        rows.append({"name": clip.name, "variation": bm.variation(outputs),
+                     "deterministic": bool(np.array_equal(first, again))})
+    return rows
+
+
+def random_targets(rng, arm, count):
+    """(count, 3) pointing targets in the character frame, drawn uniformly over the library's azimuth,
+    elevation and distance ranges from the arm's rest shoulder, at least LOWEST_TARGET_M above the floor."""
+    sign = 1.0 if arm == "LEFT" else -1.0
+    shoulder = skeleton.shoulder_rest_position(arm)
+    targets = []
+    while len(targets) < count:
+        azimuth, elevation = np.radians(rng.uniform(*AZIMUTH_DEG)), np.radians(rng.uniform(*ELEVATION_DEG))
+        direction = np.array([sign * np.sin(azimuth) * np.cos(elevation), -np.cos(azimuth) * np.cos(elevation),
+                              np.sin(elevation)])
+        target = shoulder + rng.uniform(*DISTANCE_M) * direction
+        if target[2] >= LOWEST_TARGET_M:
+            targets.append(target)
+    return np.array(targets)
+
+
+def pointing_sweep(method, arm, targets, frames, describe, exact_aim=False):
+    """Pointing angle (degrees, median over the hold) and hold (s) for each target (T, 3) at `frames`."""
+    angles, holds = [], []
+    for target in targets:
+        direction = spaces.pointing_direction(arm, target)
+        rotvecs = _answer(method, "POINT", arm, direction, frames, target, exact_aim)
+        descriptions = describe(rotvecs)
+        measures = bm.point_measures(spaces.description_joint_positions(descriptions),
+                                     bm.finger_direction(descriptions, arm), arm, target)
+        angles.append(measures["angle"])
+        holds.append(measures["hold_s"])
+    return {"angles": angles, "holds": holds, "median_angle": float(np.median(angles)),
+            "max_angle": float(np.max(angles)), "median_hold_s": float(np.median(holds))}
+
+
+def exaggeration_sweep(method, arm, frames, describe, exaggerations=EXAGGERATIONS):
+    """Wave measures at each exaggeration, and whether the swing rises strictly with it."""
+    measures = [bm.wave_measures(spaces.description_joint_positions(
+        describe(method.generate("WAVE", arm, e, frames))), arm) for e in exaggerations]
+    swings = [m["swing"] for m in measures]
+    return {"exaggerations": list(exaggerations), "swing": swings, "cycles": [m["cycles"] for m in measures],
+            "frequency": [m["frequency"] for m in measures],
+            "swing_rising": bool(np.all(np.diff(swings) > 0))}
+
+
+def summarise(rows):
+    """{behaviour: summary} of request rows: means of the scores, medians (and extremes where a bound
+    applies) of the behaviour measures."""
+    summary = {}
+    for behaviour in sorted({r["behaviour"] for r in rows}):
+        group = [r for r in rows if r["behaviour"] == behaviour]
+
+        def values(key):
+            return np.array([r[key] for r in group], dtype=np.float64)
+
+        entry = {"requests": len(group)}
+        for key in ("score", "score_class_length", "aligned_score", "smoothness"):
+            entry[key] = float(values(key).mean())
+        for key in ("elevation_first_error", "elevation_last_error"):
+            entry[f"{key}_median"], entry[f"{key}_max"] = float(np.median(values(key))), float(values(key).max())
+        if behaviour == "wave":
+            for key in ("swing_ratio", "frequency_ratio", "hand_height_ratio"):
+                entry[f"{key}_median"] = float(np.nanmedian(values(key)))
+            entry["swing_ratio_min"], entry["swing_ratio_max"] = (float(values("swing_ratio").min()),
+                                                                  float(values("swing_ratio").max()))
+            entry["cycles_min"], entry["cycles_median"] = float(values("cycles").min()), float(np.median(values("cycles")))
+            entry["accepted_share"] = float(values("wave_accepted").mean())
+        else:
+            entry["pointing_angle_median"] = float(np.median(values("pointing_angle")))
+            entry["pointing_angle_max"] = float(values("pointing_angle").max())
+            entry["hold_ratio_median"] = float(np.median(values("hold_ratio")))
+        summary[behaviour] = entry
+    return summary

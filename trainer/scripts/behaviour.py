@@ -1,0 +1,114 @@
+"""Behaviour metrics of RLAnimate and the baselines on the sample library's held-out requests:
+docs/results/behaviour.{json,md} and the held-out waves' hand paths (docs/results/behaviour_wave_paths.png).
+
+    nice -n 10 python -m trainer.scripts.behaviour [--agent PATH] [--clips MANIFEST] [--results DIR]
+                                                   [--targets 100] [--seeds 1 2 3 4]
+"""
+import argparse
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from rlanimate_addon.core import spaces
+from trainer.blender_io.clip_session import LibrarySession
+from trainer.blender_io.procedural_ik import ProceduralIK
+from trainer.blender_io.rig_session import new_empty_scene
+from trainer.evaluation import behaviour
+from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, neutral_pose
+from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
+from trainer.reporting.behaviour_report import write_behaviour
+from trainer.reporting.plots import wave_hand_paths
+from trainer.scripts.cli import run_main, script_args
+
+TARGET_SEED = 2024
+WAVE_PATHS = "behaviour_wave_paths.png"
+
+
+def behaviour_report(agent_path, manifest, target_count, seeds, results_dir):
+    """The report behaviour.json holds; also draws the hand-path figure into results_dir."""
+    session = LibrarySession(manifest)
+    train, test = session.train_clips, session.test_clips
+    agent = AgentMethod(agent_path)
+    methods = {"rlanimate": agent, "no_motion": NoMotion(neutral_pose(train)), "class_mean": ClassMean(train),
+               "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(neutral_pose(train))}
+
+    def describe(rotvecs):
+        return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
+
+    lengths = behaviour.class_lengths(train)
+    waves = [c for c in test if c.behaviour.upper() == "WAVE"]
+    points = [c for c in test if c.behaviour.upper() == "POINT"]
+    sets, clips = {"wave": {}, "point": {}, "point_exact_aim": {}}, {}
+    for name, method in methods.items():
+        rows = behaviour.request_rows(method, waves + points, session.references, describe, lengths)
+        aimed = behaviour.request_rows(method, points, session.references, describe, lengths, exact_aim=True)
+        summary, summary_aimed = behaviour.summarise(rows), behaviour.summarise(aimed)
+        sets["wave"][name], sets["point"][name] = summary["wave"], summary["point"]
+        sets["point_exact_aim"][name] = summary_aimed["point"]
+        clips[name] = rows
+
+    rng = np.random.default_rng(TARGET_SEED)
+    random_targets = {}
+    for arm in ("LEFT", "RIGHT"):
+        targets = behaviour.random_targets(rng, arm, target_count)
+        random_targets[arm.lower()] = {
+            "own": behaviour.pointing_sweep(agent, arm, targets, lengths["POINT"], describe),
+            "exact": behaviour.pointing_sweep(agent, arm, targets, lengths["POINT"], describe, exact_aim=True)}
+    sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], describe) for arm in ("LEFT", "RIGHT")}
+    seeded = behaviour.seed_variation(agent, waves + points, describe, seeds)
+    distances = [r["variation"] for r in seeded]
+
+    panels = []
+    for clip in waves:
+        reference = spaces.description_joint_positions(session.references.get(clip)[0])
+        answers = {label: spaces.description_joint_positions(describe(methods[key].generate(
+            "WAVE", clip.arm.upper(), clip.attributes, len(clip.rotvecs))))
+            for key, label in (("rlanimate", "RLAnimate"), ("class_mean", "class mean"))}
+        if seeds:
+            answers[f"RLAnimate seed {seeds[0]}"] = spaces.description_joint_positions(describe(agent.generate(
+                "WAVE", clip.arm.upper(), clip.attributes, len(clip.rotvecs), seed=seeds[0])))
+        panels.append((f"{clip.name} (e = {float(np.ravel(clip.attributes)[0]):.2f})", clip.arm.upper(),
+                       {"reference": reference, **answers}))
+    Path(results_dir).mkdir(parents=True, exist_ok=True)
+    wave_hand_paths(panels, Path(results_dir) / WAVE_PATHS)
+
+    training = agent.agent.metadata.get("training", {})
+    provenance = "untrained" if training.get("untrained") else ", ".join(
+        f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
+    seed_words = " ".join(str(s) for s in seeds)
+    description = (f"The {len(test)} held-out requests of the sample library (sample_rigs/clips), each answered at its "
+                   f"clip's own length (score, smoothness, behaviour measures) and at the class-average length "
+                   f"({lengths['POINT']} frames for point, {lengths['WAVE']} for wave: the time-scaled and the DTW "
+                   f"scores). RLAnimate: `{shown(agent_path)}` ({provenance}), deterministic rollouts of the numpy "
+                   f"runtime, FK by Blender. Regenerate: `nice -n 10 python -m trainer.scripts.behaviour --agent "
+                   f"{shown(agent_path)} --targets {target_count} --seeds {seed_words}`.")
+    return {"description": description, "class_lengths": lengths, "sets": sets,
+            "agent": {"targets_per_arm": target_count, "random_targets": random_targets,
+                      "exaggeration_sweep": sweeps,
+                      "variation": {"seeds": list(seeds), "requests": len(seeded), "median": float(np.median(distances)),
+                                    "min": float(np.min(distances)), "max": float(np.max(distances)),
+                                    "deterministic": sum(r["deterministic"] for r in seeded), "clips": seeded}},
+            "figures": {f"docs/results/{WAVE_PATHS}": "the held-out waves' wrist, reference against RLAnimate "
+                                                      "(deterministic and one seed) and the class mean"},
+            "clips": clips}
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.behaviour", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--agent", default=str(INSTALLED_AGENT), help="exported RLAnimate agent (.npz)")
+    parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
+    parser.add_argument("--results", default=str(RESULTS_DIR))
+    parser.add_argument("--targets", type=int, default=100, help="random unseen pointing targets per arm")
+    parser.add_argument("--seeds", type=int, nargs="*", default=[1, 2, 3, 4], help="variation seeds (not 0)")
+    options = parser.parse_args(script_args(argv))
+    torch.set_num_threads(1)
+    new_empty_scene()
+    report = behaviour_report(options.agent, options.clips, options.targets, tuple(options.seeds), options.results)
+    write_behaviour(options.results, report)
+    print((Path(options.results) / "behaviour.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))
