@@ -1,1 +1,1 @@
-"""The agent and Algorithm 1 in torch: configs, models, losses, buffer, training loop, checkpoints, agent files. No bpy."""
+"""The agent and Algorithm 1 in torch (no bpy): configs, models, losses, buffer, training, checkpoints, agent files."""

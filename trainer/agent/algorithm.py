@@ -8,7 +8,7 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
        objectives only (it self-describes with its portrayal model), so the whole rollout can be
        computed before the environment is asked for the real descriptions d'_t. Each episode
        (o, a, d', m, FK of m) is appended to the buffer;
-    3. run T update steps, each on C random chunks of L frames, with Adam on L1 + L2 + L3.
+    3. run T update steps, each on C random chunks of L frames, with Adam on the description, KL and pose terms (the paper's L1 + L2 + L3).
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
 that they explore and stay reproducible; evaluation rolls out deterministically.
 """

@@ -8,7 +8,6 @@ It is written atomically (trainer/files.py), so a run killed mid-write leaves th
 import random
 from pathlib import Path
 
-import numpy as np
 import torch
 
 from rlanimate_addon.core.errors import RLAnimateError

@@ -1,23 +1,23 @@
-"""The training objective (paper Section 3.3, equation 4): L1 + L2 + L3, plus two small extra terms.
+"""The training objective (paper Section 3.3, equation 4: L1 + L2 + L3), plus two small extra terms.
 
 On a batch of C chunks of L frames (batch-major, from trainer/agent/buffer.py):
-    l1         MSE of the decoder's p(d_t | h_t, b_t) against the real description d'_t, summed over
-               the 42 numbers, averaged over frames;
-    l2         KL(q || p) with KL balancing (DreamerV2: `kl_balance` of the gradient trains the prior,
-               the rest the posterior) and free nats (each side's mean KL per frame is clamped from
-               below at `free_nats`, so a KL already that small is not pushed further);
-    l3         Huber(M_t, mean of the animation model's Beta), summed over the 45 channels. It flows
-               back through the behaviour model into the portrayal model, because the posterior is
-               conditioned on the portrayal's self-description, as at inference;
-    portrayal  optional direct MSE of the self-description toward the clip's description (summed over
-               the 42 numbers), when `portrayal_direct_loss`;
-    policy     negative log-likelihood of the clip's pose under the Beta with its mean held fixed, so
-               only the concentrations learn: the spread of stochastic rollouts tracks the agent's
-               remaining error instead of staying at its initial value;
-    total      the sum of each term times its `*_scale`.
+    description  the paper's L1: MSE of the decoder's p(d_t | h_t, b_t) against the real description
+                 d'_t, summed over the 42 numbers, averaged over frames;
+    kl           the paper's L2: KL(q || p) with KL balancing (DreamerV2: `kl_balance` of the gradient
+                 trains the prior, the rest the posterior) and free nats (each side's mean KL per frame
+                 is clamped from below at `free_nats`, so a KL already that small is not pushed further);
+    pose         the paper's L3: Huber(M_t, mean of the animation model's Beta), summed over the 45
+                 channels. It flows back through the behaviour model into the portrayal model, because
+                 the posterior is conditioned on the portrayal's self-description, as at inference;
+    portrayal    optional direct MSE of the self-description toward the clip's description (summed
+                 over the 42 numbers), when `portrayal_direct_loss`;
+    policy       negative log-likelihood of the clip's pose under the Beta with its mean held fixed, so
+                 only the concentrations learn: the spread of stochastic rollouts tracks the agent's
+                 remaining error instead of staying at its initial value;
+    total        the sum of each term times its `*_scale`.
 The previous action a_{t-1} is the buffer's (the agent's own earlier rollout, teacher forced); the
-supervised variant is behaviour cloning instead: a_{t-1} is the clip's pose M_{t-1}, L1's target is
-the clip's description, and there is no L2. docs/AGENT.md gives the reasons.
+supervised variant is behaviour cloning instead: a_{t-1} is the clip's pose M_{t-1}, the description
+term's target is the clip's description, and there is no KL term. docs/AGENT.md gives the reasons.
 """
 import torch
 import torch.nn.functional as F
@@ -30,7 +30,7 @@ POSE_MARGIN = 1e-3
 
 
 def agent_losses(agent, batch, config):
-    """{"l1", "l2", "l3", "portrayal", "policy", "total"}: scalar tensors for `agent` on `batch`."""
+    """{"description", "kl", "pose", "portrayal", "policy", "total"}: scalar tensors for `agent` on `batch`."""
     objective, motion = batch["objective"], batch["motion"]  # (C, L, 7), (C, L, 45)
     supervised = agent.variant == "supervised"
     played = motion if supervised else batch["action"]  # (C, L, 45)
@@ -41,16 +41,17 @@ def agent_losses(agent, batch, config):
     features = unrolled["features"]  # (C, L, F)
 
     description_target = batch["motion_description"] if supervised else batch["description"]
-    terms = {"l1": squared_error(agent.decode(features), description_target)}
-    terms["l2"] = (torch.zeros((), dtype=objective.dtype) if supervised else
+    terms = {"description": squared_error(agent.decode(features), description_target)}  # the paper's L1
+    terms["kl"] = (torch.zeros((), dtype=objective.dtype) if supervised else  # L2
                    balanced_kl(unrolled["posterior"], unrolled["prior"], config.kl_balance, config.free_nats))
     policy = agent.policy(features)
-    terms["l3"] = F.huber_loss(policy.mean, motion, reduction="none", delta=config.huber_delta).sum(-1).mean()
+    pose_error = F.huber_loss(policy.mean, motion, reduction="none", delta=config.huber_delta)  # (C, L, 45)
+    terms["pose"] = pose_error.sum(-1).mean()  # L3
     terms["portrayal"] = (squared_error(described, batch["motion_description"])
                           if described is not None and config.portrayal_direct_loss
                           else torch.zeros((), dtype=objective.dtype))
     terms["policy"] = concentration_nll(policy, motion)
-    scales = {"l1": config.l1_scale, "l2": config.l2_scale, "l3": config.l3_scale,
+    scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
               "portrayal": config.portrayal_scale, "policy": config.policy_scale}
     terms["total"] = sum(scales[name] * value for name, value in terms.items())
     return terms

@@ -161,7 +161,8 @@ def _report(settings, trainer, final, epochs):
     cpu_seconds = sum(e["cpu_seconds"] for e in trainer.history)
     return {
         "behaviour": settings.behaviour, "variant": settings.variant, "preset": settings.preset,
-        "seed": settings.seed, "clips": str(manifest_path(settings.clips)), "epochs": epochs, "episodes": len(trainer.buffer),
+        "seed": settings.seed, "clips": str(manifest_path(settings.clips)), "epochs": epochs,
+        "episodes": len(trainer.buffer),
         "frames": trainer.buffer.frames, "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
         "torch_threads": torch.get_num_threads(),
         "held_out": final["unseen"], "training": final["seen"],

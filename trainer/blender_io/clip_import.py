@@ -217,7 +217,8 @@ def _to_canonical(canonical, frames, calibration_frames, calibration_heads, bone
     index = {name: i for i, name in enumerate(canonical)}
     source_calibration = {name: calibration_frames[i] for name, i in index.items()}
     if (bone_map.calibration == "rest" and "Hips" in index
-            and canonicalise.carries_canonical_axes(source_calibration, {n: calibration_heads[i] for n, i in index.items()})):
+            and canonicalise.carries_canonical_axes(source_calibration,
+                                                    {n: calibration_heads[i] for n, i in index.items()})):
         # The bones carry the canonical axes (a rig built from core.skeleton, like the sample
         # character): their world frames are canonical frames whatever the file's rest, and the hips
         # give the facing. That matters because an FBX without a skinned mesh has no bind pose, and

@@ -6,28 +6,24 @@ share one armature datablock and each hold their own pose. A batch of P poses is
 (depsgraph) update, bulk-read every instance's pose-bone matrices. Results are in the character
 frame: the armature's object space with its scale removed, in metres.
 
-Runs the same under `blender -b -P` and under `python` with the bpy module.
+Runs the same under `blender -b -P` and under `python` with the bpy module. Its interface, input
+checks and results are trainer/motion/fk.py's, which also holds the numpy environment.
 """
-from collections import namedtuple
-
 import numpy as np
 
-from rlanimate_addon.core import rotations, skeleton, spaces
+from rlanimate_addon.core import rotations, skeleton
 from rlanimate_addon.core.errors import RLAnimateError
-
 from trainer.blender_io import rig_session
-
-#: descriptions (P, 42), joint_positions (P, 10, 3) of skeleton.DESCRIPTION_JOINTS, bone_heads
-#: (P, n_bones, 3) in FKEnvironment.bone_names order; all in the character frame, metres.
-FKResult = namedtuple("FKResult", "descriptions joint_positions bone_heads")
+from trainer.motion.fk import FKEnvironmentBase
+from trainer.paths import SAMPLE_RIG_BLEND
 
 _COLLECTION_NAME = "RLAnimate_FK_instances"
 
 
-class FKEnvironment:
+class FKEnvironment(FKEnvironmentBase):
     """Blender as a batched FK function from local joint rotations to descriptions and joint positions."""
 
-    def __init__(self, rig_path=rig_session.SAMPLE_RIG_BLEND, instances=8):
+    def __init__(self, rig_path=SAMPLE_RIG_BLEND, instances=8):
         """Load the rig at `rig_path` (.blend or .fbx) and make `instances` armature objects of it.
 
         8 instances measured fastest on one core (docs/BENCHMARKS.md, "FK environment"): each depsgraph
@@ -47,14 +43,12 @@ class FKEnvironment:
         self.bone_names = tuple([n for n in skeleton.BONE_NAMES if n in rig_names]
                                 + [n for n in rig_names if n not in skeleton.BONE_BY_NAME])
         self._bone_index = {name: i for i, name in enumerate(self.bone_names)}
-        pose_names = [skeleton.strip_prefix(b.name) for b in self.rig.pose.bones]
-        self._pose_index = {name: k for k, name in enumerate(pose_names)}  # pose bones are in hierarchy order
-        self._pose_to_bone = np.array([self._bone_index[name] for name in pose_names])
-        self._action_slots = np.array([self._pose_index[j] for j in skeleton.ACTION_JOINTS])
+        self._pose_names = tuple(skeleton.strip_prefix(b.name) for b in self.rig.pose.bones)  # hierarchy order
+        self._pose_to_bone = np.array([self._bone_index[name] for name in self._pose_names])
         self._collection = self._bpy.data.collections.new(_COLLECTION_NAME)
         self._bpy.context.scene.collection.children.link(self._collection)
         self.objects = [self.rig] + [self._instance(k) for k in range(1, int(instances))]
-        self._matrices = np.zeros(len(pose_names) * 16, dtype=np.float32)
+        self._matrices = np.zeros(len(self._pose_names) * 16, dtype=np.float32)
 
     @property
     def instances(self):
@@ -66,13 +60,8 @@ class FKEnvironment:
         self._collection.objects.link(obj)
         return obj
 
-    def evaluate(self, action_rotvecs, extra_rotvecs=None):
-        """FKResult for P poses.
-
-        action_rotvecs: (P, 15, 3) local rotation vectors of skeleton.ACTION_JOINTS, relative to rest.
-        extra_rotvecs: optional {bone name: (P, 3)} for other bones (e.g. fingers); the rest stay at rest.
-        """
-        rotvecs = self._checked(action_rotvecs, extra_rotvecs)  # (P, B, 3) pose-bone order
+    def _pose(self, rotvecs):
+        """(P, B, 3) rotation vectors in pose-bone order -> bone heads (P, n_bones, 3), eye Y axes {eye: (P, 3)}."""
         count = len(rotvecs)
         quats = rotations.rotvec_to_quat(rotvecs).astype(np.float32)  # (P, B, 4)
         bone_count = len(self.bone_names)
@@ -93,39 +82,7 @@ class FKEnvironment:
                 heads[start + offset] = pose[:, :3, 3] * self.scale
                 for eye, slot in eye_slots.items():
                     eye_axes[eye][start + offset] = pose[slot, :3, 1]
-        positions = {name: heads[:, i] for i, name in enumerate(self.bone_names)}
-        descriptions = spaces.describe(positions, eye_axes)
-        return FKResult(descriptions, spaces.description_joint_positions(descriptions), heads)
-
-    def describe_actions(self, actions01, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-        """FKResult for (P, 45) actions in [0, 1], decoded with `bounds` (45, 2) by spaces.decode_action."""
-        actions = np.asarray(actions01, dtype=np.float64)
-        if actions.ndim != 2 or actions.shape[1] != spaces.ACTION_SIZE:
-            raise RLAnimateError(f"Actions must have shape (P, {spaces.ACTION_SIZE}), got {actions.shape}.")
-        return self.evaluate(spaces.decode_action(actions, bounds))
-
-    def _checked(self, action_rotvecs, extra_rotvecs):
-        """Validate the inputs and return (P, B, 3) rotation vectors in pose-bone order."""
-        actions = np.asarray(action_rotvecs, dtype=np.float64)
-        joints = len(skeleton.ACTION_JOINTS)
-        if actions.ndim != 3 or actions.shape[1:] != (joints, 3):
-            raise RLAnimateError(f"Action rotations must have shape (P, {joints}, 3), got {actions.shape}.")
-        if not np.all(np.isfinite(actions)):
-            raise RLAnimateError("Action rotations contain NaN or infinity: check the agent's output.")
-        rotvecs = np.zeros((len(actions), len(self._pose_index), 3))
-        rotvecs[:, self._action_slots] = actions
-        for name, values in (extra_rotvecs or {}).items():
-            bone = skeleton.strip_prefix(name)
-            if bone not in self._pose_index:
-                raise RLAnimateError(f"The rig has no bone {name!r}: use names of skeleton.BONES.")
-            values = np.asarray(values, dtype=np.float64)
-            if values.shape != (len(actions), 3):
-                raise RLAnimateError(f"Rotations of {name!r} must have shape ({len(actions)}, 3), "
-                                     f"got {values.shape}.")
-            if not np.all(np.isfinite(values)):
-                raise RLAnimateError(f"Rotations of {name!r} contain NaN or infinity.")
-            rotvecs[:, self._pose_index[bone]] = values
-        return rotvecs
+        return heads, eye_axes
 
 
 def _reset_pose(rig):

@@ -1,1 +1,1 @@
-"""Motion clips in numpy: the clip type and manifests, canonicalisation, labels, the numpy FK environment, synthesis. No bpy."""
+"""Motion clips in numpy (no bpy): the clip type and manifests, canonicalisation, labels, FK, synthesis."""

@@ -4,7 +4,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-METHOD_LABELS = {"rlanimate": "RLAnimate", "single_state": "single state",
+VARIANT_LABELS = {"rlanimate": "RLAnimate", "single_state": "single state",
                  "single_dynamics": "single dynamics space", "supervised": "supervised loss"}
 COLUMN_LABELS = {"wave": "Wave", "point": "Point", "both": "Wave and Point"}
 
@@ -41,11 +41,11 @@ def training_curves(history, path, title=""):
 
 def figure3(histories, path, split):
     """The paper's Figure 3 row for `split` ('seen' or 'unseen'): score over epochs, one panel per
-    column (wave, point, both), one line per method. `histories[method][column]` is a run's history."""
+    column (wave, point, both), one line per variant. `histories[variant][column]` is a run's history."""
     figure, axes = plt.subplots(1, 3, figsize=(15, 4.2))
     for axis, column in zip(axes, COLUMN_LABELS):
-        for method, label in METHOD_LABELS.items():
-            history = histories.get(method, {}).get(column)
+        for variant, label in VARIANT_LABELS.items():
+            history = histories.get(variant, {}).get(column)
             if history:
                 epochs, values = _series(history, f"{split}/score")
                 axis.plot(epochs, values, "-o", markersize=3, label=label)

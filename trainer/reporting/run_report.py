@@ -12,7 +12,8 @@ def write_run_report(report, output):
         json.dump(report, handle, indent=2)
     rows = []
     for label, key in (("held-out (unseen)", "held_out"), ("training (seen)", "training")):
-        rows.append([label, len(report[key]["clips"]), f"{report[key]['score']:.2f}", f"{report[key]['smoothness']:.2f}"])
+        rows.append([label, len(report[key]["clips"]), f"{report[key]['score']:.2f}",
+                     f"{report[key]['smoothness']:.2f}"])
         for behaviour, entry in report[key]["by_behaviour"].items():
             count = sum(c["behaviour"] == behaviour for c in report[key]["clips"])
             rows.append([f"{label}, {behaviour}", count, f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}"])

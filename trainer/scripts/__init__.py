@@ -1,1 +1,1 @@
-"""The trainer's command lines: the only modules with argparse and `__main__`, run as `python -m trainer.scripts.NAME`."""
+"""The trainer's command lines, run as `python -m trainer.scripts.NAME`: the only modules with argparse and `__main__`."""

@@ -2,12 +2,12 @@
 
     nice -n 10 python -m trainer.scripts.experiments [--preset default] [--epoch-scale 1.0] [--jobs 2]
 
-Trains the four methods (RLAnimate and its three ablations) on each column (wave, point, both)
+Trains the four variants (RLAnimate and its three ablations) on each column (wave, point, both)
 for the paper's 50 / 100 epochs times --epoch-scale, each run by `trainer.scripts.train` in its own
-process, --jobs at a time, into runs/experiments/<method>_<column>/. Runs that already finished are
+process, --jobs at a time, into runs/experiments/<variant>_<column>/. Runs that already finished are
 kept and interrupted ones resume from their checkpoints. Then it writes to docs/results/ (with
 --seed N other than 0: runs/experiments_seedN/ and docs/results/seedN/):
-    table4.json   {method: {column: {score, smoothness, episodes, train_seconds}}} (held-out clips)
+    table4.json   {variant: {column: {score, smoothness, episodes, train_seconds}}} (held-out clips)
     table4.md     the same as a table, with the training-clip scores and the run settings
     figure3_seen.png, figure3_unseen.png   score over epochs on seen and unseen clips
     length_flexibility.json/.png           smoothness of the RLAnimate both-agent's held-out gestures
@@ -45,7 +45,7 @@ def build_parser():
     parser.add_argument("--preset", default="default")
     parser.add_argument("--epoch-scale", type=float, default=1.0,
                         help="fraction of the paper's 50 / 100 epochs to train (CPU budget)")
-    parser.add_argument("--methods", nargs="+", choices=VARIANTS, default=list(VARIANTS))
+    parser.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(VARIANTS))
     parser.add_argument("--columns", nargs="+", choices=COLUMNS, default=list(COLUMNS))
     parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
     parser.add_argument("--runs", help="default: runs/experiments, runs/experiments_seed<N> for another seed")
@@ -67,8 +67,8 @@ def parse_options(argv=None):
     return options
 
 
-def run_folder(options, method, column):
-    return Path(options.runs) / f"{method}_{column}"
+def run_folder(options, variant, column):
+    return Path(options.runs) / f"{variant}_{column}"
 
 
 def planned_epochs(options, column):
@@ -80,37 +80,37 @@ def is_finished(folder, epochs):
     return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
 
 
-def train_command(options, method, column):
-    folder = run_folder(options, method, column)
+def train_command(options, variant, column):
+    folder = run_folder(options, variant, column)
     command = [sys.executable, "-m", "trainer.scripts.train", "--behaviour", column,
-               "--variant", method, "--preset", options.preset, "--clips", options.clips,
+               "--variant", variant, "--preset", options.preset, "--clips", options.clips,
                "--epochs", str(planned_epochs(options, column)), "--seed", str(options.seed),
                "--output", str(folder), "--eval-every", str(options.eval_every), "--quiet"]
     return command + (["--resume"] if (folder / checkpoint.FILENAME).is_file() else [])
 
 
 def train_all(options):
-    """Run every unfinished (method, column), --jobs processes at a time; raise if one fails."""
-    pending = [(m, c) for m in options.methods for c in options.columns
+    """Run every unfinished (variant, column), --jobs processes at a time; raise if one fails."""
+    pending = [(m, c) for m in options.variants for c in options.columns
                if not is_finished(run_folder(options, m, c), planned_epochs(options, c))]
     running = []
     while pending or running:
         while pending and len(running) < options.jobs:
-            method, column = pending.pop(0)
-            folder = run_folder(options, method, column)
+            variant, column = pending.pop(0)
+            folder = run_folder(options, variant, column)
             folder.mkdir(parents=True, exist_ok=True)
             log = open(folder / "train.log", "w")
-            running.append((method, column, log, subprocess.Popen(
-                train_command(options, method, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
+            running.append((variant, column, log, subprocess.Popen(
+                train_command(options, variant, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
         time.sleep(1.0)
         for entry in list(running):
-            method, column, log, process = entry
+            variant, column, log, process = entry
             if process.poll() is not None:
                 log.close()
                 running.remove(entry)
                 if process.returncode != 0:
-                    raise RuntimeError(f"{method} {column} failed: see {run_folder(options, method, column)}/train.log")
-                print(f"finished {method} {column}", flush=True)
+                    raise RuntimeError(f"{variant} {column} failed: see {run_folder(options, variant, column)}/train.log")
+                print(f"finished {variant} {column}", flush=True)
 
 
 def load_run(folder):
@@ -121,39 +121,39 @@ def load_run(folder):
 
 def table4_markdown(table, seen, settings):
     lines = ["# Table 4: final score and smoothness imitating held-out clips", "", settings, "",
-             "| method | wave score | wave smooth. | point score | point smooth. | both score | both smooth. |",
+             "| variant | wave score | wave smooth. | point score | point smooth. | both score | both smooth. |",
              "|---|---|---|---|---|---|---|"]
-    for method, columns in table.items():
+    for variant, columns in table.items():
         cells = []
         for column in COLUMNS:
             entry = columns.get(column)
             cells += [f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}"] if entry else ["-", "-"]
-        lines.append(f"| {plots.METHOD_LABELS[method]} | " + " | ".join(cells) + " |")
+        lines.append(f"| {plots.VARIANT_LABELS[variant]} | " + " | ".join(cells) + " |")
     lines += ["", "Sample episodes, training time (wall clock and CPU seconds, on a machine shared with other "
               "jobs) and score on 10 training (seen) clips per run:", "",
-              "| method | column | episodes | wall s | CPU s | seen score | seen smooth. |", "|---|---|---|---|---|---|---|"]
-    for method, columns in table.items():
+              "| variant | column | episodes | wall s | CPU s | seen score | seen smooth. |", "|---|---|---|---|---|---|---|"]
+    for variant, columns in table.items():
         for column, entry in columns.items():
-            lines.append(f"| {plots.METHOD_LABELS[method]} | {column} | {entry['episodes']} | "
-                         f"{entry['train_seconds']:.0f} | {seen[method][column]['cpu_seconds']:.0f} | "
-                         f"{seen[method][column]['score']:.2f} | {seen[method][column]['smoothness']:.2f} |")
+            lines.append(f"| {plots.VARIANT_LABELS[variant]} | {column} | {entry['episodes']} | "
+                         f"{entry['train_seconds']:.0f} | {seen[variant][column]['cpu_seconds']:.0f} | "
+                         f"{seen[variant][column]['score']:.2f} | {seen[variant][column]['smoothness']:.2f} |")
     return "\n".join(lines) + "\n"
 
 
 def write_table_and_figures(options, results):
-    """table4.json/.md and Figure 3 from every finished run of the requested methods and columns."""
+    """table4.json/.md and Figure 3 from every finished run of the requested variants and columns."""
     table, seen, histories = {}, {}, {}
-    for method in options.methods:
+    for variant in options.variants:
         for column in options.columns:
-            folder = run_folder(options, method, column)
+            folder = run_folder(options, variant, column)
             if not is_finished(folder, planned_epochs(options, column)):
                 continue
             report, history = load_run(folder)
-            table.setdefault(method, {})[column] = {
+            table.setdefault(variant, {})[column] = {
                 "score": report["held_out"]["score"], "smoothness": report["held_out"]["smoothness"],
                 "episodes": report["episodes"], "train_seconds": report["train_seconds"]}
-            seen.setdefault(method, {})[column] = {**report["training"], "cpu_seconds": report["train_cpu_seconds"]}
-            histories.setdefault(method, {})[column] = history
+            seen.setdefault(variant, {})[column] = {**report["training"], "cpu_seconds": report["train_cpu_seconds"]}
+            histories.setdefault(variant, {})[column] = history
     settings = (f"Preset `{options.preset}`, seed {options.seed}, epochs = {options.epoch_scale:g} x the paper's "
                 f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1). "
                 f"Regenerate: `nice -n 10 python -m trainer.scripts.experiments --preset {options.preset} "
@@ -194,9 +194,9 @@ def main(argv=None):
     results.mkdir(parents=True, exist_ok=True)
     train_all(options)
     table = write_table_and_figures(options, results)
-    for method, columns in table.items():
+    for variant, columns in table.items():
         for column, entry in columns.items():
-            print(f"{method:16s} {column:5s} held-out score {entry['score']:6.2f} smoothness "
+            print(f"{variant:16s} {column:5s} held-out score {entry['score']:6.2f} smoothness "
                   f"{entry['smoothness']:6.2f} episodes {entry['episodes']} {entry['train_seconds']:.0f}s")
     flexibility = write_length_flexibility(options, results)
     if flexibility:

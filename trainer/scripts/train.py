@@ -17,7 +17,7 @@ from trainer.agent.models import VARIANTS
 from trainer.agent.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.files import atomic_copy
-from trainer.paths import DEFAULT_MANIFEST, DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR
+from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR
 from trainer.scripts.cli import run_main, script_args
 
 
@@ -27,8 +27,8 @@ def build_parser():
     defaults = NEW_RUN_DEFAULTS
     parser = argparse.ArgumentParser(prog="trainer/train.py", description=__doc__.split("\n\n")[0])
     parser.add_argument("--behaviour", choices=BEHAVIOUR_CHOICES, help=f"default {defaults['behaviour']}")
-    parser.add_argument("--clips", help=f"clip library: a manifest.json or the folder that holds one "
-                                        f"(default {DEFAULT_MANIFEST.parent.parent.name}/{DEFAULT_MANIFEST.parent.name})")
+    parser.add_argument("--clips", help="clip library: a manifest.json or the folder that holds one "
+                                        "(default sample_rigs/clips)")
     parser.add_argument("--epochs", type=int,
                         help="iterations of Algorithm 1 (default: the preset's, the paper's 50 for one behaviour "
                              "and 100 for both; on --resume, the run's own)")

@@ -1,8 +1,7 @@
 """The torch agent: shapes, the file layout it exports, losses that fall, and gradients that reach
-the portrayal model through L3."""
+the portrayal model through the pose term (the paper's L3)."""
 import dataclasses
 
-import numpy as np
 import pytest
 import torch
 
@@ -69,10 +68,10 @@ def test_sampled_rollout_is_reproducible_from_its_generator_alone():
 def test_losses_report_every_term_as_a_finite_scalar():
     config, train = load_preset("debug")
     losses = RLAnimateAgent(config).losses(synthetic_batch(4, 8), train)
-    assert set(losses) == {"l1", "l2", "l3", "portrayal", "policy", "total"}
+    assert set(losses) == {"description", "kl", "pose", "portrayal", "policy", "total"}
     for value in losses.values():
         assert value.shape == () and torch.isfinite(value)
-    scales = {"l1": train.l1_scale, "l2": train.l2_scale, "l3": train.l3_scale,
+    scales = {"description": train.description_scale, "kl": train.kl_scale, "pose": train.pose_scale,
               "portrayal": train.portrayal_scale, "policy": train.policy_scale}
     expected_total = sum(scales[name] * losses[name] for name in scales)
     assert torch.allclose(losses["total"], expected_total)
@@ -93,14 +92,14 @@ def test_losses_fall_on_a_tiny_batch(variant):
         optimiser.step()
         history.append({name: float(value.detach()) for name, value in losses.items()})
     assert history[-1]["total"] < 0.5 * history[0]["total"]
-    assert history[-1]["l3"] < 0.75 * history[0]["l3"]
-    assert history[-1]["l1"] < 0.5 * history[0]["l1"]
+    assert history[-1]["pose"] < 0.75 * history[0]["pose"]
+    assert history[-1]["description"] < 0.5 * history[0]["description"]
 
 
 def test_l3_reaches_the_portrayal_model_through_the_behaviour_model():
     config, train = load_preset("debug")
     agent = RLAnimateAgent(config)
-    agent.losses(synthetic_batch(4, 8), dataclasses.replace(train, portrayal_direct_loss=False))["l3"].backward()
+    agent.losses(synthetic_batch(4, 8), dataclasses.replace(train, portrayal_direct_loss=False))["pose"].backward()
     for name, parameter in agent.named_parameters():
         if name.startswith(("portrayal.", "task_rnn.", "behaviour_cell.", "posterior.", "animation.")):
             assert parameter.grad is not None and parameter.grad.abs().sum() > 0, name
@@ -121,7 +120,7 @@ def test_supervised_variant_clones_the_clip_without_kl():
     agent = RLAnimateAgent(config, "supervised")
     batch = synthetic_batch(4, 8)
     losses = agent.losses(batch, train)
-    assert float(losses["l2"]) == 0.0
+    assert float(losses["kl"]) == 0.0
     torch.manual_seed(1)
     changed = dict(batch, action=torch.rand_like(batch["action"]),
                    description=torch.rand_like(batch["description"]))

@@ -1,4 +1,5 @@
-"""trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its outputs exist and load without torch."""
+"""trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its
+outputs exist and load without torch."""
 import json
 import subprocess
 import sys
