@@ -1,4 +1,8 @@
 """Export FBX: the active armature, its meshes and its baked animation, through Blender's FBX exporter."""
+import os
+import re
+from pathlib import Path
+
 import bpy
 from bpy_extras.io_utils import ExportHelper
 
@@ -36,6 +40,30 @@ def animation_range(rig):
     return int(min(r[0] for r in ranges)), int(round(max(r[1] for r in ranges)))
 
 
+def check_path(filepath):
+    """The absolute path to write, or RLAnimateError naming what is wrong with it."""
+    if not filepath:
+        raise RLAnimateError("No file chosen: give a path ending in .fbx.")
+    if "\0" in filepath:
+        raise RLAnimateError(f"The path {filepath!r} holds a NUL character: choose another file name.")
+    path = Path(bpy.path.abspath(filepath))
+    if path.is_dir():
+        raise RLAnimateError(f"{path} is a folder: give a file name ending in .fbx.")
+    if not path.parent.is_dir():
+        raise RLAnimateError(f"The folder {path.parent} does not exist: choose an existing folder.")
+    if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise RLAnimateError(f"Cannot write {path}: you lack write permission there. Choose a folder you can "
+                             "write to.")
+    return path
+
+
+def _reason(error):
+    """The last line of the Python error inside the RuntimeError bpy.ops raises (not its traceback)."""
+    lines = [line.strip() for line in str(error).splitlines()]
+    errors = [line for line in lines if re.match(r"^[A-Za-z_.]*(Error|Exception): ", line)]
+    return errors[-1] if errors else (lines[0] if lines else "unknown error")
+
+
 def export_rig(context, filepath):
     """Write the active armature and its meshes to `filepath`; returns a one-line summary.
 
@@ -45,8 +73,7 @@ def export_rig(context, filepath):
     rig = context.active_object
     if rig is None or rig.type != "ARMATURE":
         raise RLAnimateError("The active object is not an armature: select the character's armature.")
-    if not filepath:
-        raise RLAnimateError("No file chosen: give a path ending in .fbx.")
+    path = check_path(filepath)
     scene, view_layer = context.scene, context.view_layer
     objects = [rig] + rig_meshes(rig, scene)
     selected = [o for o in view_layer.objects if o.select_get()]
@@ -59,9 +86,10 @@ def export_rig(context, filepath):
             obj.select_set(True)
         if keyed is not None:
             scene.frame_start, scene.frame_end = min(frame_range[0], keyed[0]), max(frame_range[1], keyed[1])
-        bpy.ops.export_scene.fbx(filepath=bpy.path.abspath(filepath), **FBX_SETTINGS)
+        bpy.ops.export_scene.fbx(filepath=str(path), **FBX_SETTINGS)
     except RuntimeError as error:
-        raise RLAnimateError(f"Could not write {filepath}: {error}. Choose a folder you can write to.") from None
+        raise RLAnimateError(f"Could not write {path}: {_reason(error)}. Choose a folder you can write "
+                             "to.") from None
     finally:
         scene.frame_start, scene.frame_end = frame_range
         for obj in objects:

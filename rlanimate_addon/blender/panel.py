@@ -3,7 +3,7 @@ import bpy
 
 from ..core import gesture
 from ..core.errors import RLAnimateError
-from . import preferences
+from . import armature_io, constraints, preferences
 
 
 def _agent_summary(context, behaviour):
@@ -16,6 +16,18 @@ def _agent_summary(context, behaviour):
         return name, str(error)
     shortest, longest = gesture.supported_length_range(average)
     return f"{name}: learned {int(round(average))} frames, supported {shortest}-{longest}", None
+
+
+def _overriding_constraints(context, settings):
+    """Constraints of the active armature that would override the gesture (empty for other objects)."""
+    obj = context.active_object
+    if obj is None or obj.type != "ARMATURE":
+        return []
+    try:
+        _, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
+    except RLAnimateError:  # Generate names the problem
+        return []
+    return constraints.overriding(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm))
 
 
 class VIEW3D_PT_rlanimate(bpy.types.Panel):
@@ -56,4 +68,10 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             box.label(text=error, icon="ERROR")
 
         layout.operator("rlanimate.generate_gesture", icon="ARMATURE_DATA")
+        overriding = _overriding_constraints(context, settings)
+        if overriding:
+            box = layout.box()
+            box.label(text=f"{constraints.describe(overriding)} would override the gesture", icon="ERROR")
+            box.operator("rlanimate.generate_gesture", text="Generate, Muting Constraints",
+                         icon="CONSTRAINT_BONE").mute_constraints = True
         layout.operator("rlanimate.export_fbx", icon="EXPORT")

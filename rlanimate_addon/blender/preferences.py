@@ -39,7 +39,11 @@ def selected_agent_path(context):
 
 
 def load_agent(path):
-    """The agent at `path`, loaded once per file version; RLAnimateError when missing or damaged."""
+    """The agent at `path`, loaded once per file version; RLAnimateError when missing or damaged.
+
+    A failure is cached like a success, per path, modification time and size: the panel asks on every
+    redraw, and a bad file is read once, not on each of them.
+    """
     from ..core import runtime
 
     path = Path(path)
@@ -51,7 +55,12 @@ def load_agent(path):
     key = (str(path), stat.st_mtime_ns, stat.st_size)
     if key not in _cache:
         _cache.clear()
-        _cache[key] = runtime.load_agent(path)
+        try:
+            _cache[key] = runtime.load_agent(path)
+        except RLAnimateError as error:
+            _cache[key] = str(error)
+    if isinstance(_cache[key], str):
+        raise RLAnimateError(_cache[key])
     return _cache[key]
 
 

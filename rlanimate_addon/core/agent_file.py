@@ -11,8 +11,14 @@ Layout (format FORMAT_NAME, version FORMAT_VERSION):
 `expected_weight_shapes` is the single statement of which arrays an agent of a given config and
 variant has; the torch model, the exporter and the numpy runtime all agree with it.
 """
+import contextlib
 import json
+import math
+import struct
+import tokenize
+import warnings
 import zipfile
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -84,39 +90,118 @@ def expected_weight_shapes(agent_config, variant):
 
 
 def load_agent_file(path):
-    """(weights {name: float array}, metadata dict) from the agent file at `path`, fully validated."""
+    """(weights {name: float array}, metadata dict) from the agent file at `path`, fully validated.
+
+    Nothing is allocated or inflated before its declared size is checked: the metadata against
+    MAX_METADATA_BYTES, each weight array's npy header against the shape the metadata implies. Every
+    failure is an RLAnimateError.
+    """
     path = Path(path)
     if not path.is_file():
         raise RLAnimateError(f"No agent file at {path}: choose an existing .npz agent in the add-on preferences.")
-    arrays = _read_arrays(path)
-    metadata = _parse_metadata(path, arrays.pop(METADATA_KEY, None))
-    _check_weights(path, arrays, metadata)
-    _check_metadata_values(path, metadata)
-    return arrays, metadata
+    with _open_archive(path) as archive:
+        entries = _entries(path, archive)
+        metadata = _parse_metadata(path, _read_metadata(path, archive, entries.pop(METADATA_KEY, None)))
+        expected = _check_metadata_values(path, metadata)
+        weights = _read_weights(path, archive, entries, expected)
+    return weights, metadata
 
 
-def _read_arrays(path):
+#: Hard caps, far above any agent the trainer writes (the paper preset's file is under 10 MB), checked
+#: before anything is read or allocated.
+MAX_FILE_BYTES = 256 * 2 ** 20
+MAX_ENTRIES = 1024
+MAX_METADATA_BYTES = 4 * 2 ** 20
+MAX_PARAMETERS = 16 * 2 ** 20
+MAX_SIZE = 4096  # any one agent_config width
+MAX_HIDDEN_LAYERS = 16
+MAX_AVERAGE_FRAMES = 10_000
+MAX_ABS_BOUND = 2.0 * np.pi  # radians per rotation-vector component
+MAX_CONFIG_SCALAR = 1e6
+#: What a hostile archive can raise from zipfile, zlib and numpy's npy header parser (ast, tokenize,
+#: dtype) before a check of ours sees it: `_unreadable` turns each into an RLAnimateError.
+_UNREADABLE = (OSError, EOFError, ValueError, TypeError, KeyError, IndexError, OverflowError, MemoryError,
+               RecursionError, SyntaxError, NotImplementedError, RuntimeError, zipfile.BadZipFile, zlib.error,
+               struct.error, tokenize.TokenError)
+_NPY = ".npy"
+
+
+@contextlib.contextmanager
+def _unreadable(path):
+    """Around code that parses the file's bytes: what the parsers raise becomes 'truncated or damaged'."""
     try:
-        archive = np.load(path, allow_pickle=False)
-        if not hasattr(archive, "files"):  # a bare .npy array, not an archive
-            raise _not_an_agent(path)
-        with archive:
-            return {name: archive[name] for name in archive.files}
-    except ValueError as error:
-        if "Object arrays cannot be loaded" in str(error):
-            raise RLAnimateError(f"The agent file {path} carries a pickled Python object, which is refused "
-                                 f"because loading it could run code: use an agent exported by "
-                                 f"trainer/agent/agent_export.py.") from error
-        if "pickled data" in str(error):  # neither .npz nor .npy: numpy would have to unpickle it
-            raise RLAnimateError(f"{path} is not an RLAnimate agent file (not a numpy archive; pickled "
-                                 f"data is refused): choose a .npz written by trainer/agent/agent_export.py.") from error
+        yield
+    except _UNREADABLE as error:
         raise _damaged(path, error) from error
-    except (OSError, EOFError, zipfile.BadZipFile, KeyError) as error:
-        raise _damaged(path, error) from error
+
+
+def _open_archive(path):
+    with _unreadable(path):
+        size = path.stat().st_size
+        with open(path, "rb") as handle:
+            magic = handle.read(2)
+    if size > MAX_FILE_BYTES:
+        raise RLAnimateError(f"The agent file {path} is {size / 2 ** 20:.0f} MB, more than any agent "
+                             f"({MAX_FILE_BYTES // 2 ** 20} MB at most): choose a .npz written by "
+                             f"trainer/agent/agent_export.py.")
+    if not magic:
+        raise _damaged(path, "the file is empty")
+    if magic != b"PK":  # a bare .npy, a pickle, text: numpy would have to unpickle some of them
+        raise RLAnimateError(f"{path} is not an RLAnimate agent file (not a numpy .npz archive; pickled data is "
+                             f"refused): choose a .npz written by trainer/agent/agent_export.py.")
+    with _unreadable(path):
+        return zipfile.ZipFile(path)
+
+
+def _entries(path, archive):
+    """{array name: ZipInfo} of the archive, its size and names checked."""
+    infos = archive.infolist()
+    if len(infos) > MAX_ENTRIES:
+        raise _not_an_agent(path)
+    entries = {}
+    for info in infos:
+        if not info.filename.endswith(_NPY) or info.filename[:-len(_NPY)] in entries:
+            raise _damaged(path, f"entry {info.filename!r} is not one numpy array")
+        entries[info.filename[:-len(_NPY)]] = info
+    return entries
+
+
+def _npy_header(stream):
+    """(shape, fortran_order, dtype) from the npy header at the start of `stream`, by numpy's own parser."""
+    version = np.lib.format.read_magic(stream)
+    read = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+    if read is None:
+        raise ValueError(f"npy format version {version}")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # numpy's note on headers written by Python 2
+        return read(stream)
+
+
+def _read_npy(path, archive, info, name, check):
+    """The array in the archive entry `info`; `check(shape, dtype)` sees the header before any data is read."""
+    with _unreadable(path), archive.open(info) as stream:
+        shape, fortran_order, dtype = _npy_header(stream)
+        if dtype.hasobject:
+            raise _pickled(path, name)
+        if any(n < 0 for n in shape):
+            raise _damaged(path, f"{name} has the shape {shape}")
+        check(shape, dtype)
+        size = math.prod(shape) * dtype.itemsize
+        if stream.tell() + size != info.file_size:
+            raise _damaged(path, f"{name} declares {size} bytes of data in an entry of {info.file_size}")
+        data = stream.read(size)  # the zip CRC is checked as the entry's last byte is read
+        if len(data) != size:
+            raise _damaged(path, f"{name} ends early")
+        return np.frombuffer(bytearray(data), dtype=dtype).reshape(shape, order="F" if fortran_order else "C")
 
 
 def _damaged(path, error):
     return RLAnimateError(f"The agent file {path} is truncated or damaged ({error}): export or copy it again.")
+
+
+def _pickled(path, name):
+    return RLAnimateError(f"The agent file {path} carries a pickled Python object in {name}, which is refused "
+                          f"because loading it could run code: use an agent exported by trainer/agent/agent_export.py.")
 
 
 def _not_an_agent(path):
@@ -124,16 +209,28 @@ def _not_an_agent(path):
                           f"written by trainer/agent/agent_export.py.")
 
 
-def _parse_metadata(path, entry):
-    if entry is None or entry.dtype.kind != "U" or entry.shape != ():
+def _read_metadata(path, archive, info):
+    if info is None:
         raise _not_an_agent(path)
+
+    def check(shape, dtype):
+        if dtype.kind != "U" or shape != ():
+            raise _not_an_agent(path)
+        if not 0 < dtype.itemsize <= MAX_METADATA_BYTES:  # numpy's itemsize wraps negative past 2 GB
+            raise RLAnimateError(f"The agent file {path} declares more metadata than any agent has "
+                                 f"({MAX_METADATA_BYTES // 2 ** 20} MB at most): re-export it.")
+
+    return _read_npy(path, archive, info, METADATA_KEY, check)
+
+
+def _parse_metadata(path, entry):
     try:
         metadata = json.loads(str(entry))
-    except json.JSONDecodeError as error:
+    except (ValueError, RecursionError) as error:
         raise _damaged(path, error) from error
     if not isinstance(metadata, dict) or metadata.get("format") != FORMAT_NAME:
         raise _not_an_agent(path)
-    if metadata.get("format_version") != FORMAT_VERSION:
+    if not _is_int(metadata.get("format_version")) or metadata["format_version"] != FORMAT_VERSION:
         raise RLAnimateError(f"The agent file {path} is format version {metadata.get('format_version')!r}, but "
                              f"this add-on reads version {FORMAT_VERSION}: update the add-on, or re-export "
                              f"the agent with this version's trainer.")
@@ -144,41 +241,81 @@ def _parse_metadata(path, entry):
     return metadata
 
 
-def _check_weights(path, arrays, metadata):
+def _is_int(value):
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _is_number(value):
+    """An int (of any size: the range checks that follow compare it exactly) or a finite float."""
+    return _is_int(value) or isinstance(value, float) and math.isfinite(value)
+
+
+def _check_metadata_values(path, metadata):
+    """Every metadata value the add-on uses, checked for type and range; returns the expected weight shapes."""
     config = metadata["agent_config"]
-    if not isinstance(config, dict) or any(not isinstance(config.get(k), int) or config[k] <= 0
-                                           for k in _AGENT_SIZES) \
-            or any(not isinstance(config.get(k), (int, float)) or not config[k] > 0 for k in _AGENT_SCALARS):
-        raise RLAnimateError(f"The agent file {path} has an invalid agent_config: re-export it with "
-                             f"trainer/agent/agent_export.py.")
+    if not isinstance(config, dict) \
+            or any(not _is_int(config.get(k)) or not 0 < config[k] <= MAX_SIZE for k in _AGENT_SIZES) \
+            or config["hidden_layers"] > MAX_HIDDEN_LAYERS \
+            or any(not _is_number(config.get(k)) or not 0 < config[k] <= MAX_CONFIG_SCALAR for k in _AGENT_SCALARS):
+        raise RLAnimateError(f"The agent file {path} has an invalid agent_config (widths 1-{MAX_SIZE}, "
+                             f"hidden_layers 1-{MAX_HIDDEN_LAYERS}, {', '.join(_AGENT_SCALARS)} positive and "
+                             f"at most {MAX_CONFIG_SCALAR:g}): re-export it with trainer/agent/agent_export.py.")
+    if not isinstance(metadata["variant"], str):
+        raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
+                             f"{', '.join(VARIANTS)}.")
     expected = expected_weight_shapes(config, metadata["variant"])
-    missing = sorted(set(expected) - set(arrays))
-    extra = sorted(set(arrays) - set(expected))
-    wrong = [f"{name} {arrays[name].shape} (expected {expected[name]})"
-             for name in sorted(set(expected) & set(arrays)) if arrays[name].shape != tuple(expected[name])]
+    parameters = sum(math.prod(shape) for shape in expected.values())
+    if parameters > MAX_PARAMETERS:
+        raise RLAnimateError(f"The agent file {path} describes an agent of {parameters:,} parameters, more than "
+                             f"the add-on runs ({MAX_PARAMETERS:,}): train a smaller agent.")
+    bounds = metadata["action_bounds"]
+    if not isinstance(bounds, list) or len(bounds) != spaces.ACTION_SIZE or any(
+            not isinstance(pair, list) or len(pair) != 2 or not all(_is_number(b) for b in pair)
+            or not -MAX_ABS_BOUND <= pair[0] < pair[1] <= MAX_ABS_BOUND for pair in bounds):
+        raise RLAnimateError(f"The agent file {path} has invalid action_bounds (need {spaces.ACTION_SIZE} "
+                             f"[low, high] pairs of numbers with low < high, within +-2 pi radians): "
+                             f"re-export it with trainer/agent/agent_export.py.")
+    frames = metadata["average_frames"]
+    if not isinstance(frames, dict) or not frames or any(
+            b not in spaces.BEHAVIOURS or not _is_number(n) or not 2 <= n <= MAX_AVERAGE_FRAMES
+            for b, n in frames.items()):
+        raise RLAnimateError(f"The agent file {path} has invalid average_frames (need a length of 2 to "
+                             f"{MAX_AVERAGE_FRAMES:,} frames for each behaviour it was trained for, among "
+                             f"{', '.join(spaces.BEHAVIOURS)}): re-export it.")
+    return {name: tuple(shape) for name, shape in expected.items()}
+
+
+def _read_weights(path, archive, entries, expected):
+    """{name: float array} of the weight entries, checked against the expected shapes before any is read."""
+    missing = sorted(set(expected) - set(entries))
+    extra = sorted(set(entries) - set(expected))
+    headers = {}
+    for name, info in entries.items():
+        with _unreadable(path), archive.open(info) as stream:
+            headers[name] = _npy_header(stream)
+        if headers[name][2].hasobject:
+            raise _pickled(path, name)
+    wrong = [f"{name} {headers[name][0]} (expected {expected[name]})"
+             for name in sorted(set(expected) & set(entries)) if headers[name][0] != expected[name]]
     if missing or extra or wrong:
         problems = ([f"missing {', '.join(missing)}"] if missing else []) + \
                    ([f"unexpected {', '.join(extra)}"] if extra else []) + \
                    ([f"wrong shape {'; '.join(wrong)}"] if wrong else [])
         raise RLAnimateError(f"The agent file {path} does not match its own config: {'; '.join(problems)}. "
                              f"Re-export the agent with trainer/agent/agent_export.py.")
-    for name, array in arrays.items():
-        if array.dtype.kind != "f":
-            raise RLAnimateError(f"The agent file {path} holds {name} as {array.dtype}, not floats: re-export it.")
-        if not np.all(np.isfinite(array)):
+
+    def check(name):
+        def floats(shape, dtype):
+            if shape != expected[name]:
+                raise _damaged(path, f"{name} changed its shape")
+            if dtype.kind != "f":
+                raise RLAnimateError(f"The agent file {path} holds {name} as {dtype}, not floats: re-export it.")
+        return floats
+
+    weights = {}
+    for name in sorted(expected):
+        weights[name] = _read_npy(path, archive, entries[name], name, check(name))
+        if not np.all(np.isfinite(weights[name])):
             raise RLAnimateError(f"The agent file {path} has NaN or infinite values in {name}: its training "
                                  f"diverged; train it again (a lower learning rate or gradient clip helps).")
-
-
-def _check_metadata_values(path, metadata):
-    bounds = np.asarray(metadata["action_bounds"], dtype=np.float64)
-    if bounds.shape != (spaces.ACTION_SIZE, 2) or not np.all(np.isfinite(bounds)) \
-            or not np.all(bounds[:, 0] < bounds[:, 1]):
-        raise RLAnimateError(f"The agent file {path} has invalid action_bounds (need ({spaces.ACTION_SIZE}, 2) "
-                             f"finite [low, high] pairs): re-export it with trainer/agent/agent_export.py.")
-    frames = metadata["average_frames"]
-    if not isinstance(frames, dict) or not frames or any(
-            b not in spaces.BEHAVIOURS or not isinstance(n, (int, float)) or not n >= 2 for b, n in frames.items()):
-        raise RLAnimateError(f"The agent file {path} has invalid average_frames (need a length of at least 2 "
-                             f"frames for each behaviour it was trained for, among "
-                             f"{', '.join(spaces.BEHAVIOURS)}): re-export it.")
+    return weights

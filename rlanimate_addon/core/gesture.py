@@ -46,6 +46,17 @@ POINTING_HAND = {
 }
 
 
+#: The shortest gesture that moves: the first and last frames are the start pose (`blend_weights`).
+MIN_FRAMES = 3
+
+
+def check_length(frame_count):
+    """RLAnimateError for a gesture too short to move."""
+    if int(frame_count) < MIN_FRAMES:
+        raise RLAnimateError(f"The gesture is {int(frame_count)} frames long: it starts and ends at the pose of "
+                             f"its start frame, so nothing would move. Set a length of at least {MIN_FRAMES} frames.")
+
+
 def supported_length_range(average_frames):
     """(shortest, longest) gesture length in frames the agent portrays without visible artefacts."""
     low, high = SUPPORTED_LENGTH
@@ -82,15 +93,19 @@ def pointing_directions(arm, targets, rest_heads):
     offsets = np.atleast_2d(np.asarray(targets, dtype=np.float64)) - shoulder  # (N, 3)
     norms = np.linalg.norm(offsets, axis=1)
     scale = np.linalg.norm(np.subtract(rest_heads["Head"], shoulder))
-    if not np.all(np.isfinite(norms)) or np.any(norms < 1e-3 * scale):
+    broken = ~np.isfinite(norms)
+    if np.any(broken):
+        raise RLAnimateError(f"The target's position is not a number (NaN or infinite) on {broken.sum()} of the "
+                             f"gesture's {len(norms)} frames: check the target's location, constraints, drivers "
+                             "and parents, and the armature's transform.")
+    if np.any(norms < 1e-3 * scale):
         raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
     return (offsets / norms[:, None]) @ character_frame(rest_heads).T
 
 
 def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5):
     """(N, 7) objectives for a gesture: POINT needs targets (N, 3) and rest_heads; WAVE an exaggeration."""
-    if int(frame_count) < 2:
-        raise RLAnimateError(f"The gesture is {int(frame_count)} frames long: set a length of at least 2 frames.")
+    check_length(frame_count)
     if behaviour == "POINT":
         if targets is None:
             raise RLAnimateError("Point needs a target: pick a target object, or tick 'Use 3D Cursor'.")
@@ -325,7 +340,14 @@ def gesture_rotations(agent, request, rig):
                         aim.pointing_phase(phase_base))
         keyed[:, arm_column] = matrix_to_quat(aimed[:, :3, :3] / np.linalg.norm(aimed[:, :3, :3], axis=-2,
                                                                                   keepdims=True))
-    return tuple(bones), continuous(keyed), continuous(under)
+    keyed, under = continuous(keyed), continuous(under)
+    finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
+    broken = [bone for bone, ok in zip(bones, finite) if not ok]
+    if broken:
+        raise RLAnimateError(f"The gesture's rotations of {', '.join(broken)} are not numbers (NaN): check those "
+                             "bones' pose and animation at the gesture's frames and the rig's rest pose for NaN "
+                             "values.")
+    return tuple(bones), keyed, under
 
 
 class GestureRequest:

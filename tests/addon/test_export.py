@@ -1,4 +1,6 @@
 """Export FBX: Blender's exporter writes the rig, its mesh and the baked gesture, and they read back."""
+import os
+
 import addon_helpers as helpers
 import bpy
 import numpy as np
@@ -47,3 +49,28 @@ def test_export_refuses_without_an_armature(settings, tmp_path):
     with pytest.raises(RuntimeError, match="not an armature"):
         bpy.ops.rlanimate.export_fbx(filepath=str(tmp_path / "x.fbx"))
     assert not (tmp_path / "x.fbx").exists()
+
+
+@pytest.mark.parametrize("where, message", [
+    ("missing_folder/x.fbx", r"The folder .*missing_folder does not exist: choose an existing folder\."),
+    ("", r"is a folder: give a file name ending in \.fbx\."),
+    ("a_file.txt/x.fbx", r"The folder .*a_file\.txt does not exist"),
+])
+def test_export_to_a_bad_path_is_one_clear_message(settings, tmp_path, where, message):
+    helpers.load_sample_rig()
+    (tmp_path / "a_file.txt").write_text("not a folder")
+    before = sorted(p.name for p in tmp_path.iterdir())
+    with pytest.raises(RuntimeError, match=message) as refusal:
+        bpy.ops.rlanimate.export_fbx(filepath=str(tmp_path / where))
+    assert "Traceback" not in str(refusal.value) and len(str(refusal.value).splitlines()) == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+    assert bpy.context.scene.frame_end == 250
+
+
+@pytest.mark.skipif(not os.access("/proc", os.W_OK), reason="needs a writable-looking /proc (Linux, as root)")
+def test_an_export_the_fbx_writer_fails_on_is_one_line_with_its_reason(settings):
+    helpers.load_sample_rig()
+    with pytest.raises(RuntimeError, match=r"Could not write /proc/rlanimate\.fbx: FileNotFoundError: \[Errno 2\]") \
+            as refusal:
+        bpy.ops.rlanimate.export_fbx(filepath="/proc/rlanimate.fbx")
+    assert "Traceback" not in str(refusal.value) and len(str(refusal.value).splitlines()) == 1

@@ -186,14 +186,17 @@ def _state(rig):
     """What a failed Generate must leave as it was."""
     data = rig.animation_data
     return (sorted(a.name for a in bpy.data.actions), bpy.context.scene.frame_current,
-            None if data is None else (data.action, len(data.nla_tracks)),
-            [tuple(pb.rotation_quaternion) for pb in rig.pose.bones])
+            None if data is None else (data.action, len(data.nla_tracks),
+                                       [(d.data_path, d.driver.expression) for d in data.drivers]),
+            [tuple(pb.rotation_quaternion) for pb in rig.pose.bones],
+            [(c.name, c.influence, c.mute) for pb in rig.pose.bones for c in pb.constraints])
 
 
-def _assert_refused(rig, message):
+def _assert_refused(rig, message, **options):
     before = _state(rig)
-    with pytest.raises(RuntimeError, match=message):
-        bpy.ops.rlanimate.generate_gesture()
+    with pytest.raises(RuntimeError, match=message) as refusal:
+        bpy.ops.rlanimate.generate_gesture(**options)
+    assert "Traceback" not in str(refusal.value)
     assert _state(rig) == before
 
 
@@ -212,10 +215,23 @@ def test_every_bad_input_is_refused_with_its_message_and_changes_nothing(setting
 
     settings.target = target
     settings.frame_count = 0
-    _assert_refused(rig, "at least 2 frames")
+    _assert_refused(rig, "at least 3 frames")
     settings.frame_count = 1
-    _assert_refused(rig, "at least 2 frames")
+    _assert_refused(rig, "at least 3 frames")
+    settings.frame_count = 2  # the first and last frames are the start pose: nothing would move
+    _assert_refused(rig, "2 frames long: it starts and ends at the pose of its start frame, so nothing would move")
     settings.frame_count = 50
+
+    for start in (1_048_574 - 48, 2_000_000_000, -1_048_575):  # past the last frame; keys collapsing
+        settings.start_frame = start
+        _assert_refused(rig, rf"Frames {start}-{start + 49} leave Blender's frame range \(-1048574 to 1048574\)")
+    settings.start_frame = 1_048_574 - 49
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}, "the last frames Blender has are allowed"
+    settings.start_frame = 1
+
+    target.location = (float("nan"), -2.0, 1.5)
+    _assert_refused(rig, r"target's position is not a number \(NaN or infinite\) on 50 of the gesture's 50 frames")
+    target.location = (1.0, -2.0, 1.5)
 
     damaged = tmp_path / "damaged.npz"
     damaged.write_bytes(b"PK\x03\x04 truncated")
@@ -283,3 +299,29 @@ def test_exact_aim_off_bakes_the_agents_own_aim(settings, arm):
     others = [k for k, n in enumerate(names) if n not in arm_chain and not skeleton.strip_prefix(n).startswith(
         skeleton.ARM_PREFIX[arm] + "Hand")]
     np.testing.assert_allclose(runs[True][1][:, others], runs[False][1][:, others], atol=1e-6)
+
+
+def test_a_linked_armature_is_refused_and_a_library_override_keeps_its_gesture(settings, tmp_path):
+    """A gesture on linked data would vanish on save; on a library override it survives a reopen."""
+    helpers.load_sample_rig()
+    library = tmp_path / "character.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(library))
+    settings = helpers.enable_addon()
+    with bpy.data.libraries.load(str(library), link=True) as (_, linked):
+        linked.objects = [helpers.SAMPLE_RIG]
+    rig = linked.objects[0]
+    bpy.context.scene.collection.objects.link(rig)
+    helpers.activate(rig)
+    settings.behaviour = "WAVE"
+    _assert_refused(rig, rf"is linked from .*character\.blend, so a gesture baked onto it would be lost when the "
+                         r"file is saved\. Make a library override")
+    assert rig.animation_data is None
+
+    override = rig.override_create(remap_local_usages=True)
+    helpers.activate(override)
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
+    scene_file = tmp_path / "shot.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(scene_file))
+    bpy.ops.wm.open_mainfile(filepath=str(scene_file))
+    reopened = next(o for o in bpy.data.objects if o.override_library is not None)
+    assert reopened.animation_data.action.name.startswith("RLAnimate Wave Right"), "the gesture was kept"

@@ -1,10 +1,18 @@
 """Registration, the Scene.rlanimate contract, and the N-panel's placement and draw()."""
+import os
+import time
+import types
+import zipfile
+from unittest import mock
+
 import addon_helpers
 import bpy
+import numpy as np
 import pytest
 
 import rlanimate_addon
 from rlanimate_addon.blender import panel, registration
+from rlanimate_addon.core import runtime
 
 CONTRACT = {
     "behaviour": ("ENUM", {"POINT", "WAVE"}),
@@ -71,6 +79,7 @@ class RecordingLayout:
 
     def operator(self, idname, **kwargs):
         self.calls.append(("operator", idname, kwargs))
+        return kwargs.setdefault("properties", types.SimpleNamespace())
 
     def label(self, **kwargs):
         self.calls.append(("label", kwargs))
@@ -121,3 +130,37 @@ def test_panel_names_a_damaged_agent_file_instead_of_failing(settings, tmp_path)
     labels = [c[1] for c in _draw(settings) if c[0] == "label"]
     assert any(label.get("icon") == "ERROR" for label in labels)
     assert any("broken.npz" in label.get("text", "") for label in labels)
+
+
+def test_panel_draws_in_under_a_millisecond_after_one_failed_load(settings, tmp_path):
+    """A bad agent file is read once: the failure is cached per path and modification time."""
+    bomb = tmp_path / "bomb.npz"
+    with zipfile.ZipFile(bomb, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("__metadata__.npy", bytes(64 * 2 ** 20))  # 64 MB of zeros, 64 KB deflated
+    addon_helpers.addon_preferences().agent_path = str(bomb)
+    with mock.patch.object(runtime, "load_agent", wraps=runtime.load_agent) as load:
+        labels = [c[1] for c in _draw(settings) if c[0] == "label"]
+        times = []
+        for _ in range(50):
+            start = time.perf_counter()
+            _draw(settings)
+            times.append(time.perf_counter() - start)
+    assert load.call_count == 1, "the failed load is cached"
+    assert any("bomb.npz" in label.get("text", "") for label in labels)
+    assert np.median(times) < 1e-3, f"panel draw took {np.median(times) * 1e3:.2f} ms"
+    os.utime(bomb, ns=(0, 0))  # another version of the file is read again
+    with mock.patch.object(runtime, "load_agent", wraps=runtime.load_agent) as load:
+        _draw(settings)
+    assert load.call_count == 1
+
+
+def test_panel_offers_to_mute_constraints_that_override_the_gesture(settings):
+    rig = addon_helpers.load_sample_rig()
+    forearm = rig.pose.bones[addon_helpers.rig_bone(rig, "LeftForeArm")]
+    forearm.constraints.new("COPY_ROTATION").target = addon_helpers.add_empty("Other", (0, 0, 0))
+    calls = _draw(settings)
+    labels = " ".join(c[1].get("text", "") for c in calls if c[0] == "label")
+    assert f"'Copy Rotation' (Copy Rotation) on {forearm.name} would override the gesture" in labels
+    mute = [c for c in calls if c[0] == "operator" and c[2].get("text") == "Generate, Muting Constraints"]
+    assert len(mute) == 1 and mute[0][1] == "rlanimate.generate_gesture"
+    assert mute[0][2]["properties"].mute_constraints is True

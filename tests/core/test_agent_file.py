@@ -1,6 +1,11 @@
 """The agent-file loader: a real exported file loads; every kind of bad file gets its own clear error."""
+import io
 import json
 import pickle
+import re
+import struct
+import time
+import zipfile
 
 import numpy as np
 import pytest
@@ -91,14 +96,14 @@ def test_pickled_object_array_is_refused(tmp_path, exported):
     weights, metadata = load_agent_file(exported)
     path = tmp_path / "pickled.npz"
     rewrite(path, weights, metadata, payload=np.array([{"run": "code"}], dtype=object))
-    with pytest.raises(RLAnimateError, match="pickled"):
+    with pytest.raises(RLAnimateError, match="pickled Python object in payload"):
         load_agent_file(path)
 
 
 def test_pickled_object_in_place_of_a_weight(tmp_path, exported):
     weights, metadata = load_agent_file(exported)
     weights["decoder.layers.0.bias"] = np.array([None] * len(weights["decoder.layers.0.bias"]), dtype=object)
-    with pytest.raises(RLAnimateError, match="pickled"):
+    with pytest.raises(RLAnimateError, match=r"pickled Python object in decoder\.layers\.0\.bias"):
         load_agent_file(rewrite(tmp_path / "pickled_weight.npz", weights, metadata))
 
 
@@ -173,3 +178,119 @@ def test_missing_metadata_field(tmp_path, exported):
     del metadata["average_frames"]
     with pytest.raises(RLAnimateError, match="lacks metadata average_frames"):
         load_agent_file(rewrite(tmp_path / "meta.npz", weights, metadata))
+
+
+def _rezip(path, replaced, compression=zipfile.ZIP_STORED):
+    """A copy of the agent at `path` with some entries' bytes replaced (valid zip CRCs)."""
+    with zipfile.ZipFile(path) as source:
+        contents = {info.filename: source.read(info) for info in source.infolist()}
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w", compression=compression) as archive:
+        for name, data in contents.items():
+            archive.writestr(name, replaced.get(name, data))
+    return out.getvalue()
+
+
+def _npy_header_text(path, entry):
+    with zipfile.ZipFile(path) as archive:
+        data = archive.read(entry)
+    length = struct.unpack_from("<H", data, 8)[0]
+    return data[10:10 + length].decode("latin1"), data[10 + length:]
+
+
+def _with_header(text, body):
+    header = text.encode("latin1")
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header + body
+
+
+def test_an_npy_header_claiming_terabytes_is_refused_before_anything_is_allocated(tmp_path, exported):
+    entry = "animation.layers.0.weight.npy"
+    text, body = _npy_header_text(exported, entry)
+    huge = re.sub(r"'shape': \([^)]*\)", "'shape': (1099511627776, 2)", text)  # 8 TiB of float32
+    path = tmp_path / "huge.npz"
+    path.write_bytes(_rezip(exported, {entry: _with_header(huge, body)}))
+    start = time.perf_counter()
+    with pytest.raises(RLAnimateError, match=r"wrong shape animation\.layers\.0\.weight \(1099511627776, 2\)"):
+        load_agent_file(path)
+    assert time.perf_counter() - start < 1.0
+
+
+def test_metadata_declaring_gigabytes_is_refused(tmp_path, exported):
+    entry = agent_file.METADATA_KEY + ".npy"
+    text, body = _npy_header_text(exported, entry)
+    huge = re.sub(r"'descr': '<U\d+'", "'descr': '<U2000000000'", text)
+    path = tmp_path / "huge_metadata.npz"
+    path.write_bytes(_rezip(exported, {entry: _with_header(huge, body)}))
+    with pytest.raises(RLAnimateError, match="declares more metadata than any agent has"):
+        load_agent_file(path)
+
+
+def test_a_deflate_bomb_is_refused_without_inflating_it(tmp_path, exported):
+    entry = "decoder.layers.0.weight.npy"
+    text, body = _npy_header_text(exported, entry)
+    bomb = _with_header(text, body + bytes(256 * 2 ** 20))  # 256 MB of zeros behind the array's own header
+    path = tmp_path / "bomb.npz"
+    path.write_bytes(_rezip(exported, {entry: bomb}, zipfile.ZIP_DEFLATED))
+    assert path.stat().st_size < 2 * 2 ** 20
+    start = time.perf_counter()
+    with pytest.raises(RLAnimateError, match=r"truncated or damaged \(decoder\.layers\.0\.weight declares"):
+        load_agent_file(path)
+    assert time.perf_counter() - start < 0.5
+
+
+def test_an_unparseable_npy_header_is_refused(tmp_path, exported):
+    entry = "prior.layers.0.bias.npy"
+    text, body = _npy_header_text(exported, entry)
+    path = tmp_path / "token.npz"
+    path.write_bytes(_rezip(exported, {entry: _with_header(text.replace("}", "(", 1), body)}))
+    with pytest.raises(RLAnimateError, match="truncated or damaged"):
+        load_agent_file(path)
+
+
+def test_an_unsupported_zip_version_is_refused(tmp_path, exported):
+    data = bytearray(exported.read_bytes())
+    central = data.index(b"PK\x01\x02")
+    data[central + 6:central + 8] = struct.pack("<H", 0xFF)  # "version needed to extract": 25.5
+    path = tmp_path / "version.npz"
+    path.write_bytes(bytes(data))
+    with pytest.raises(RLAnimateError, match="truncated or damaged"):
+        load_agent_file(path)
+
+
+@pytest.mark.parametrize("field, value, message", [
+    ("action_bounds", [[-1e300, 1e300]] * 45, "action_bounds"),
+    ("action_bounds", [["a", "b"]] * 45, "action_bounds"),
+    ("action_bounds", [[0.0, float("nan")]] * 45, "action_bounds"),
+    ("action_bounds", [[0.0, True]] * 45, "action_bounds"),
+    ("average_frames", {"POINT": float("inf")}, "average_frames"),
+    ("average_frames", {"POINT": 1e12}, "average_frames"),
+    ("average_frames", {"POINT": 10 ** 400}, "average_frames"),
+    ("average_frames", {"POINT": "90"}, "average_frames"),
+    ("average_frames", [90], "average_frames"),
+    ("variant", ["rlanimate"], "names no agent variant"),
+    ("format_version", True, "format version True"),
+])
+def test_metadata_values_of_the_wrong_type_or_range(tmp_path, exported, field, value, message):
+    weights, metadata = load_agent_file(exported)
+    with pytest.raises(RLAnimateError, match=message):
+        load_agent_file(rewrite(tmp_path / "meta.npz", weights, {**metadata, field: value}))
+
+
+@pytest.mark.parametrize("key, value", [("hidden_layers", 10 ** 8), ("hidden_size", 10 ** 6), ("task_size", 0),
+                                        ("min_std", float("inf")), ("concentration_scale", "100"),
+                                        ("hidden_layers", True)])
+def test_agent_config_values_out_of_range_are_refused_at_once(tmp_path, exported, key, value):
+    weights, metadata = load_agent_file(exported)
+    metadata["agent_config"][key] = value
+    path = rewrite(tmp_path / "config.npz", weights, metadata)
+    start = time.perf_counter()
+    with pytest.raises(RLAnimateError, match="invalid agent_config"):
+        load_agent_file(path)
+    assert time.perf_counter() - start < 0.5
+
+
+def test_an_agent_too_large_to_run_is_refused(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    metadata["agent_config"].update(hidden_size=4096, hidden_layers=16)
+    with pytest.raises(RLAnimateError, match="more than the add-on runs"):
+        load_agent_file(rewrite(tmp_path / "big.npz", weights, metadata))

@@ -212,8 +212,10 @@ def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
 
 @pytest.mark.parametrize("request_kwargs, message", [
     (dict(behaviour="POINT", targets=None), "needs a target"),
-    (dict(frames=1), "at least 2 frames"),
-    (dict(frames=0), "at least 2 frames"),
+    (dict(frames=2), "nothing would move. Set a length of at least 3 frames"),
+    (dict(frames=1), "at least 3 frames"),
+    (dict(frames=0), "at least 3 frames"),
+    (dict(behaviour="POINT", targets=np.full((60, 3), np.nan)), r"target's position is not a number .* on 60 of"),
 ])
 def test_bad_requests_raise_before_the_agent_runs(request_kwargs, message):
     agent = ReplayAgent(RNG.uniform(size=(10, spaces.ACTION_SIZE)))
@@ -266,3 +268,10 @@ def test_exact_aim_off_keys_the_agents_own_aim():
     full = int(np.argmax(gesture.blend_weights(50)))
     arm = names.index("RightArm")
     assert abs(np.sum(raw[full, arm] * expected[full, arm])) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_a_nan_start_pose_is_refused_before_anything_is_returned():
+    rig = gesture.canonical_rig()
+    rig.under[rig.skeleton.index["RightForeArm"], :3, :3] = np.nan
+    with pytest.raises(RLAnimateError, match="rotations of RightForeArm are not numbers"):
+        gesture.gesture_rotations(ReplayAgent(np.full((60, 45), 0.5)), _request(behaviour="WAVE"), rig)

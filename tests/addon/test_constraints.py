@@ -1,0 +1,75 @@
+"""Constraints that would override the gesture: refused by name, or muted over the gesture's frames only."""
+import addon_helpers as helpers
+import bpy
+import numpy as np
+import pytest
+
+from test_generate import _assert_refused, _fcurves, _key_existing_animation, _state
+
+START, COUNT = 40, 41
+
+
+def _ik_rig():
+    """The sample rig with an IK constraint (influence 0.7) on the right forearm towards an empty."""
+    rig = helpers.load_sample_rig()
+    forearm = rig.pose.bones[helpers.rig_bone(rig, "RightForeArm")]
+    ik = forearm.constraints.new("IK")
+    ik.target, ik.chain_count, ik.influence = helpers.add_empty("IK Target", (-0.8, -0.5, 1.0)), 2, 0.7
+    return helpers.activate(rig), forearm, ik
+
+
+def test_a_constraint_overriding_the_arm_is_refused_by_name_and_changes_nothing(settings):
+    rig, forearm, _ = _ik_rig()
+    settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
+    _assert_refused(rig, rf"Constraint 'IK' \(Inverse Kinematics\) on {forearm.name} overrides the rotations the "
+                         rf"gesture keys, so the bake would not play\. Click 'Generate, Muting Constraints'")
+
+
+def test_muting_keeps_the_constraint_outside_the_gesture_and_lets_the_gesture_play_inside(settings):
+    rig, forearm, ik = _ik_rig()
+    _key_existing_animation(rig)  # the gesture goes on an NLA strip, with no effect outside its frames
+    outside = [1, START - 1, START + COUNT, 200]
+    before = helpers.bone_heads(rig, [forearm.name, helpers.rig_bone(rig, "RightHand")], outside)
+    settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
+    assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    after = helpers.bone_heads(rig, [forearm.name, helpers.rig_bone(rig, "RightHand")], outside)
+    assert np.abs(after - before).max() < 1e-5, "outside the gesture the constraint still acts"
+    keyed = next(a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Right"))
+    curves = sorted((f for f in _fcurves(keyed) if f'"{forearm.name}"' in f.data_path), key=lambda f: f.array_index)
+    for frame in (START, START + 20, START + COUNT - 1):
+        bpy.context.scene.frame_set(frame)
+        assert ik.influence == 0.0
+        # The forearm's evaluated rotation (constraints included) is the keyed one.
+        evaluated = (forearm.parent.matrix.inverted() @ forearm.matrix).to_quaternion()
+        rest = (forearm.parent.bone.matrix_local.inverted() @ forearm.bone.matrix_local).to_quaternion()
+        keyed_rotation = rest @ type(rest)([f.evaluate(frame) for f in curves])
+        assert abs(evaluated.dot(keyed_rotation)) == pytest.approx(1.0, abs=1e-5)
+    for frame in outside:
+        bpy.context.scene.frame_set(frame)
+        assert ik.influence == pytest.approx(0.7, abs=1e-6)
+
+    # A second gesture mutes it over its own frames as well, the first one's frames kept.
+    settings.start_frame = 200
+    assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    expression = rig.animation_data.drivers.find(ik.path_from_id("influence")).driver.expression
+    assert expression == "0.7 * ((frame < 40) + (frame > 80)) * ((frame < 200) + (frame > 240))"
+
+
+def test_a_constraint_with_an_animated_influence_is_not_overwritten(settings):
+    rig, forearm, ik = _ik_rig()
+    ik.keyframe_insert("influence", frame=1)
+    settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
+    before = _state(rig)
+    _assert_refused(rig, "has an animated influence, which Generate will not overwrite", mute_constraints=True)
+    assert _state(rig) == before
+
+
+def test_muted_disabled_and_unrelated_constraints_are_left_alone(settings):
+    rig, forearm, ik = _ik_rig()
+    ik.mute = True
+    leg = rig.pose.bones[helpers.rig_bone(rig, "LeftUpLeg")]
+    leg.constraints.new("COPY_ROTATION").target = helpers.add_empty("Leg Target", (0, 0, 0))
+    settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
+    assert not rig.animation_data.drivers
+
