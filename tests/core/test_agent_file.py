@@ -14,8 +14,8 @@ import torch
 from rlanimate_addon.core import agent_file
 from rlanimate_addon.core.agent_file import load_agent_file
 from rlanimate_addon.core.errors import RLAnimateError
-from trainer.agent.config import load_preset
 from trainer.agent.agent_export import export_agent
+from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
 
 torch.set_num_threads(1)

@@ -6,8 +6,8 @@ import torch
 from rlanimate_addon.core import runtime as runtime_module
 from rlanimate_addon.core import spaces
 from rlanimate_addon.core.runtime import GestureAgent, load_agent
-from trainer.agent.config import load_preset
 from trainer.agent.agent_export import export_agent
+from trainer.agent.config import load_preset
 from trainer.agent.models import VARIANTS, RLAnimateAgent
 
 torch.set_num_threads(1)

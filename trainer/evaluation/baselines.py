@@ -10,8 +10,8 @@ NearestClip      retrieval, as motion matching does: the training clip of the sa
                  exaggerations), time-warped uniformly to the requested length (per-joint slerp).
 ProceduralIK     Blender's IK constraint on the sample rig (trainer/blender_io/procedural_ik.py).
 
-Nearest clip and procedural IK start from and return to `neutral` (15, 3), the pose the training
-clips start in.
+Nearest clip and procedural IK start from and return to `mean_start_pose(clips)` (15, 3), the pose
+the training clips start in.
 AgentMethod (an exported .npz, numpy runtime) and TrainedAgentMethod (a trainer's torch agent) put
 RLAnimate behind the same generate() interface, so all are scored by one code path.
 """
@@ -19,13 +19,12 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import metrics, rotations, skeleton, spaces
+from rlanimate_addon.core import rotations, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 
 
-
-def neutral_pose(clips):
+def mean_start_pose(clips):
     """(15, 3) start pose: the mean first frame of `clips` (they all start standing neutrally)."""
     if not clips:
         raise RLAnimateError("No training clips: a baseline needs at least one clip to start from.")
@@ -148,59 +147,6 @@ class AgentMethod:
         return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
 
 
-def evaluate_motions(env, motions, clips, references):
-    """{'score', 'smoothness', 'clips': [{name, behaviour, score, smoothness}]} of generated
-    (F_i, 15, 3) `motions` against `clips` (references: algorithm.ClipReferences), as evaluate.evaluate_clips."""
-    ends = np.cumsum([len(m) for m in motions])[:-1]
-    positions = np.split(np.asarray(env.evaluate(np.concatenate(motions)).joint_positions), ends)
-    rows = []
-    for clip, generated in zip(clips, positions):
-        _, reference = references.get(clip)
-        rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
-                     "score": float(metrics.score(generated, reference)),
-                     "smoothness": float(metrics.smoothness(generated))})
-    return {"score": float(np.mean([r["score"] for r in rows])),
-            "smoothness": float(np.mean([r["smoothness"] for r in rows])), "clips": rows}
-
-
 def generate_for(baseline, clips):
     """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
     return [baseline.generate(c.behaviour.upper(), c.arm.upper(), c.attributes, len(c.rotvecs)) for c in clips]
-
-
-METHOD_LABELS = {"rlanimate": "RLAnimate", "no_motion": "No motion", "class_mean": "Class mean",
-                 "nearest_clip": "Nearest clip", "procedural_ik": "Procedural IK"}
-METRIC_LABELS = {"score": "score", "smoothness": "smoothness", "label_error": "label error (autolabel)",
-                 "forearm_angle_deg": "forearm angle at hold (deg)"}
-
-
-def write_results(results_dir, section, description, sets):
-    """Merge one section into results_dir/baselines.json and rewrite baselines.md from the whole file.
-
-    sets: {set name: {method: {metric: value, ...}}}; the other sections are kept as they are, so
-    the sample-library and the real-data runs each update their own.
-    """
-    import json
-    results_dir = Path(results_dir)
-    results_dir.mkdir(parents=True, exist_ok=True)
-    path = results_dir / "baselines.json"
-    table = json.loads(path.read_text()) if path.is_file() else {}
-    table[section] = {"description": description, "sets": sets}
-    path.write_text(json.dumps(table, indent=2) + "\n")
-    lines = ["# RLAnimate against the baselines an animator would try first", "",
-             "Nearest clip: the training clip with the closest label, time-warped to the requested length. "
-             "Procedural IK: Blender's IK constraint with minimum-jerk timing (trainer/evaluation/baselines.py). "
-             "Each method answers the held-out clip's own request (label and length); score and smoothness "
-             "as in docs/METRICS.md. Discussion: docs/REALMOCAP.md.", ""]
-    for name, entry in table.items():
-        lines += [f"## {name}", "", entry["description"], ""]
-        for set_name, methods in entry["sets"].items():
-            metric_names = [m for m in METRIC_LABELS if any(m in row for row in methods.values())]
-            lines += [f"**{set_name}**", "", "| method | " + " | ".join(METRIC_LABELS[m] for m in metric_names) + " |",
-                      "|---|" + "---|" * len(metric_names)]
-            for method, row in methods.items():
-                lines.append(f"| {METHOD_LABELS.get(method, method)} | "
-                             + " | ".join(f"{row[m]:.3g}" if m == "label_error" else f"{row[m]:.2f}"
-                                          for m in metric_names) + " |")
-            lines.append("")
-    (results_dir / "baselines.md").write_text("\n".join(lines))

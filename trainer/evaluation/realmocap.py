@@ -3,7 +3,7 @@
 
 The clips are read from ../shared/realmocap/ beside the repository (never copied into it; see
 docs/REALMOCAP.md). Each BVH goes through trainer/blender_io/clip_import.py (Blender's BVH importer and
-the canonicalisation); the capture has no fingers, so a relaxed open hand (motion/realmocap_takes.py)
+the canonicalisation); the capture has no fingers, so the synthesised clips' relaxed hand (motion/realmocap_takes.py)
 is put on, and labels come from the motion (trainer/motion/autolabel.py).
 
 Experiments, each trained with trainer.agent.run.train on a session of real clips (runs/realmocap/<name>/):
@@ -33,7 +33,7 @@ from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
-from trainer.evaluation import baselines
+from trainer.evaluation import baselines, scoring
 from trainer.motion import autolabel
 from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
                                             style_holdout_split, wave_split)
@@ -112,12 +112,12 @@ def train_agent(session, name, behaviour, epochs, preset, seed, runs=REALMOCAP_R
 
 
 def compare(methods, clips, env, references):
-    """{method: evaluate_motions result} on `clips`; for waves also `label_error`, the mean
+    """{method: scoring.score_motions result} on `clips`; for waves also `label_error`, the mean
     |autolabel exaggeration of the generated wave - requested exaggeration| (does it portray the label?)."""
     results = {}
     for name, method in methods.items():
         motions = baselines.generate_for(method, clips)
-        result = baselines.evaluate_motions(env, motions, clips, references)
+        result = scoring.score_motions(env, motions, clips, references)
         if all(c.behaviour == "WAVE" for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
                                                    for m, c in zip(motions, clips)]))
@@ -189,7 +189,7 @@ def run_experiments(options):
         session = RealSession(env, references, train_clips, test_clips)
         report, agent = train_agent(session, name, "wave", options.epochs, options.preset, options.seed, options.runs)
         methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
-                   "procedural_ik": ProceduralIK(baselines.neutral_pose(train_clips))}
+                   "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
         sets = {"test": test_clips} if name == "holdout" else {"test": test_clips, "bye": byes}
         entry = {"train_clips": len(train_clips), "episodes": report["episodes"],
                  "train_seconds": report["train_seconds"], "seen": _summary(report["training"])}
@@ -211,7 +211,7 @@ def run_experiments(options):
         results["guide"] = {"skipped": str(error)}
         return results
     guide_methods = {"rlanimate": point_method, "nearest_clip": baselines.NearestClip(point_clips),
-                     "procedural_ik": ProceduralIK(baselines.neutral_pose(point_clips))}
+                     "procedural_ik": ProceduralIK(baselines.mean_start_pose(point_clips))}
     agent_path = point_method.path.resolve()
     results["guide"] = {"point_agent": str(shown(agent_path)),
                         **{name: guide_angles(method, guides, env) for name, method in guide_methods.items()}}

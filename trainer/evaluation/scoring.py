@@ -1,9 +1,10 @@
 """Evaluation as in the paper's Section 4: score and smoothness of deterministic rollouts.
 
-For each clip the agent is rolled out deterministically on the clip's objectives, its actions are
-played through the bpy FK environment (all clips in one batch), and the 10 description joints are
-compared with the FK of the clip's own motion: `metrics.score(generated, reference)` and
-`metrics.smoothness(generated)`. A clip set's figures are the means over its clips.
+For each clip the agent is rolled out deterministically on the clip's objectives (a baseline answers
+the same request), the motions are played through the FK environment (all clips in one batch), and the
+10 description joints are compared with the FK of the clip's own motion by the one scorer,
+`score_positions`: `metrics.score(generated, reference)` and `metrics.smoothness(generated)`. A clip
+set's figures are the means over its clips.
 """
 import numpy as np
 
@@ -38,16 +39,30 @@ def generate_positions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUN
 
 
 def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-    """{'score', 'smoothness', 'by_behaviour': {behaviour: {score, smoothness}},
-    'clips': [{name, behaviour, score, smoothness}]}: means over `clips`, per behaviour, and per clip."""
+    """score_positions of `agent`'s deterministic rollouts on each clip's own request."""
     agent.eval()
     generated = generate_positions(agent, env, [clip_objective(clip) for clip in clips], bounds)
+    return score_positions(clips, generated, references)
+
+
+def score_motions(env, motions, clips, references):
+    """score_positions of generated (F_i, 15, 3) action rotations `motions`, one per clip of `clips` (the
+    baselines' and the agents' answers alike), played through `env` in one batch."""
+    ends = np.cumsum([len(m) for m in motions])[:-1]
+    positions = np.split(np.asarray(env.evaluate(np.concatenate(motions)).joint_positions), ends)
+    return score_positions(clips, positions, references)
+
+
+def score_positions(clips, positions, references):
+    """The one scorer: {'score', 'smoothness', 'by_behaviour': {behaviour: {score, smoothness}},
+    'clips': [{name, behaviour, score, smoothness}]} of generated (F_i, 10, 3) joint `positions` against
+    each clip's own FK (references: algorithm.ClipReferences): means over the clips, per behaviour, per clip."""
     rows = []
-    for clip, positions in zip(clips, generated):
+    for clip, generated in zip(clips, positions):
         _, reference = references.get(clip)
         rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
-                     "score": float(metrics.score(positions, reference)),
-                     "smoothness": float(metrics.smoothness(positions))})
+                     "score": float(metrics.score(generated, reference)),
+                     "smoothness": float(metrics.smoothness(generated))})
     by_behaviour = {}
     for behaviour in sorted({r["behaviour"] for r in rows}):
         group = [r for r in rows if r["behaviour"] == behaviour]

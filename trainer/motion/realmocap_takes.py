@@ -1,5 +1,6 @@
 """The Bandai Namco real motion capture as data: file names, styles and takes, splits, and the relaxed hand
 put on a capture without fingers (numpy; the clips are read in place from ../shared/realmocap/, CC BY-NC)."""
+import functools
 import re
 from dataclasses import replace
 from pathlib import Path
@@ -8,6 +9,7 @@ import numpy as np
 
 from rlanimate_addon.core import skeleton
 from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion.synthesis import FINGER_BONES, neutral_pose
 from trainer.paths import REALMOCAP_DIR
 
 STYLES = ("active", "elderly", "exhausted", "feminine", "masculine", "normal", "youthful")
@@ -17,11 +19,6 @@ TEST_TAKES = ("009", "010")
 #: (exaggeration ~0.3 and ~0.55 against 0.1 feminine and 0.75-1 for the rest), as the paper's unseen
 #: waves are exaggerations between the training ones.
 HOLDOUT_STYLES = ("elderly", "exhausted")
-#: Relaxed open hand for a capture without fingers: {finger bone: local rotation vector (rad)}.
-#: Fingers curl about their local X axis (negative: towards the palm), a little more towards the
-#: pinky; the thumb rests slightly in. Index1 is an action joint; the rest only show in pictures.
-RELAXED_HAND = {"Index": -0.12, "Middle": -0.18, "Ring": -0.24, "Pinky": -0.3}
-RELAXED_THUMB = (0.0, 0.0, 0.15)
 
 _NAME = re.compile(r"dataset-(?P<dataset>\d)_(?P<content>[a-z]+)(?:-(?P<side>left|right)-hand)?"
                    r"_(?P<style>[a-z-]+)_(?P<take>\d{3})$")
@@ -46,19 +43,22 @@ def parse_name(path):
             "style": match["style"], "take": match["take"]}
 
 
+@functools.cache
+def _relaxed_hand():
+    """{finger bone: (3,) rotation vector} of the synthesised neutral pose's relaxed hands."""
+    return {name: rotvec for name, rotvec in neutral_pose().items() if name in FINGER_BONES}
+
+
 def relaxed_hand(clip):
-    """`clip` with a relaxed open hand on both sides: Index1 in its rotvecs, the other fingers in .fingers."""
+    """`clip` with the synthesised clips' relaxed hand (synthesis.neutral_pose) on both sides, for a capture
+    without fingers: Index1 in its rotvecs, the other finger bones in .fingers."""
     rotvecs = np.array(clip.rotvecs, dtype=np.float64)
-    frames = len(rotvecs)
     fingers = dict(clip.fingers)
-    for side in ("Left", "Right"):
-        rotvecs[:, skeleton.ACTION_JOINTS.index(side + "HandIndex1")] = (RELAXED_HAND["Index"], 0.0, 0.0)
-        for finger, curl in RELAXED_HAND.items():
-            for k in (1, 2, 3):
-                name = f"{side}Hand{finger}{k}"
-                if name not in skeleton.ACTION_JOINTS:
-                    fingers[name] = np.tile((curl, 0.0, 0.0), (frames, 1))
-        fingers[f"{side}HandThumb1"] = np.tile(RELAXED_THUMB, (frames, 1))
+    for name, rotvec in _relaxed_hand().items():
+        if name in skeleton.ACTION_JOINTS:
+            rotvecs[:, skeleton.ACTION_JOINTS.index(name)] = rotvec
+        else:
+            fingers[name] = np.tile(rotvec, (len(rotvecs), 1))
     return replace(clip, rotvecs=rotvecs, fingers=fingers)
 
 

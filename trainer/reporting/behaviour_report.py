@@ -3,8 +3,8 @@ import json
 import math
 from pathlib import Path
 
-from trainer.evaluation.baselines import METHOD_LABELS
 from trainer.files import atomic_write_text
+from trainer.reporting.baselines_report import METHOD_LABELS
 from trainer.reporting.tables import markdown_table
 
 WAVE_COLUMNS = ("score", "score, class length", "score, DTW", "smoothness", "swing ratio: median (range)",

@@ -2,8 +2,9 @@
 import matplotlib
 
 from rlanimate_addon.core import skeleton
-from trainer.evaluation.baselines import METHOD_LABELS
 from trainer.motion.realmocap_takes import HOLDOUT_STYLES
+from trainer.reporting.baselines_report import METHOD_LABELS
+from trainer.reporting.tables import markdown_table
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -44,45 +45,46 @@ def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
 
 
 def realmocap_markdown(results):
+    """docs/results/realmocap.md from the results run_experiments returns."""
+    label_rows = [[style, f"{row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f}", f"{row['elevation_deg']:.0f}",
+                   f"{row['stroke_arm_lengths']:.2f}", f"{row['arm_correct']}/{row['clips']}"]
+                  for style, row in results["labels"]["wave"].items()]
+    score_rows = []
+    for name, label in (("wave", "wave agent, takes 001-008 (112 clips)"),
+                        ("holdout", f"wave agent, 5 styles (100 clips; unseen: {', '.join(HOLDOUT_STYLES)})")):
+        entry = results[name]
+        for set_name in ("test", "bye"):
+            for method, result in entry.get(set_name, {}).items():
+                score_rows.append([label, f"{set_name} ({len(result['clips'])})", METHOD_LABELS[method],
+                                   f"{result['score']:.2f}", f"{result['smoothness']:.2f}", f"{result['label_error']:.3f}"])
+        score_rows.append([label, "seen (10 training clips)", "RLAnimate", f"{entry['seen']['score']:.2f}",
+                           f"{entry['seen']['smoothness']:.2f}", ""])
+    bye = results["labels"]["bye"].items()
     lines = ["# Learning from real motion capture", "",
              f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), retargeted onto the "
              f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
              f"Preset `{results['preset']}`, {results['epochs']} epochs, seed {results['seed']}. "
              f"Regenerate: `{results['command']}`.", "",
              "## Auto-labels per style (one-arm waves, 20 clips each)", "",
-             "| style | exaggeration (mean ± sd) | elevation (deg) | stroke (arm lengths) | arm detected |",
-             "|---|---|---|---|---|"]
-    for style, row in results["labels"]["wave"].items():
-        lines.append(f"| {style} | {row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f} | {row['elevation_deg']:.0f} | "
-                     f"{row['stroke_arm_lengths']:.2f} | {row['arm_correct']}/{row['clips']} |")
-    bye = results["labels"]["bye"].items()
-    lines += ["", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), ""]
-    lines += ["## Score and smoothness", "",
-              "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
-              "| experiment | test set | method | score | smoothness | label error |", "|---|---|---|---|---|---|"]
-    for name, label in (("wave", "wave agent, takes 001-008 (112 clips)"),
-                        ("holdout", f"wave agent, 5 styles (100 clips; unseen: {', '.join(HOLDOUT_STYLES)})")):
-        entry = results[name]
-        for set_name in ("test", "bye"):
-            for method, result in entry.get(set_name, {}).items():
-                lines.append(f"| {label} | {set_name} ({len(result['clips'])}) | {METHOD_LABELS[method]} | "
-                             f"{result['score']:.2f} | {result['smoothness']:.2f} | {result['label_error']:.3f} |")
-        lines.append(f"| {label} | seen (10 training clips) | RLAnimate | {entry['seen']['score']:.2f} | "
-                     f"{entry['seen']['smoothness']:.2f} | |")
-    lines += ["", f"Training: wave agent {results['wave']['episodes']} episodes, {results['wave']['train_seconds']:.0f} s; "
-              f"hold-out agent {results['holdout']['episodes']} episodes, {results['holdout']['train_seconds']:.0f} s "
-              "(1 torch thread).", "",
-              "## Guide clips as pointing", ""]
+             *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
+                              "arm detected"], label_rows),
+             "", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), "",
+             "## Score and smoothness", "",
+             "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
+             *markdown_table(["experiment", "test set", "method", "score", "smoothness", "label error"], score_rows),
+             "", f"Training: wave agent {results['wave']['episodes']} episodes, "
+             f"{results['wave']['train_seconds']:.0f} s; hold-out agent {results['holdout']['episodes']} episodes, "
+             f"{results['holdout']['train_seconds']:.0f} s (1 torch thread).", "",
+             "## Guide clips as pointing", ""]
     if "skipped" in results["guide"]:
         return "\n".join(lines + [f"Not run: {results['guide']['skipped']}", "",
                                    "![real and generated frames](realmocap_frames.png)", ""])
-    lines += [f"Pointing agent `{results['guide']['point_agent']}`, given the direction in which the actor held the arm "
-              "(rest shoulder to the index base at the hold). Angle between the generated and the real forearm "
-              "(elbow to wrist), each at its own hold:", "",
-              "| method | mean (deg) | median (deg) |", "|---|---|---|"]
-    for method, entry in results["guide"].items():
-        if isinstance(entry, dict):
-            lines.append(f"| {METHOD_LABELS[method]} | {entry['mean_forearm_angle_deg']:.1f} | "
-                         f"{entry['median_forearm_angle_deg']:.1f} |")
-    lines += ["", "![real and generated frames](realmocap_frames.png)", ""]
+    guide_rows = [[METHOD_LABELS[method], f"{entry['mean_forearm_angle_deg']:.1f}",
+                   f"{entry['median_forearm_angle_deg']:.1f}"]
+                  for method, entry in results["guide"].items() if isinstance(entry, dict)]
+    lines += [f"Pointing agent `{results['guide']['point_agent']}`, given the direction in which the actor held "
+              "the arm (rest shoulder to the index base at the hold). Angle between the generated and the real "
+              "forearm (elbow to wrist), each at its own hold:", "",
+              *markdown_table(["method", "mean (deg)", "median (deg)"], guide_rows),
+              "", "![real and generated frames](realmocap_frames.png)", ""]
     return "\n".join(lines)

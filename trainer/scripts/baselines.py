@@ -13,11 +13,11 @@ from trainer.agent.algorithm import ClipReferences
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
-from trainer.evaluation.baselines import (AgentMethod, NearestClip, evaluate_motions, generate_for, neutral_pose,
-                                          write_results)
-from trainer.evaluation.scoring import select_clips
+from trainer.evaluation.baselines import AgentMethod, NearestClip, generate_for, mean_start_pose
+from trainer.evaluation.scoring import score_motions, select_clips
 from trainer.motion import autolabel
 from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
+from trainer.reporting.baselines_report import write_baselines_results
 from trainer.scripts.cli import run_main, script_args
 
 
@@ -28,7 +28,7 @@ def sample_library_comparison(agent_path, manifest):
     session = LibrarySession(manifest)
     train_clips = session.train_clips
     methods = {"rlanimate": AgentMethod(agent_path), "nearest_clip": NearestClip(train_clips),
-               "procedural_ik": ProceduralIK(neutral_pose(train_clips))}
+               "procedural_ik": ProceduralIK(mean_start_pose(train_clips))}
     references = ClipReferences(session.env)
     sets = {}
     for behaviour in ("point", "wave"):
@@ -36,7 +36,7 @@ def sample_library_comparison(agent_path, manifest):
         rows = {}
         for name, method in methods.items():
             motions = generate_for(method, clips)
-            result = evaluate_motions(session.env, motions, clips, references)
+            result = score_motions(session.env, motions, clips, references)
             rows[name] = {key: result[key] for key in ("score", "smoothness")}
             if behaviour == "wave":
                 rows[name]["label_error"] = float(np.mean([
@@ -58,7 +58,7 @@ def main(argv=None):
     agent = shown(options.agent)
     provenance = "untrained" if training.get("untrained") else ", ".join(
         f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
-    write_results(options.results, "sample library",
+    write_baselines_results(options.results, "sample library",
                   f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
                   f"RLAnimate: `{agent}` ({provenance}). "
                   f"Regenerate: `nice -n 10 python -m trainer.scripts.baselines --agent {agent}`.", sets)

@@ -15,7 +15,7 @@ from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
 from trainer.evaluation import behaviour
-from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, neutral_pose
+from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.reporting.behaviour_report import write_behaviour
 from trainer.reporting.plots import wave_hand_paths
@@ -30,8 +30,8 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir):
     session = LibrarySession(manifest)
     train, test = session.train_clips, session.test_clips
     agent = AgentMethod(agent_path)
-    methods = {"rlanimate": agent, "no_motion": NoMotion(neutral_pose(train)), "class_mean": ClassMean(train),
-               "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(neutral_pose(train))}
+    methods = {"rlanimate": agent, "no_motion": NoMotion(mean_start_pose(train)), "class_mean": ClassMean(train),
+               "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(mean_start_pose(train))}
 
     def describe(rotvecs):
         return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)

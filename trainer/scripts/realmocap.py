@@ -7,9 +7,9 @@ import argparse
 import json
 from pathlib import Path
 
-from trainer.evaluation.baselines import write_results
 from trainer.evaluation.realmocap import baseline_sets, run_experiments
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
+from trainer.reporting.baselines_report import write_baselines_results
 from trainer.reporting.realmocap_report import realmocap_markdown
 from trainer.scripts.cli import run_main, script_args
 
@@ -34,7 +34,7 @@ def main(argv=None):
     out = Path(options.results)
     (out / "realmocap.json").write_text(json.dumps(results, indent=2) + "\n")
     (out / "realmocap.md").write_text(realmocap_markdown(results))
-    write_results(out, "real motion capture",
+    write_baselines_results(out, "real motion capture",
                   "Agents trained on the real waves (takes 001-008, or 5 styles); pointing agent from "
                   f"the sample library for the guide clips. Regenerate: `{results['command']}`.",
                   baseline_sets(results))

@@ -8,8 +8,8 @@ from tests.trainer.synthetic_library import make_library
 from trainer.agent.algorithm import ClipReferences, Trainer, clip_objective, clips_for_behaviour
 from trainer.agent.buffer import EPISODE_KEYS, EpisodeBuffer
 from trainer.agent.config import load_preset
-from trainer.blender_io.fk_env import FKEnvironment
 from trainer.agent.models import RLAnimateAgent
+from trainer.motion.fk import NumpyFKEnvironment
 
 torch.set_num_threads(1)
 
@@ -51,7 +51,7 @@ def test_episodes_with_mismatched_lengths_are_rejected():
 
 @pytest.fixture(scope="module")
 def env():
-    return FKEnvironment(instances=16)
+    return NumpyFKEnvironment()
 
 
 @pytest.fixture(scope="module")

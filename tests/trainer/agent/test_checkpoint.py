@@ -10,11 +10,11 @@ import torch
 from rlanimate_addon.core.errors import RLAnimateError
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint
-from trainer.agent.run import RunSettings, train
 from trainer.agent.algorithm import ClipReferences, Trainer
 from trainer.agent.config import load_preset
-from trainer.blender_io.fk_env import FKEnvironment
 from trainer.agent.models import RLAnimateAgent
+from trainer.agent.run import RunSettings, train
+from trainer.motion.fk import NumpyFKEnvironment
 
 torch.set_num_threads(1)
 
@@ -56,7 +56,7 @@ def test_missing_damaged_and_foreign_checkpoints_raise_clear_errors(tmp_path):
 
 @pytest.fixture(scope="module")
 def session():
-    env = FKEnvironment(instances=16)
+    env = NumpyFKEnvironment()
     library = make_library(seed=5)
     return SimpleNamespace(env=env, references=ClipReferences(env), train_clips=library.train,
                            test_clips=library.test)

@@ -1,28 +1,19 @@
-"""Baselines: nearest-clip retrieval and procedural IK produce valid clips that the evaluator scores."""
+"""Baselines: nearest-clip retrieval answers requests with valid clips that the one scorer scores."""
 import numpy as np
 import pytest
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import skeleton
+from rlanimate_addon.core.errors import RLAnimateError
+from tests.trainer.synthetic_library import make_clip
 from trainer.agent.algorithm import ClipReferences
-from trainer.blender_io.fk_env import FKEnvironment
-from trainer.blender_io.procedural_ik import ProceduralIK
-from trainer.blender_io.rig_session import new_empty_scene
-from trainer.evaluation import baselines
-from trainer.motion.clip import MotionClip
+from trainer.evaluation import baselines, scoring
+from trainer.motion.fk import NumpyFKEnvironment
 
 JOINTS = len(skeleton.ACTION_JOINTS)
 
 
-@pytest.fixture(scope="module")
-def scene():
-    """Factory-fresh scene with the FK environment and the procedural-IK rig side by side."""
-    new_empty_scene()
-    env = FKEnvironment(instances=8)
-    neutral = np.zeros((JOINTS, 3))
-    for side, sign in (("Left", 1.0), ("Right", -1.0)):  # arms lowered 70 deg from the T-pose
-        rest = skeleton.rest_frame(skeleton.BONE_BY_NAME[side + "Arm"])
-        neutral[skeleton.ACTION_JOINTS.index(side + "Arm")] = rest.T @ np.array([0.0, sign * 1.22, 0.0])
-    return env, ProceduralIK(neutral)
+def _wave(exaggeration, frames):
+    return make_clip(f"wave_{exaggeration}", "WAVE", "RIGHT", exaggeration, frames)
 
 
 def _valid(motion, frames):
@@ -39,40 +30,32 @@ def test_time_warp_keeps_the_ends_and_resamples_the_length():
     np.testing.assert_allclose(baselines.time_warp(clip, 40), clip, atol=1e-9)
 
 
-def test_nearest_clip_retrieves_the_closest_label(scene):
-    _, ik = scene
-    library = [MotionClip(f"wave_{e}", "", 30.0, ik.generate("WAVE", "RIGHT", e, 60 + int(100 * e)),
-                          behaviour="WAVE", arm="RIGHT", attributes=e) for e in (0.1, 0.5, 0.9)]
-    up = spaces.pointing_direction("LEFT", [1.0, -2.0, 2.5])
-    library.append(MotionClip("point_up", "", 30.0, ik.generate("POINT", "LEFT", up, 70),
-                              behaviour="POINT", arm="LEFT", attributes=up))
+def test_nearest_clip_retrieves_the_closest_label():
+    library = [_wave(e, 60 + int(100 * e)) for e in (0.1, 0.5, 0.9)]
+    library.append(make_clip("point_up", "POINT", "LEFT", [1.0, -2.0, 2.5], 70))
+    up = library[-1].attributes
     nearest = baselines.NearestClip(library)
     assert nearest.nearest("WAVE", "RIGHT", 0.62).name == "wave_0.5"
     motion = nearest.generate("WAVE", "RIGHT", 0.62, 97)
     _valid(motion, 97)
     np.testing.assert_allclose(motion[[0, -1]], library[1].rotvecs[[0, -1]], atol=1e-9)
     assert nearest.nearest("POINT", "LEFT", [0.3, -1.0, 0.4]).name == "point_up"
-    from rlanimate_addon.core.errors import RLAnimateError
     with pytest.raises(RLAnimateError, match="right arm"):
         nearest.generate("POINT", "RIGHT", up, 50)
 
 
-def test_the_evaluator_scores_baseline_clips(scene):
-    env, ik = scene
-    e = 0.7
-    reference = MotionClip("ref", "", 30.0, ik.generate("WAVE", "RIGHT", e, 80), behaviour="WAVE",
-                           arm="RIGHT", attributes=e)
-    other = MotionClip("other", "", 30.0, ik.generate("WAVE", "RIGHT", 0.2, 60), behaviour="WAVE",
-                       arm="RIGHT", attributes=0.2)
+def test_the_evaluator_scores_baseline_clips():
+    env = NumpyFKEnvironment()
+    reference, other = _wave(1.0, 80), _wave(0.0, 60)
     references = ClipReferences(env)
-    for baseline in (baselines.NearestClip([other]), ik):
+    for baseline in (baselines.NearestClip([other]), baselines.NearestClip([reference, other])):
         motions = baselines.generate_for(baseline, [reference])
         _valid(motions[0], 80)
-        result = baselines.evaluate_motions(env, motions, [reference], references)
+        result = scoring.score_motions(env, motions, [reference], references)
         assert np.isfinite(result["score"]) and 0.0 <= result["smoothness"] <= 100.0
-        assert result["clips"][0]["name"] == "ref"
-    exact = baselines.evaluate_motions(env, [reference.rotvecs], [reference], references)
+        assert result["clips"][0]["name"] == "wave_1.0" and set(result["by_behaviour"]) == {"wave"}
+    exact = scoring.score_motions(env, [reference.rotvecs], [reference], references)
     assert exact["score"] == pytest.approx(100.0)
-    copied = baselines.evaluate_motions(env, baselines.generate_for(baselines.NearestClip([other]), [reference]),
-                                        [reference], references)
+    copied = scoring.score_motions(env, baselines.generate_for(baselines.NearestClip([other]), [reference]),
+                                   [reference], references)
     assert copied["score"] < exact["score"] - 0.5  # a different exaggeration costs score

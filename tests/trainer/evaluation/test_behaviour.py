@@ -50,7 +50,7 @@ def test_copy_passes_and_still_arm_and_class_mean_do_not(library):
     train, test = library
     lengths = behaviour.class_lengths(train)
     results = {}
-    for name, method in (("copy", Copy(test)), ("no_motion", baselines.NoMotion(baselines.neutral_pose(train))),
+    for name, method in (("copy", Copy(test)), ("no_motion", baselines.NoMotion(baselines.mean_start_pose(train))),
                          ("class_mean", baselines.ClassMean(train))):
         rows = behaviour.request_rows(method, test, NumpyReferences(), kinematics.describe, lengths)
         results[name] = behaviour.summarise(rows)

@@ -9,7 +9,8 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
 from trainer.evaluation import baselines, realmocap
 from trainer.motion import autolabel
-from trainer.motion.realmocap_takes import RELAXED_HAND, wave_split
+from trainer.motion.realmocap_takes import wave_split
+from trainer.motion.synthesis import neutral_pose
 from trainer.paths import REALMOCAP_DIR
 from trainer.reporting.realmocap_report import frames_figure
 
@@ -25,7 +26,7 @@ def test_imported_clips_are_labelled_from_their_motion(tmp_path):
     assert (wave.behaviour, wave.arm, wave.named_arm, wave.style, wave.take) == ("WAVE", "RIGHT", "RIGHT", "normal", "003")
     assert 0.0 <= wave.exaggeration <= 1.0 and wave.attributes == wave.exaggeration
     assert np.allclose(wave.rotvecs[:, skeleton.ACTION_JOINTS.index("RightHandIndex1")],
-                       (RELAXED_HAND["Index"], 0.0, 0.0))
+                       neutral_pose()["RightHandIndex1"])
     guide = realmocap.import_real_clip(REALMOCAP_DIR / "guide" / "dataset-1_guide_normal_001.bvh", tmp_path)
     assert guide.behaviour == "POINT" and guide.arm == "RIGHT"
     assert abs(np.linalg.norm(guide.attributes) - 1.0) < 1e-9
@@ -48,7 +49,7 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     exported = baselines.AgentMethod(agent.path).generate("WAVE", "LEFT", 0.4, 40)
     np.testing.assert_allclose(exported, agent.generate("WAVE", "LEFT", 0.4, 40), atol=1e-4)
     methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train),
-               "procedural_ik": ProceduralIK(baselines.neutral_pose(train))}
+               "procedural_ik": ProceduralIK(baselines.mean_start_pose(train))}
     comparison = realmocap.compare(methods, test, env, references)
     for result in comparison.values():
         assert np.isfinite(result["score"]) and 0.0 <= result["smoothness"] <= 100.0

@@ -5,11 +5,11 @@ import torch
 
 from rlanimate_addon.core import metrics, spaces
 from tests.trainer.synthetic_library import make_library
-from trainer.evaluation import scoring
 from trainer.agent.algorithm import ClipReferences, clip_objective
 from trainer.agent.config import load_preset
-from trainer.blender_io.fk_env import FKEnvironment
 from trainer.agent.models import RLAnimateAgent
+from trainer.evaluation import scoring
+from trainer.motion.fk import NumpyFKEnvironment
 
 torch.set_num_threads(1)
 
@@ -32,7 +32,7 @@ class ReplayAgent(torch.nn.Module):
 
 @pytest.fixture(scope="module")
 def env():
-    return FKEnvironment(instances=16)
+    return NumpyFKEnvironment()
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,7 @@
 """trainer.scripts.experiments' command line: another seed gets its own runs and results, never seed 0's."""
 from pathlib import Path
 
+from trainer.evaluation.experiments import run_folder
 from trainer.paths import REPO_ROOT, RESULTS_DIR
 from trainer.scripts import experiments
 
@@ -15,8 +16,8 @@ def test_another_seed_never_reuses_seed_zero_runs_or_overwrites_its_results():
     options = experiments.parse_options(["experiments", "--seed", "3"])
     assert Path(options.runs) == REPO_ROOT / "runs" / "experiments_seed3"
     assert Path(options.results) == RESULTS_DIR / "seed3"
-    assert experiments.run_folder(options, "rlanimate", "wave") != \
-        experiments.run_folder(experiments.parse_options(["experiments"]), "rlanimate", "wave")
+    assert run_folder(options, "rlanimate", "wave") != \
+        run_folder(experiments.parse_options(["experiments"]), "rlanimate", "wave")
 
 
 def test_explicit_folders_win(tmp_path):

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import kinematics, skeleton, spaces
-from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.easing import minimum_jerk
+from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import matrix_to_rotvec, rotvec_to_matrix
 from trainer.motion import synthesis as gs
 from trainer.motion.synthesis.timing import blend_rotation
