@@ -10,6 +10,8 @@ import numpy as np
 
 LAYERED = "slots" in bpy.types.Action.bl_rna.properties
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
+_BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZIER"].value
+_FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
 
 
 class ActionTarget:
@@ -73,6 +75,27 @@ def write_keys(fcurve, frames, values):
     points.add(count)
     points.foreach_set("co", np.column_stack([frames, values]).astype(np.float32).ravel())
     points.foreach_set("interpolation", np.full(count, _LINEAR, dtype=np.int32))
+
+
+def write_bezier_keys(fcurve, frames, values, tangents):
+    """Bulk-write Bezier keys (frames (K,), values (K,), slopes per frame (K,)) into an empty F-curve.
+
+    Each key's handles sit a third of the way to its neighbouring keys along its slope (free handles,
+    so Blender keeps them): every segment then plays the cubic Hermite curve core.key_reduction predicts.
+    """
+    frames, values, tangents = (np.asarray(a, dtype=np.float64) for a in (frames, values, tangents))
+    gaps = np.diff(frames) / 3.0
+    left = np.concatenate([gaps[:1], gaps])
+    right = np.concatenate([gaps, gaps[-1:]])
+    count = len(frames)
+    points = fcurve.keyframe_points
+    points.add(count)
+    for name, data in (("co", np.column_stack([frames, values])),
+                       ("handle_left", np.column_stack([frames - left, values - tangents * left])),
+                       ("handle_right", np.column_stack([frames + right, values + tangents * right]))):
+        points.foreach_set(name, data.astype(np.float32).ravel())
+    for name, value in (("interpolation", _BEZIER), ("handle_left_type", _FREE), ("handle_right_type", _FREE)):
+        points.foreach_set(name, np.full(count, value, dtype=np.int32))
 
 
 def active_target(obj):

@@ -10,7 +10,7 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..core import rig_roles
+from ..core import key_reduction, rig_roles
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState
 from ..core.rig import RigSkeleton
@@ -119,17 +119,24 @@ def _to_armature(obj, point):
 def write_gesture(obj, name, start_frame, keys, blend_type="REPLACE"):
     """Key a gesture from start_frame into a new action called `name`; returns the new action.
 
-    keys: {bone name: (rotation mode, (N, C) channel values)}. On a rig with no animation the action
+    keys: {bone name: (rotation mode, (N, C) channel values per frame, kept frame indices or None)}:
+    with kept indices, Bezier keys on those frames only (core.key_reduction), else a linear key on
+    every frame. On a rig with no animation the action
     becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
     Blender's Push Down does, and the gesture goes on a new NLA track above it with the blend type
     ('REPLACE' or 'COMBINE') and no effect outside its frames.
     """
     target = action_adapter.new_action(name, obj)
-    for bone, (mode, values) in keys.items():
+    for bone, (mode, values, kept) in keys.items():
         frames = start_frame + np.arange(len(values))
         path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
+        tangents = key_reduction.slopes(values)
         for channel in range(values.shape[1]):
-            action_adapter.write_keys(target.new_fcurve(path, channel, bone), frames, values[:, channel])
+            fcurve = target.new_fcurve(path, channel, bone)
+            if kept is None:
+                action_adapter.write_keys(fcurve, frames, values[:, channel])
+            else:
+                action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel])
     if action_adapter.is_animated(obj):
         action_adapter.push_down(obj)
         strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)

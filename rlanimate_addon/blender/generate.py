@@ -1,8 +1,8 @@
-"""Generate Gesture: run the agent for the scene's settings and bake the result onto the active armature."""
+"""Generate Gesture: run the agent for the scene's settings and bake the result onto the selected armatures."""
 import bpy
 import numpy as np
 
-from ..core import channels, gesture, rig_roles
+from ..core import channels, gesture, key_reduction, rig_roles
 from ..core.errors import RLAnimateError
 from . import action_adapter, armature_io, constraints, preferences
 
@@ -45,69 +45,111 @@ def check_frames(start, frame_count):
                              f"{high - frame_count + 1}.")
 
 
-def generate(context, settings, progress=lambda step: None, mute_constraints=False):
-    """Bake the gesture the settings describe onto the active armature; returns a one-line summary.
+def selected_armatures(context, settings):
+    """The armatures to bake onto: the active object, which must be one, then every other selected
+    armature (the Point target excluded)."""
+    active = context.active_object
+    if active is None or active.type != "ARMATURE":
+        raise RLAnimateError("The active object is not an armature: select the character's armature.")
+    return [active] + [o for o in context.selected_objects
+                       if o.type == "ARMATURE" and o is not active and o is not settings.target]
 
-    Every check runs before the first write, so an RLAnimateError leaves the file as it was (the scene
-    frame included). Constraints that would override the gesture are refused, or muted over its frames
-    with mute_constraints (blender/constraints.py).
-    """
-    obj = context.active_object
+
+class _Plan:
+    """One armature's checked settings, and then its gesture, ready to write."""
+
+    def __init__(self, obj, family, roles, overriding):
+        self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
+        self.rig = self.bones = self.keys = self.blend_type = None
+        self.worst = 0.0
+
+
+def _check(obj, settings, start, end, mute_constraints):
+    """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
     check_keepable(obj)
-    agent = preferences.selected_agent(context)
-    frame_count, start = int(settings.frame_count), int(settings.start_frame)
-    gesture.check_length(frame_count)
-    check_frames(start, frame_count)
-    end = start + frame_count - 1
-    _check_target(settings)
     overriding = constraints.overriding(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm))
     constraints.check(obj, overriding, start, end, mute_constraints)
-    progress(1)
+    return _Plan(obj, family, roles, overriding)
 
-    scene = context.scene
+
+def _compute(context, plan, settings, agent, frames):
+    """Fill in the plan's gesture and keys (nothing written)."""
+    obj, scene = plan.obj, context.scene
     original_frame = scene.frame_current
-    frames = start + np.arange(frame_count)
     target = settings.target if settings.behaviour == "POINT" else None
     try:
-        rig, below_values, targets = armature_io.sample_rig(context, obj, roles, family, frames, target,
+        rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
                                                             settings.target_bone if target else "")
     finally:
         if scene.frame_current != original_frame:
             scene.frame_set(original_frame)
-    progress(2)
-
-    request = gesture.GestureRequest(settings.behaviour, settings.arm, frame_count,
+    request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
                                      targets=targets if settings.behaviour == "POINT" else None,
                                      exaggeration=settings.exaggeration, seed=settings.seed or None,
                                      exact_aim=settings.exact_aim)
-    bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
-    blend_type = settings.blend_type if rig.animated else "REPLACE"
-    keys = {}
-    for column, bone in enumerate(bones):
+    plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
+    plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
+    plan.keys = {}
+    for column, bone in enumerate(plan.bones):
         mode = obj.pose.bones[bone].rotation_mode
-        keys[bone] = (mode, channels.rotation_keys(mode, keyed[:, column], below[:, column],
-                                                   below_values[bone], blend_type))
+        values = channels.rotation_keys(mode, keyed[:, column], below[:, column], below_values[bone],
+                                        plan.blend_type)
+        kept = None
+        if settings.editable_keys:
+            added = below_values[bone] if plan.blend_type == "COMBINE" and mode != "QUATERNION" else None
+            kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
+            plan.worst = max(plan.worst, deviation)
+        plan.keys[bone] = (mode, values, kept)
+
+
+def generate(context, settings, progress=lambda step: None, mute_constraints=False):
+    """Bake the gesture the settings describe onto the active armature and every other selected one
+    (one shared target); returns a summary, one line per armature.
+
+    Every check, for every armature, runs before the first write, so an RLAnimateError leaves the file
+    as it was (the scene frame included). Constraints that would override the gesture are refused, or
+    muted over its frames with mute_constraints (blender/constraints.py).
+    """
+    frame_count, start = int(settings.frame_count), int(settings.start_frame)
+    end = start + frame_count - 1
+    plans = [_check(obj, settings, start, end, mute_constraints) for obj in selected_armatures(context, settings)]
+    agent = preferences.selected_agent(context)
+    gesture.check_length(frame_count)
+    check_frames(start, frame_count)
+    _check_target(settings)
+    progress(1)
+    frames = start + np.arange(frame_count)
+    for plan in plans:
+        _compute(context, plan, settings, agent, frames)
     progress(3)
 
     label = f"{settings.behaviour.title()} {settings.arm.title()}"
-    action = armature_io.write_gesture(obj, f"RLAnimate {label}", start, keys, blend_type)
-    constraints.mute(obj, overriding, start, end)
-    progress(4)
-    note = f" (muted {constraints.describe(overriding)} over its frames)" if overriding else ""
+    note = ""
     shortest, longest = gesture.supported_length_range(agent.average_frames[settings.behaviour])
     if not shortest <= frame_count <= longest:
         note += f" (time-scaled: the agent's range is {shortest}-{longest} frames)"
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
-    layer = f", {blend_type.title()} layer over its animation" if rig.animated else ""
-    return (f"Baked {label} on {obj.name!r} ({family} bones): {len(bones)} bones, frames {start}-{end}, "
-            f"action {action.name!r}{layer}{note}")
+    lines = []
+    for plan in plans:
+        action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type)
+        constraints.mute(plan.obj, plan.overriding, start, end)
+        muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
+        layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
+        editable = ""
+        if settings.editable_keys:
+            count = sum(len(kept) * values.shape[1] for _, values, kept in plan.keys.values())
+            editable = f"; editable: {count} Bezier keys, worst deviation {plan.worst:.2f} deg"
+        lines.append(f"Baked {label} on {plan.obj.name!r} ({plan.family} bones): {len(plan.bones)} bones, frames "
+                     f"{start}-{end}, action {action.name!r}{layer}{muted}{note}{editable}")
+    progress(4)
+    return "\n".join(lines)
 
 
 class RLANIMATE_OT_generate_gesture(bpy.types.Operator):
-    """Bake a pointing or waving gesture onto the active armature with the RLAnimate agent"""
+    """Bake a pointing or waving gesture onto the selected armatures with the RLAnimate agent"""
     bl_idname = "rlanimate.generate_gesture"
     bl_label = "Generate Gesture"
     bl_options = {"REGISTER", "UNDO"}

@@ -58,6 +58,10 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
 
         layout.prop(settings, "blend_type", expand=True)
         row = layout.row(align=True)
+        row.prop(settings, "editable_keys")
+        if settings.editable_keys:
+            row.prop(settings, "key_tolerance")
+        row = layout.row(align=True)
         row.prop(settings, "bone_map_file")
         row.operator("rlanimate.save_bone_map", text="", icon="FILE_TICK")
 

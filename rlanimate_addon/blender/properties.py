@@ -55,6 +55,13 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
                                       "(NLA Replace)"),
                ("COMBINE", "Combine", "Over existing animation, the gesture is added to the bones it drives "
                                       "(NLA Combine)")])
+    editable_keys: bpy.props.BoolProperty(
+        name="Editable Keys", default=False,
+        description="Bake a few Bezier keys per bone, only where needed to stay within the tolerance, instead "
+                    "of a key on every frame")
+    key_tolerance: bpy.props.FloatProperty(
+        name="Tolerance", default=0.5, min=0.01, max=10.0, precision=2,
+        description="Largest rotation, in degrees, by which the editable keys may stray from the baked gesture")
     bone_map_file: bpy.props.StringProperty(
         name="Bone Map", default="", subtype="FILE_PATH",
         description="A bone-map file (JSON) naming the rig's bone for each role; empty detects the bones")

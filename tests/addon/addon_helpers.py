@@ -96,9 +96,12 @@ def add_empty(name, location):
 
 
 def generate(rig, settings, **values):
-    """Set Scene.rlanimate from `values` and run Generate Gesture on `rig`; returns the operator result."""
+    """Set Scene.rlanimate from `values` and run Generate Gesture on `rig` alone (active, the only one
+    selected); returns the operator result."""
     for key, value in values.items():
         setattr(settings, key, value)
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj is rig)
     activate(rig)
     return bpy.ops.rlanimate.generate_gesture()
 
