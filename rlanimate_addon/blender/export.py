@@ -1,12 +1,11 @@
 """Export FBX: the active armature, its meshes and its baked animation, through Blender's FBX exporter."""
 import os
-import re
 from pathlib import Path
 
 import bpy
 from bpy_extras.io_utils import ExportHelper
 
-from ..core.errors import RLAnimateError
+from ..core.errors import RLAnimateError, operator_error_reason
 
 #: Settings a Mixamo-style consumer (Unity, Unreal, Mixamo itself) reads back as it was baked: no leaf
 #: bones, Blender's bone axes, one take of the evaluated scene animation (NLA strips included),
@@ -57,13 +56,6 @@ def check_path(filepath):
     return path
 
 
-def _reason(error):
-    """The last line of the Python error inside the RuntimeError bpy.ops raises (not its traceback)."""
-    lines = [line.strip() for line in str(error).splitlines()]
-    errors = [line for line in lines if re.match(r"^[A-Za-z_.]*(Error|Exception): ", line)]
-    return errors[-1] if errors else (lines[0] if lines else "unknown error")
-
-
 def export_rig(context, filepath):
     """Write the active armature and its meshes to `filepath`; returns a one-line summary.
 
@@ -88,7 +80,7 @@ def export_rig(context, filepath):
             scene.frame_start, scene.frame_end = min(frame_range[0], keyed[0]), max(frame_range[1], keyed[1])
         bpy.ops.export_scene.fbx(filepath=str(path), **FBX_SETTINGS)
     except RuntimeError as error:
-        raise RLAnimateError(f"Could not write {path}: {_reason(error)}. Choose a folder you can write "
+        raise RLAnimateError(f"Could not write {path}: {operator_error_reason(error)}. Choose a folder you can write "
                              "to.") from None
     finally:
         scene.frame_start, scene.frame_end = frame_range

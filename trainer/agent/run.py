@@ -18,7 +18,7 @@ from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
 from trainer.agent.agent_export import export_agent
 from trainer.agent.algorithm import Trainer
-from trainer.agent.config import load_preset
+from trainer.agent.config import PRESETS, load_preset
 from trainer.agent.models import RLAnimateAgent
 from trainer.evaluation.scoring import evaluate_seen_unseen
 from trainer.motion.manifest import manifest_path
@@ -55,20 +55,53 @@ def resolve(settings):
     """`settings` with every None filled: from the run's checkpoint when resuming (RLAnimateError when a
     given value conflicts with the run's own), else from NEW_RUN_DEFAULTS. `epochs` stays None when not
     given to a new run (the preset decides)."""
+    check_settings(settings)
     saved = checkpoint.load(Path(settings.output) / checkpoint.FILENAME) if settings.resume else None
-    return _resolved(settings, saved and saved["arguments"])
+    return _resolved(settings, saved)
 
 
-def _resolved(settings, saved_arguments):
-    if saved_arguments is None:
+def check_settings(settings):
+    """RLAnimateError naming every setting no run can use: called before any work is done."""
+    problems = []
+    if settings.epochs is not None and not (_is_count(settings.epochs) and settings.epochs >= 1):
+        problems.append(f"--epochs {settings.epochs}: train at least 1 epoch (leave --epochs out for the "
+                        "preset's length, the paper's 50 for one behaviour and 100 for both)")
+    if not (_is_count(settings.checkpoint_every) and settings.checkpoint_every >= 1):
+        problems.append(f"--checkpoint-every {settings.checkpoint_every}: write a checkpoint every 1 or more "
+                        "epochs (the default 1 writes one after every epoch)")
+    if settings.eval_every is not None and not (_is_count(settings.eval_every) and settings.eval_every >= 0):
+        problems.append(f"--eval-every {settings.eval_every}: evaluate every N >= 1 epochs, or 0 for only at the "
+                        "end")
+    if settings.seed is not None and not (_is_count(settings.seed) and 0 <= settings.seed < 2 ** 32):
+        problems.append(f"--seed {settings.seed}: use a seed from 0 to {2 ** 32 - 1}")
+    if settings.preset is not None and settings.preset not in PRESETS:
+        problems.append(f"--preset {settings.preset}: unknown config preset; use one of {', '.join(PRESETS)}")
+    if problems:
+        raise RLAnimateError("; ".join(problems) + ". Nothing was trained.")
+
+
+def _is_count(value):
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def _resolved(settings, saved):
+    """`settings` checked and completed from NEW_RUN_DEFAULTS, or from the checkpoint `saved` when resuming."""
+    check_settings(settings)
+    if saved is None:
         return replace(settings, **{name: value for name, value in NEW_RUN_DEFAULTS.items()
                                     if getattr(settings, name) is None})
+    saved_arguments = saved["arguments"]
     conflicts = [f"--{name.replace('_', '-')} {getattr(settings, name)} (the run has {saved_arguments[name]})"
                  for name in RESUMED_SETTINGS
                  if getattr(settings, name) is not None and getattr(settings, name) != saved_arguments[name]]
     if conflicts:
         raise RLAnimateError(f"Cannot resume the run in {settings.output} with {', '.join(conflicts)}: a resumed "
                              "run keeps its own settings. Leave those options out, or start a new run elsewhere.")
+    trained = saved["trainer"]["epoch"]
+    if settings.epochs is not None and settings.epochs < trained:
+        raise RLAnimateError(f"--epochs {settings.epochs}, but the run in {settings.output} has trained {trained} "
+                             f"epochs already: give {trained} or more to finish or extend it, or leave --epochs out "
+                             "to finish it as planned.")
     return replace(settings, **{name: saved_arguments[name] for name in RESUMED_SETTINGS},
                    epochs=settings.epochs or saved_arguments["epochs"])
 
@@ -107,14 +140,14 @@ class MetricsLog:
 
 
 def train(settings, session):
-    """Train (or resume) the run `settings` describes on `session` (env, references, train_clips, test_clips:
-    trainer.blender_io.clip_session.LibrarySession of `resolve(settings).clips`, or the real-mocap one);
-    returns (report dict, Trainer)."""
+    """Train (or resume) the run `settings` describes on `session` (env, references, train_clips, test_clips,
+    problems: trainer.blender_io.clip_session.LibrarySession of `resolve(settings).clips`, or the real-mocap
+    one); returns (report dict, Trainer). report.json lists the clips the session skipped."""
     torch.set_num_threads(1)
     output = Path(settings.output)
     output.mkdir(parents=True, exist_ok=True)
     saved = checkpoint.load(output / checkpoint.FILENAME) if settings.resume else None
-    settings = _resolved(settings, saved and saved["arguments"])
+    settings = _resolved(settings, saved)
     agent_config, train_config = load_preset(settings.preset)
     epochs = settings.epochs or (train_config.epochs_both if settings.behaviour == "both"
                                  else train_config.epochs_single)
@@ -143,7 +176,7 @@ def train(settings, session):
     if final is None:  # resumed a run that had already finished
         final = evaluate_seen_unseen(trainer, session)
     log.close()
-    report = _report(settings, trainer, final, epochs)
+    report = _report(settings, trainer, final, epochs, session.problems)
     export_agent(agent, output / "agent.npz", _agent_metadata(report, trainer))
     write_run_report(report, output)
     plots.training_curves(trainer.history, output / "training_curves.png",
@@ -156,7 +189,7 @@ def _flatten(evaluation):
             for name in ("score", "smoothness")}
 
 
-def _report(settings, trainer, final, epochs):
+def _report(settings, trainer, final, epochs, skipped):
     seconds = sum(e["collect_seconds"] + e["update_seconds"] for e in trainer.history)
     cpu_seconds = sum(e["cpu_seconds"] for e in trainer.history)
     return {
@@ -167,6 +200,7 @@ def _report(settings, trainer, final, epochs):
         "torch_threads": torch.get_num_threads(),
         "held_out": final["unseen"], "training": final["seen"],
         "final_losses": {k[5:]: v for k, v in trainer.history[-1].items() if k.startswith("loss/")},
+        "skipped_clips": list(skipped),
     }
 
 

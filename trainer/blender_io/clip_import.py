@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from rlanimate_addon.core import bone_maps, rotations, skeleton
-from rlanimate_addon.core.errors import RLAnimateError
+from rlanimate_addon.core.errors import RLAnimateError, operator_error_reason
 from trainer.blender_io import rig_session
 from trainer.motion import canonicalise, clip_cache
 from trainer.motion.clip import ClipSet, MotionClip
@@ -39,9 +39,8 @@ def _import_file(bpy, path):
         else:
             bpy.ops.import_anim.bvh(filepath=str(path), update_scene_fps=True, update_scene_duration=False)
     except (RuntimeError, ValueError, IndexError) as error:
-        detail = str(error).strip().splitlines()[-1] if str(error).strip() else type(error).__name__
         raise RLAnimateError(f"{path}: the file is corrupt or not a valid {suffix[1:].upper()} file "
-                             f"({detail}). Re-export it from your animation tool.") from error
+                             f"({operator_error_reason(error)}). Re-export it from your animation tool.") from error
     return [o for o in bpy.data.objects if o not in before and o.type == "ARMATURE"]
 
 
@@ -284,8 +283,8 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
     if cache_file.is_file():
         try:
             return clip_cache.load_cached(cache_file, path)
-        except (OSError, KeyError, ValueError):
-            pass  # a damaged cache entry: import again and overwrite it
+        except RLAnimateError as error:  # import again and overwrite it
+            print(f"clip_import: {error} Importing {path.name} again.", file=sys.stderr)
     clip = _import_uncached(path, float(expected_fps), bone_map)
     try:
         clip_cache.save_cached(cache_file, clip)
@@ -312,8 +311,7 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None):
         entries = [{"file": p.name} for p in sorted(path.iterdir()) if p.suffix.lower() in CLIP_SUFFIXES]
         default_fps, manifest_path = EXPECTED_FPS, None
     else:
-        raise RLAnimateError(f"{path}: neither a clip directory nor a manifest .json. "
-                             "Point to the folder of FBX/BVH clips or to its manifest.json.")
+        raise _no_library(path)
     if cache_dir is None:  # cache beside a manifest's clips; never write into a plain folder such as
         cache_dir = folder / clip_cache.CACHE_DIR_NAME if manifest_path is not None else False  # ../shared/realmocap
     cache = Path(cache_dir) if cache_dir else None
@@ -329,6 +327,21 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None):
         except RLAnimateError as error:
             problems.append(str(error))
     return clips, problems
+
+
+def _no_library(path):
+    """The RLAnimateError for a path that is neither a clip folder nor an existing manifest .json."""
+    folder = path.parent if path.name == "manifest.json" else path
+    if folder.is_dir():
+        count = sum(p.suffix.lower() in CLIP_SUFFIXES for p in folder.iterdir())
+        return RLAnimateError(f"The folder {folder} has {count} FBX/BVH clips but no manifest.json, and training "
+                              "needs each clip's labels (behaviour, arm, target or exaggeration, train or test "
+                              "split): write a manifest.json there as docs/CLIPS.md describes, or use a clip "
+                              "library that has one.")
+    if path.exists():
+        return RLAnimateError(f"{path} is not a clip manifest (.json) or a folder of clips: use a clip library's "
+                              "manifest.json or the folder that holds it.")
+    return RLAnimateError(f"{path} does not exist: use a clip library's manifest.json or the folder that holds it.")
 
 
 def load_clip_set(manifest_path):

@@ -9,7 +9,7 @@ from trainer.paths import SAMPLE_RIG_BLEND
 
 class LibrarySession:
     """What a run needs besides the trainer (trainer.agent.run.train's `session`): env, references,
-    train_clips, test_clips."""
+    train_clips, test_clips, problems."""
 
     def __init__(self, clips, rig_path=SAMPLE_RIG_BLEND):
         self.manifest = manifest_path(clips)
@@ -24,3 +24,8 @@ class LibrarySession:
     @property
     def test_clips(self):
         return self.clip_set.test
+
+    @property
+    def problems(self):
+        """One message per clip of the manifest that could not be used (the run's report lists them)."""
+        return self.clip_set.problems

@@ -61,10 +61,11 @@ def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_c
 
 
 class RealSession:
-    """What train.run needs (env, references, train_clips, test_clips), over real clips."""
+    """What train.run needs (env, references, train_clips, test_clips, problems), over real clips (every one
+    imported: a take that does not import stops the experiment)."""
 
     def __init__(self, env, references, train_clips, test_clips):
-        self.env, self.references = env, references
+        self.env, self.references, self.problems = env, references, []
         for split, clips in (("train", train_clips), ("test", test_clips)):
             for clip in clips:
                 clip.split = split

@@ -1,10 +1,13 @@
 """The import cache: imported clips kept as .npz files keyed by the source file's SHA-256, so training does
 not re-import every FBX file each run. Numpy only; trainer/blender_io/clip_import.py fills it."""
 import hashlib
+import zipfile
+import zlib
 
 import numpy as np
 
 from rlanimate_addon.core import skeleton
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.files import atomic_open
 from trainer.motion.clip import MotionClip
 
@@ -23,12 +26,25 @@ def file_hash(path):
     return digest.hexdigest()[:32]
 
 
+#: What numpy and zipfile raise on a truncated, overwritten or foreign cache file.
+_DAMAGED = (OSError, EOFError, ValueError, KeyError, IndexError, zipfile.BadZipFile, zlib.error)
+
+
 def load_cached(cache_file, path):
-    with np.load(cache_file, allow_pickle=False) as data:
-        finger_names = [str(n) for n in data["finger_names"]]
-        fingers = {name: data["fingers"][:, i] for i, name in enumerate(finger_names)}
-        return MotionClip(name=path.stem, source=str(path), fps=float(data["fps"]),
-                          rotvecs=data["rotvecs"], fingers=fingers)
+    """The clip cached in `cache_file` for the clip file `path`; RLAnimateError when the entry is damaged."""
+    try:
+        with np.load(cache_file, allow_pickle=False) as data:
+            rotvecs, fps, fingers = data["rotvecs"], float(data["fps"]), data["fingers"]
+            finger_names = [str(n) for n in data["finger_names"]]
+    except _DAMAGED as error:
+        raise RLAnimateError(f"The import cache entry {cache_file} is damaged ({error}).") from error
+    frames = len(rotvecs)
+    if rotvecs.shape != (frames, len(skeleton.ACTION_JOINTS), 3) or fingers.shape != (frames, len(finger_names), 3) \
+            or not (np.all(np.isfinite(rotvecs)) and np.all(np.isfinite(fingers)) and np.isfinite(fps) and fps > 0):
+        raise RLAnimateError(f"The import cache entry {cache_file} is damaged (arrays of shapes {rotvecs.shape} "
+                             f"and {fingers.shape}, or values that are not finite).")
+    return MotionClip(name=path.stem, source=str(path), fps=fps, rotvecs=rotvecs,
+                      fingers={name: fingers[:, i] for i, name in enumerate(finger_names)})
 
 
 def save_cached(cache_file, clip):

@@ -27,4 +27,7 @@ def write_run_report(report, output):
              *markdown_table(["clip", "behaviour", "score", "smoothness"],
                              [[c["name"], c["behaviour"], f"{c['score']:.2f}", f"{c['smoothness']:.2f}"]
                               for c in report["held_out"]["clips"]])]
+    if report["skipped_clips"]:
+        lines += ["", f"Skipped {len(report['skipped_clips'])} clip(s) of the library that did not import:", "",
+                  *(f"- {problem}" for problem in report["skipped_clips"])]
     (output / "report.md").write_text("\n".join(lines) + "\n")

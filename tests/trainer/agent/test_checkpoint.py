@@ -1,5 +1,6 @@
 """Checkpoints: atomic, plain data, clear errors; and a resumed run equals the uninterrupted one bit for bit."""
 import dataclasses
+import json
 import random
 from types import SimpleNamespace
 
@@ -59,7 +60,7 @@ def session():
     env = NumpyFKEnvironment()
     library = make_library(seed=5)
     return SimpleNamespace(env=env, references=ClipReferences(env), train_clips=library.train,
-                           test_clips=library.test)
+                           test_clips=library.test, problems=["clips/wave_left_009.fbx: the file is corrupt"])
 
 
 def _run(session, output, epochs, resume=False):
@@ -84,6 +85,8 @@ def test_resumed_run_equals_the_uninterrupted_run(session, tmp_path):
     assert [e["loss/total"] for e in a["history"]] == [e["loss/total"] for e in b["history"]]
     lines = (tmp_path / "resumed" / "metrics.jsonl").read_text().splitlines()
     assert len(lines) == 4  # the metrics log is rebuilt from the checkpoint, not duplicated
+    report = json.loads((tmp_path / "resumed" / "report.json").read_text())
+    assert report["skipped_clips"] == session.problems, "clips that did not import are in report.json"
 
 
 def test_a_run_killed_mid_schedule_resumes_exactly(session, tmp_path):

@@ -115,6 +115,9 @@ def library(tmp_path_factory):
     files["garbage"].write_bytes(b"Kaydara FBX Binary  \x00\x1a\x00" + bytes(range(256)) * 4)
     files["truncated"] = folder / "truncated.fbx"
     files["truncated"].write_bytes(files["fbx"].read_bytes()[:5000])
+    files["garbled_bvh"] = folder / "garbled.bvh"  # the hierarchy cut inside a joint
+    files["garbled_bvh"].write_text("HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition "
+                                    "Zposition Zrotation Xrotation Yrotation\n JOINT Spine {\nMOTION\n")
     files["no_animation"] = SAMPLE_RIG_FBX  # the sample character: a rig with no action
 
     scene = rig_session.new_empty_scene()
@@ -157,6 +160,7 @@ def test_import_leaves_the_scene_as_it_was(library):
     ("empty", "empty"),
     ("garbage", "corrupt"),
     ("truncated", "corrupt"),
+    ("garbled_bvh", r"not a valid BVH file \(IndexError: list index out of range\)\. Re-export it"),
     ("no_animation", "no animation"),
     ("missing", "lacks the bones LeftForeArm, RightForeArm"),
     ("nan", "NaN"),
@@ -167,6 +171,7 @@ def test_bad_clips_raise_an_error_naming_the_file_and_the_problem(library, kind,
     with pytest.raises(RLAnimateError, match=message) as error:
         clip_import.import_clip(files[kind])
     assert str(files[kind]) in str(error.value)
+    assert "Location:" not in str(error.value) and "Traceback" not in str(error.value)
 
 
 def test_directory_import_reports_each_bad_file_and_keeps_the_good_ones(library, tmp_path):
@@ -262,3 +267,40 @@ def test_a_changed_skeleton_does_not_reuse_clips_cached_for_the_old_one(library,
     clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
     assert imported == [files["fbx"].name], "a clip cached for other rest frames must be imported again"
     assert len(list(tmp_path.glob("*.npz"))) == 2
+
+
+@pytest.mark.parametrize("damage", ["truncated", "garbage", "wrong_shape", "nan"])
+def test_a_damaged_cache_entry_is_imported_again_and_rewritten(library, tmp_path, monkeypatch, capsys, damage):
+    files, _, _ = library
+    first = clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
+    (entry,) = tmp_path.glob("*.npz")
+    good = entry.read_bytes()
+    if damage == "truncated":
+        entry.write_bytes(good[:len(good) // 2])
+    elif damage == "garbage":
+        entry.write_bytes(b"not an archive at all")
+    else:
+        with np.load(entry) as data:
+            arrays = dict(data)
+        arrays["rotvecs"] = arrays["rotvecs"][:, :4] if damage == "wrong_shape" else arrays["rotvecs"] * np.nan
+        np.savez(entry, **arrays)
+    imported = count_imports(monkeypatch)
+    again = clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
+    assert imported == [files["fbx"].name], "the damaged entry is imported again"
+    assert f"The import cache entry {entry} is damaged" in capsys.readouterr().err
+    np.testing.assert_array_equal(again.rotvecs, first.rotvecs)
+    assert entry.read_bytes() == good, "and rewritten"
+    imported.clear()
+    clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
+    assert imported == [], "the rewritten entry is used"
+
+
+def test_a_clip_folder_without_a_manifest_is_named_with_what_training_needs(library, tmp_path):
+    files, _, _ = library
+    shutil.copy(files["fbx"], tmp_path / "point_left_000.fbx")
+    with pytest.raises(RLAnimateError, match=rf"The folder {tmp_path} has 1 FBX/BVH clips but no manifest\.json, "
+                                             r"and training needs each clip's labels"):
+        clip_import.load_clip_set(tmp_path / "manifest.json")
+    with pytest.raises(RLAnimateError, match=rf"{tmp_path / 'elsewhere'} does not exist"):
+        clip_import.load_clip_set(tmp_path / "elsewhere")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["point_left_000.fbx"], "nothing was written"

@@ -72,4 +72,22 @@ def test_unknown_preset_is_a_clear_error(tiny_library, tmp_path):
     command = [sys.executable, str(REPO_ROOT / "trainer" / "train.py"), "--preset", "huge",
                "--output", str(tmp_path / "run"), "--clips", str(tiny_library)]
     result = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
-    assert result.returncode == 2 and "Unknown config preset 'huge'" in result.stderr
+    assert result.returncode == 2 and "--preset huge: unknown config preset; use one of debug" in result.stderr
+    assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("option, value, message", [
+    ("--epochs", "0", "--epochs 0: train at least 1 epoch"),
+    ("--epochs", "-3", "--epochs -3: train at least 1 epoch"),
+    ("--checkpoint-every", "0", "--checkpoint-every 0: write a checkpoint every 1 or more epochs"),
+])
+def test_unusable_arguments_stop_the_script_before_any_clip_is_imported(tmp_path, monkeypatch, capsys, option,
+                                                                        value, message):
+    def no_import(clips):
+        raise AssertionError("the clips were imported before the arguments were checked")
+
+    monkeypatch.setattr(train, "LibrarySession", no_import)
+    argv = ["train.py", "--preset", "debug", "--output", str(tmp_path / "run"), option, value]
+    assert cli.run_main(train.main, argv) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
