@@ -4,7 +4,7 @@ Layout (format FORMAT_NAME, version FORMAT_VERSION):
     "__metadata__"   0-d numpy unicode array holding JSON text (see docs/AGENT.md for its fields)
     "<module>.<parameter>"   one float32 array per torch parameter, named as in the torch state_dict:
         portrayal.layers.K.{weight,bias}        o_t -> self-description d_t     (absent in single_state)
-        task_rnn.{weight,bias}_{ih,hh}_l0       GRU h_t = f1(h_{t-1}, o_t)      (absent in single_dynamics)
+        task_rnn.{weight,bias}_{ih,hh}_l0       GRU h_t = f1(h_{t-1}, o_t)      (absent in single_state, single_dynamics)
         behaviour_cell.{weight,bias}_{ih,hh}    GRUCell e_t = f2(e_{t-1}; x_t)
         prior.layers.K.*, posterior.layers.K.*  Gaussian p(z_t | e_t), q(z_t | e_t, d_t)
         animation.layers.K.*, decoder.layers.K.*  Beta over a_t, and p(d_t | h_t, b_t)
@@ -46,8 +46,9 @@ def uses_portrayal(variant):
 
 
 def uses_task_state(variant):
-    """Whether the variant keeps a separate task state h_t (all but single_dynamics)."""
-    return variant != "single_dynamics"
+    """Whether the variant keeps a separate task state h_t: not single_dynamics (one latent space) and
+    not single_state (the objective is the agent's only state; paper Section 4.3)."""
+    return variant not in ("single_state", "single_dynamics")
 
 
 def mlp_shapes(name, inputs, hidden, layers, outputs):

@@ -20,8 +20,9 @@ training chunk starts from h_0 = e_0 = 0, z_0 = 0 and a_0 = agent_file.INITIAL_A
 
 Variants (the paper's Table 4 ablations; docs/AGENT.md defines them):
     rlanimate        as above;
-    single_state     no portrayal model: the posterior is conditioned on the real description d'_t
-                     in training, and rollouts use the prior p(z_t | e_t);
+    single_state     the objective as a single state: no portrayal model and no task state (f2 takes
+                     o_t in place of h_t, the heads see (e_t, z_t)); the posterior is conditioned on
+                     the real description d'_t in training, and rollouts use the prior p(z_t | e_t);
     single_dynamics  no task state: f2 takes o_t in place of h_t, and the heads see (e_t, z_t) only;
     supervised       rlanimate's networks trained as behaviour cloning (trainer/agent/losses.py).
 Tensors are batch-major: B sequences of T frames.
@@ -84,7 +85,7 @@ class RLAnimateAgent(nn.Module):
         return self.portrayal(objectives) if self.uses_portrayal else None
 
     def task_features(self, objectives):
-        """(B, T, 7) -> (B, T, K): the task state h_{1:T} (K = task_size), or o_{1:T} in single_dynamics."""
+        """(B, T, 7) -> (B, T, K): the task state h_{1:T} (K = task_size), or o_{1:T} without one."""
         if not self.uses_task_state:
             return objectives
         states, _ = self.task_rnn(objectives)  # h_0 = 0
@@ -103,7 +104,7 @@ class RLAnimateAgent(nn.Module):
         return self._gaussian(self.posterior(torch.cat([e, description], -1)))
 
     def features(self, task, e, z):
-        """What the animation model and the decoder see: (h_t, e_t, z_t), or (e_t, z_t) in single_dynamics."""
+        """What the animation model and the decoder see: (h_t, e_t, z_t), or (e_t, z_t) without a task state."""
         return torch.cat([task, e, z], -1) if self.uses_task_state else torch.cat([e, z], -1)
 
     def policy(self, features):

@@ -1,8 +1,10 @@
-"""The paper's Section 4 experiments: one training run per (variant, column), each in its own process,
-then Table 4, Figure 3 and length flexibility from the finished runs (`python -m trainer.scripts.experiments`).
+"""The paper's Section 4 experiments: one training run per (seed, variant, column), each in its own
+process, then Table 4 (mean ± sd over seeds, with the baselines and the behaviour metrics, on the held-out
+and the harder split), Figure 3 and length flexibility from the finished runs
+(`python -m trainer.scripts.experiments`).
 
 `options` is the experiments' command line (trainer/scripts/experiments.py): preset, epoch_scale,
-variants, columns, clips, runs, results, eval_every, seed, jobs.
+variants, columns, clips, runs, results, eval_every, seeds, jobs.
 """
 import json
 import subprocess
@@ -16,8 +18,11 @@ from rlanimate_addon.core import metrics
 from trainer.agent import checkpoint
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
-from trainer.blender_io.clip_session import LibrarySession
-from trainer.evaluation import scoring
+from trainer.blender_io.procedural_ik import ProceduralIK
+from trainer.evaluation import behaviour, scoring
+from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
+from trainer.evaluation.harder_split import harder_clips
+from trainer.files import atomic_write_text
 from trainer.paths import REPO_ROOT
 from trainer.reporting import plots
 from trainer.reporting.table4 import table4_markdown
@@ -28,8 +33,11 @@ PAPER_EPOCHS = {"point": 50, "wave": 50, "both": 100}
 LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
 
 
-def run_folder(options, variant, column):
-    return Path(options.runs) / f"{variant}_{column}"
+def run_folder(options, seed, variant, column):
+    """<runs>/<variant>_<column> for seed 0, <runs>_seed<N>/<variant>_<column> for another seed, so that
+    no seed reuses another's runs."""
+    root = Path(options.runs)
+    return (root if seed == 0 else root.with_name(f"{root.name}_seed{seed}")) / f"{variant}_{column}"
 
 
 def planned_epochs(options, column):
@@ -41,37 +49,38 @@ def is_finished(folder, epochs):
     return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
 
 
-def train_command(options, variant, column):
-    folder = run_folder(options, variant, column)
+def train_command(options, seed, variant, column):
+    folder = run_folder(options, seed, variant, column)
     command = [sys.executable, "-m", "trainer.scripts.train", "--behaviour", column,
                "--variant", variant, "--preset", options.preset, "--clips", options.clips,
-               "--epochs", str(planned_epochs(options, column)), "--seed", str(options.seed),
+               "--epochs", str(planned_epochs(options, column)), "--seed", str(seed),
                "--output", str(folder), "--eval-every", str(options.eval_every), "--quiet"]
     return command + (["--resume"] if (folder / checkpoint.FILENAME).is_file() else [])
 
 
 def train_all(options):
-    """Run every unfinished (variant, column), --jobs processes at a time; raise if one fails."""
-    pending = [(m, c) for m in options.variants for c in options.columns
-               if not is_finished(run_folder(options, m, c), planned_epochs(options, c))]
+    """Run every unfinished (seed, variant, column), --jobs processes at a time; raise if one fails."""
+    pending = [(s, v, c) for s in options.seeds for v in options.variants for c in options.columns
+               if not is_finished(run_folder(options, s, v, c), planned_epochs(options, c))]
     running = []
     while pending or running:
         while pending and len(running) < options.jobs:
-            variant, column = pending.pop(0)
-            folder = run_folder(options, variant, column)
+            seed, variant, column = pending.pop(0)
+            folder = run_folder(options, seed, variant, column)
             folder.mkdir(parents=True, exist_ok=True)
             log = open(folder / "train.log", "w")
-            running.append((variant, column, log, subprocess.Popen(
-                train_command(options, variant, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
+            running.append((seed, variant, column, log, subprocess.Popen(
+                train_command(options, seed, variant, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
         time.sleep(1.0)
         for entry in list(running):
-            variant, column, log, process = entry
+            seed, variant, column, log, process = entry
             if process.poll() is not None:
                 log.close()
                 running.remove(entry)
                 if process.returncode != 0:
-                    raise RuntimeError(f"{variant} {column} failed: see {run_folder(options, variant, column)}/train.log")
-                print(f"finished {variant} {column}", flush=True)
+                    raise RuntimeError(f"{variant} {column} seed {seed} failed: see "
+                                       f"{run_folder(options, seed, variant, column)}/train.log")
+                print(f"finished {variant} {column} seed {seed}", flush=True)
 
 
 def load_run(folder):
@@ -80,29 +89,87 @@ def load_run(folder):
     return report, history
 
 
-def write_table_and_figures(options, results):
-    """table4.json/.md and Figure 3 from every finished run of the requested variants and columns."""
-    table, seen, histories = {}, {}, {}
-    for variant in options.variants:
+def finished_runs(options):
+    """{(seed, variant, column): folder} of the runs that finished their planned epochs."""
+    return {(s, v, c): run_folder(options, s, v, c) for s in options.seeds for v in options.variants
+            for c in options.columns if is_finished(run_folder(options, s, v, c), planned_epochs(options, c))}
+
+
+def column_behaviours(column):
+    return ("WAVE", "POINT") if column == "both" else (column.upper(),)
+
+
+def evaluate_runs(options, runs, session):
+    """{split: {column: {method: [behaviour.summarise of each seed]}}}: every finished run's agent (its
+    agent.npz, numpy runtime) and each baseline on the held-out clips and the harder split; an agent trained
+    on one behaviour is asked for that behaviour only."""
+    train = session.train_clips
+    lengths = behaviour.class_lengths(train)
+    splits = {"held-out": session.test_clips, "harder": harder_clips()}
+    baselines = {"no_motion": NoMotion(mean_start_pose(train)), "class_mean": ClassMean(train),
+                 "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(mean_start_pose(train))}
+
+    def describe(rotvecs):
+        return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
+
+    def summary(method, clips):
+        return behaviour.summarise(behaviour.request_rows(method, clips, session.references, describe, lengths))
+
+    results = {}
+    for split, clips in splits.items():
         for column in options.columns:
-            folder = run_folder(options, variant, column)
-            if not is_finished(folder, planned_epochs(options, column)):
-                continue
-            report, history = load_run(folder)
-            table.setdefault(variant, {})[column] = {
-                "score": report["held_out"]["score"], "smoothness": report["held_out"]["smoothness"],
-                "episodes": report["episodes"], "train_seconds": report["train_seconds"]}
-            seen.setdefault(variant, {})[column] = {**report["training"], "cpu_seconds": report["train_cpu_seconds"]}
+            wanted = [c for c in clips if c.behaviour.upper() in column_behaviours(column)]
+            entry = results.setdefault(split, {}).setdefault(column, {})
+            for (seed, variant, run_column), folder in sorted(runs.items()):
+                if run_column == column:
+                    entry.setdefault(variant, []).append(summary(AgentMethod(folder / "agent.npz"), wanted))
+            for name, method in baselines.items():
+                entry[name] = [summary(method, wanted)]
+    return results
+
+
+def aggregate(per_seed):
+    """[summary per seed] -> {behaviour: {metric: {mean, sd, n}}}; sd 0 for one value, NaN values (a ratio
+    to a zero reference) left out."""
+    out = {}
+    for key in per_seed[0]:
+        out[key] = {}
+        for metric in per_seed[0][key]:
+            values = np.array([s[key][metric] for s in per_seed], dtype=np.float64)
+            values = values[~np.isnan(values)]
+            out[key][metric] = {"mean": float(np.mean(values)) if len(values) else None,
+                                "sd": float(np.std(values, ddof=1)) if len(values) > 1 else 0.0, "n": len(values)}
+    return out
+
+
+def write_table_and_figures(options, results, session):
+    """table4.json/.md over the finished runs, and Figure 3 from the first seed's histories; returns the
+    number of finished runs."""
+    runs = finished_runs(options)
+    evaluated = evaluate_runs(options, runs, session)
+    table = {split: {column: {method: aggregate(per_seed) for method, per_seed in methods.items()}
+                     for column, methods in columns.items()} for split, columns in evaluated.items()}
+    training, histories = {}, {}
+    for (seed, variant, column), folder in sorted(runs.items()):
+        report, history = load_run(folder)
+        training[f"{variant} {column} seed {seed}"] = {
+            "variant": variant, "column": column, "seed": seed, "episodes": report["episodes"],
+            "train_seconds": report["train_seconds"], "train_cpu_seconds": report["train_cpu_seconds"],
+            "held_out_score": report["held_out"]["score"], "seen_score": report["training"]["score"]}
+        if seed == options.seeds[0]:
             histories.setdefault(variant, {})[column] = history
-    settings = (f"Preset `{options.preset}`, seed {options.seed}, epochs = {options.epoch_scale:g} x the paper's "
-                f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1). "
+    seeds = " ".join(str(s) for s in options.seeds)
+    settings = (f"Preset `{options.preset}`, seeds {seeds}, epochs = {options.epoch_scale:g} x the paper's "
+                f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1); "
+                f"{len(runs)} of {len(options.seeds) * len(options.variants) * len(options.columns)} runs finished. "
                 f"Regenerate: `nice -n 10 python -m trainer.scripts.experiments --preset {options.preset} "
-                f"--epoch-scale {options.epoch_scale:g}{f' --seed {options.seed}' if options.seed else ''}`.")
-    (results / "table4.json").write_text(json.dumps(table, indent=2) + "\n")
-    (results / "table4.md").write_text(table4_markdown(table, seen, settings))
+                f"--epoch-scale {options.epoch_scale:g} --seeds {seeds}`.")
+    report = {"settings": settings, "seeds": list(options.seeds), "table": table, "training": training}
+    atomic_write_text(results / "table4.json", json.dumps(report, indent=1) + "\n")
+    atomic_write_text(results / "table4.md", table4_markdown(report))
     for split in ("seen", "unseen"):
         plots.figure3(histories, results / f"figure3_{split}.png", split)
-    return table
+    return len(runs)
 
 
 def load_trained_agent(folder, preset):
@@ -113,15 +180,14 @@ def load_trained_agent(folder, preset):
     return agent
 
 
-def write_length_flexibility(options, results):
-    """Section 4.4 for the RLAnimate both-behaviour agent on the held-out clips."""
-    folder = run_folder(options, "rlanimate", "both")
+def write_length_flexibility(options, results, session):
+    """Section 4.4 for the first seed's RLAnimate both-behaviour agent on the held-out clips."""
+    folder = run_folder(options, options.seeds[0], "rlanimate", "both")
     if not is_finished(folder, planned_epochs(options, "both")):
         return None
-    session = LibrarySession(options.clips)
     agent = load_trained_agent(folder, options.preset)
     test = scoring.select_clips(session.test_clips, "both")
     flexibility = scoring.length_flexibility(agent, session.env, test, session.train_clips, LENGTH_SCALES)
-    (results / "length_flexibility.json").write_text(json.dumps(flexibility, indent=2) + "\n")
+    atomic_write_text(results / "length_flexibility.json", json.dumps(flexibility, indent=2) + "\n")
     plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)
     return flexibility

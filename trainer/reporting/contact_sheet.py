@@ -124,3 +124,24 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
     fig.savefig(out)
     plt.close(fig)
     return out
+
+
+def generated_sheet(rows, out, title, fps=30):
+    """One PNG of rendered frames: rows [(row title, [(frame offset, png path)])], a column per key frame."""
+    columns = max(len(frames) for _, frames in rows)
+    fig, axes = plt.subplots(len(rows), columns, figsize=(columns * 1.9, len(rows) * 2.0), dpi=110, squeeze=False)
+    for (row_title, frames), row_axes in zip(rows, axes):
+        for ax, (offset, path) in zip(row_axes, frames):
+            ax.imshow(plt.imread(str(path)))
+            ax.set_title(f"{offset / fps:.2f}s", fontsize=7, pad=2)
+        for ax in row_axes:
+            ax.set_xticks([])
+            ax.set_yticks([])
+        row_axes[0].set_ylabel(row_title, fontsize=7)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out)
+    plt.close(fig)
+    return out

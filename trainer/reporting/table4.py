@@ -1,27 +1,52 @@
-"""Table 4 as markdown: final held-out score and smoothness per variant and column, and each run's details."""
+"""docs/results/table4.md: RLAnimate, its ablations and the baselines, methods as rows, mean ± sd over seeds."""
+from trainer.reporting.baselines_report import METHOD_LABELS as BASELINE_LABELS
 from trainer.reporting.plots import COLUMN_LABELS, VARIANT_LABELS
 from trainer.reporting.tables import markdown_table
 
+LABELS = {**VARIANT_LABELS, **BASELINE_LABELS, "rlanimate": "RLAnimate"}
+SHARED = (("score", "score", 2), ("aligned_score", "score, DTW", 2), ("smoothness", "smoothness", 2))
+WAVE = (("swing_ratio_median", "swing ratio", 2), ("frequency_ratio_median", "frequency ratio", 2),
+        ("cycles_min", "full cycles (min)", 1), ("accepted_share", "waves accepted (share)", 2))
+POINT = (("pointing_angle_median", "own aim (deg, median)", 1), ("pointing_angle_max", "own aim (deg, max)", 1))
+ELEVATION = (("elevation_first_error_max", "elevation error, first frame (deg, max)", 1),
+             ("elevation_last_error_max", "last frame", 1))
+SPLITS = {"held-out": "Held-out requests of the sample library (the paper's test set)",
+          "harder": "Harder split: targets outside the training ranges, new wave styles, 0.5x-1.5x lengths "
+                    "(trainer/evaluation/harder_split.py)"}
 
-def table4_markdown(table, seen, settings):
-    """table: {variant: {column: {score, smoothness, episodes, train_seconds}}}; seen: {variant: {column:
-    {score, smoothness, cpu_seconds}}} on training clips; settings: the line that says how the runs were made."""
-    rows = []
-    for variant, columns in table.items():
-        cells = []
-        for column in COLUMN_LABELS:
-            entry = columns.get(column)
-            cells += [f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}"] if entry else ["-", "-"]
-        rows.append([VARIANT_LABELS[variant]] + cells)
-    details = [[VARIANT_LABELS[variant], column, entry["episodes"], f"{entry['train_seconds']:.0f}",
-                f"{seen[variant][column]['cpu_seconds']:.0f}", f"{seen[variant][column]['score']:.2f}",
-                f"{seen[variant][column]['smoothness']:.2f}"]
-               for variant, columns in table.items() for column, entry in columns.items()]
-    lines = ["# Table 4: final score and smoothness imitating held-out clips", "", settings, "",
-             *markdown_table(["variant", "wave score", "wave smooth.", "point score", "point smooth.", "both score",
-                              "both smooth."], rows),
-             "", "Sample episodes, training time (wall clock and CPU seconds, on a machine shared with other "
-             "jobs) and score on 10 training (seen) clips per run:", "",
-             *markdown_table(["variant", "column", "episodes", "wall s", "CPU s", "seen score", "seen smooth."],
-                             details)]
+
+def cell(value, digits):
+    """'mean ± sd' over seeds, or the value alone for one seed (or a deterministic baseline)."""
+    if value["mean"] is None:
+        return "n/a"
+    mean = f"{value['mean']:.{digits}f}"
+    return f"{mean} ± {value['sd']:.{digits}f}" if value["n"] > 1 else mean
+
+
+def table4_markdown(report):
+    lines = ["# Table 4: RLAnimate, its ablations and the baselines", "", report["settings"], "",
+             "Each method answers the split's requests (label and length); behaviour metrics as in docs/METRICS.md "
+             "(per seed: scores are means over the requests, behaviour measures medians or extremes; here the mean "
+             "± sd of those over the seeds that finished, n = seeds). Baselines are deterministic: one value. An "
+             "agent trained on one behaviour is asked for that behaviour only.", ""]
+    for split, columns in report["table"].items():
+        lines += [f"## {SPLITS.get(split, split)}", ""]
+        for column, methods in columns.items():
+            for behaviour in ("wave", "point"):
+                rows = {m: entry[behaviour] for m, entry in methods.items() if behaviour in entry}
+                if not rows:
+                    continue
+                fields = SHARED + (WAVE if behaviour == "wave" else POINT) + ELEVATION
+                count = next(iter(rows.values()))["requests"]["mean"]
+                lines += [f"### {COLUMN_LABELS[column]} agents: {behaviour} requests ({count:.0f})", ""]
+                lines += markdown_table(("method", "n") + tuple(title for _, title, _ in fields),
+                                        [[LABELS.get(m, m), str(entry["score"]["n"])]
+                                         + [cell(entry[key], digits) for key, _, digits in fields]
+                                         for m, entry in rows.items()])
+                lines.append("")
+    lines += ["## Training runs", ""]
+    lines += markdown_table(("variant", "column", "seed", "episodes", "wall s", "CPU s", "held-out score", "seen score"),
+                            [[LABELS.get(r["variant"], r["variant"]), r["column"], r["seed"], r["episodes"],
+                              f"{r['train_seconds']:.0f}", f"{r['train_cpu_seconds']:.0f}", f"{r['held_out_score']:.2f}",
+                              f"{r['seen_score']:.2f}"] for r in report["training"].values()])
     return "\n".join(lines) + "\n"

@@ -1,22 +1,60 @@
-"""Render the clip library's contact sheet (docs/contact_sheet.png).
+"""Contact sheets: the clip library's key frames (docs/contact_sheet.png), or, with --generated, the add-on's
+Generate Gesture on the sample character rendered by Blender (Cycles, CPU) into
+docs/results/generated_frames.png.
 
     python -m trainer.scripts.contact_sheet [--out docs/contact_sheet.png] [--seed S]
+    nice -n 10 python -m trainer.scripts.contact_sheet --generated [--agent PATH] [--out PNG]
 """
 import argparse
+import tempfile
 from pathlib import Path
 
 from trainer.motion.library_plan import DEFAULT_SEED
-from trainer.paths import CONTACT_SHEET
-from trainer.reporting.contact_sheet import render
+from trainer.paths import CONTACT_SHEET, RESULTS_DIR, shown
+from trainer.reporting.contact_sheet import generated_sheet, render
+from trainer.scripts.cli import run_main, script_args
+
+GENERATED_SHEET = RESULTS_DIR / "generated_frames.png"
+TARGET_HIGH = (-0.9, -2.0, 1.7)  # ahead, up and to the character's right
+TARGET_ACROSS = (-0.9, -1.8, 0.9)  # low, across the body for the left arm
+
+
+def generated_requests():
+    """The requests of the generated sheet: points with and without exact aim, waves small to big, a seed."""
+    from trainer.blender_io.gesture_render import RenderRequest
+    return [
+        RenderRequest("point right, exact aim", {"behaviour": "POINT", "arm": "RIGHT", "exact_aim": True, "seed": 0},
+                      target=TARGET_HIGH),
+        RenderRequest("point right, own aim", {"behaviour": "POINT", "arm": "RIGHT", "exact_aim": False, "seed": 0},
+                      target=TARGET_HIGH),
+        RenderRequest("point left across, own aim", {"behaviour": "POINT", "arm": "LEFT", "exact_aim": False,
+                                                     "seed": 0}, target=TARGET_ACROSS),
+        RenderRequest("wave right, e 0.2", {"behaviour": "WAVE", "arm": "RIGHT", "exaggeration": 0.2, "seed": 0}),
+        RenderRequest("wave right, e 0.9", {"behaviour": "WAVE", "arm": "RIGHT", "exaggeration": 0.9, "seed": 0}),
+        RenderRequest("wave left, e 0.6, seed 3", {"behaviour": "WAVE", "arm": "LEFT", "exaggeration": 0.6, "seed": 3}),
+    ]
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description="Render the clip library's contact sheet.")
-    parser.add_argument("--out", type=Path, default=CONTACT_SHEET)
-    parser.add_argument("--seed", type=int, default=DEFAULT_SEED)
-    args = parser.parse_args(argv)
-    print(f"wrote {render(args.out, args.seed)}")
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path)
+    parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="library plan seed (library sheet)")
+    parser.add_argument("--generated", action="store_true", help="render Generate Gesture's output with Blender")
+    parser.add_argument("--agent", type=Path, help="agent file for the add-on (default: the bundled agent)")
+    args = parser.parse_args(script_args(argv))
+    if not args.generated:
+        print(f"wrote {render(args.out or CONTACT_SHEET, args.seed)}")
+        return 0
+    from trainer.blender_io.gesture_render import render_requests
+    with tempfile.TemporaryDirectory() as frames:
+        requests = render_requests(generated_requests(), frames, agent_path=args.agent)
+        agent = shown(args.agent) if args.agent else "the bundled agent"
+        out = generated_sheet([(r.title, r.frames) for r in requests], args.out or GENERATED_SHEET,
+                              f"Generate Gesture on the sample character, {agent}, rendered by Blender (Cycles); "
+                              f"red: the target")
+    print(f"wrote {out}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(run_main(main))

@@ -1,5 +1,6 @@
 """The one markdown-table writer, and Table 4 written with it."""
-from trainer.reporting.table4 import table4_markdown
+from trainer.evaluation.experiments import aggregate
+from trainer.reporting.table4 import cell, table4_markdown
 from trainer.reporting.tables import markdown_table
 
 
@@ -8,10 +9,20 @@ def test_markdown_table_has_a_header_a_rule_and_one_line_per_row():
     assert lines == ["| clip | score |", "|---|---:|", "| a | 1.5 |", "| b | - |"]
 
 
-def test_table4_puts_each_column_in_its_place_and_dashes_missing_runs():
-    table = {"rlanimate": {"both": {"score": 91.234, "smoothness": 99.5, "episodes": 200, "train_seconds": 600.4}}}
-    seen = {"rlanimate": {"both": {"score": 95.0, "smoothness": 99.6, "cpu_seconds": 580.0}}}
-    lines = table4_markdown(table, seen, "Preset `default`.").splitlines()
-    assert lines[0] == "# Table 4: final score and smoothness imitating held-out clips" and lines[2] == "Preset `default`."
-    assert "| RLAnimate | - | - | - | - | 91.23 | 99.50 |" in lines
-    assert "| RLAnimate | both | 200 | 600 | 580 | 95.00 | 99.60 |" in lines
+def test_markdown_shows_mean_and_sd_only_over_several_seeds():
+    assert cell({"mean": 99.123, "sd": 0.05, "n": 3}, 2) == "99.12 ± 0.05"
+    assert cell({"mean": 99.123, "sd": 0.0, "n": 1}, 2) == "99.12"
+    assert cell({"mean": None, "sd": 0.0, "n": 0}, 2) == "n/a"
+    entry = {"requests": 4.0, "score": 99.0, "aligned_score": 99.5, "smoothness": 99.9, "swing_ratio_median": 0.4,
+             "frequency_ratio_median": 0.2, "cycles_min": 1.0, "accepted_share": 0.0,
+             "elevation_first_error_max": 1.0, "elevation_last_error_max": 2.0}
+    agent = aggregate([{"wave": entry}, {"wave": {**entry, "score": 98.0}}])
+    baseline = aggregate([{"wave": entry}])
+    report = {"settings": "Settings.", "table": {"held-out": {"wave": {"rlanimate": agent, "class_mean": baseline}}},
+              "training": {"rlanimate wave seed 0": {"variant": "rlanimate", "column": "wave", "seed": 0, "episodes": 5,
+                                                     "train_seconds": 10.0, "train_cpu_seconds": 9.0,
+                                                     "held_out_score": 99.0, "seen_score": 99.1}}}
+    markdown = table4_markdown(report)
+    assert "| RLAnimate | 2 | 98.50 ± 0.71 |" in markdown
+    assert "| Class mean | 1 | 99.00 |" in markdown
+    assert "wave requests (4)" in markdown

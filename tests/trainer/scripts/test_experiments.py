@@ -1,26 +1,32 @@
-"""trainer.scripts.experiments' command line: another seed gets its own runs and results, never seed 0's."""
+"""trainer.scripts.experiments: every seed gets its own runs; Table 4 cells are mean ± sd over seeds."""
+import math
 from pathlib import Path
 
-from trainer.evaluation.experiments import run_folder
+from trainer.evaluation import experiments as harness
 from trainer.paths import REPO_ROOT, RESULTS_DIR
 from trainer.scripts import experiments
 
 
-def test_seed_zero_uses_the_shared_folders():
-    options = experiments.parse_options(["experiments", "--seed", "0"])
-    assert Path(options.runs) == REPO_ROOT / "runs" / "experiments"
+def test_seed_zero_uses_the_shared_folders_and_three_seeds_by_default():
+    options = experiments.parse_options(["experiments"])
+    assert options.seeds == [0, 1, 2]
+    assert harness.run_folder(options, 0, "rlanimate", "wave") == REPO_ROOT / "runs" / "experiments" / "rlanimate_wave"
     assert Path(options.results) == RESULTS_DIR
 
 
-def test_another_seed_never_reuses_seed_zero_runs_or_overwrites_its_results():
-    options = experiments.parse_options(["experiments", "--seed", "3"])
-    assert Path(options.runs) == REPO_ROOT / "runs" / "experiments_seed3"
-    assert Path(options.results) == RESULTS_DIR / "seed3"
-    assert run_folder(options, "rlanimate", "wave") != \
-        run_folder(experiments.parse_options(["experiments"]), "rlanimate", "wave")
+def test_another_seed_never_reuses_seed_zero_runs(tmp_path):
+    options = experiments.parse_options(["experiments", "--seeds", "0", "3", "--runs", str(tmp_path / "r")])
+    assert harness.run_folder(options, 3, "rlanimate", "wave") == tmp_path / "r_seed3" / "rlanimate_wave"
+    assert harness.run_folder(options, 0, "rlanimate", "wave") == tmp_path / "r" / "rlanimate_wave"
+    assert "--seed" in (command := harness.train_command(options, 3, "rlanimate", "wave"))
+    assert command[command.index("--seed") + 1] == "3"
 
 
-def test_explicit_folders_win(tmp_path):
-    argv = ["experiments", "--seed", "3", "--runs", str(tmp_path / "r"), "--results", str(tmp_path)]
-    options = experiments.parse_options(argv)
-    assert (Path(options.runs), Path(options.results)) == (tmp_path / "r", tmp_path)
+def test_aggregate_gives_mean_sd_and_count_and_skips_undefined_ratios():
+    per_seed = [{"wave": {"score": 99.0, "swing_ratio_median": 0.5}},
+                {"wave": {"score": 98.0, "swing_ratio_median": math.nan}},
+                {"wave": {"score": 97.0, "swing_ratio_median": 0.7}}]
+    table = harness.aggregate(per_seed)["wave"]
+    assert table["score"] == {"mean": 98.0, "sd": 1.0, "n": 3}
+    assert table["swing_ratio_median"]["n"] == 2 and abs(table["swing_ratio_median"]["mean"] - 0.6) < 1e-12
+    assert harness.aggregate(per_seed[:1])["wave"]["score"] == {"mean": 99.0, "sd": 0.0, "n": 1}
