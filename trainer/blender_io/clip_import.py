@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from rlanimate_addon.core import bone_maps, rotations, skeleton
 from rlanimate_addon.core.errors import RLAnimateError, operator_error_reason
@@ -293,12 +294,13 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
     return clip
 
 
-def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None):
+def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, progress=None):
     """Import every clip of a directory (its manifest.json when it has one, else every .fbx/.bvh) or
     of a manifest file. Returns (clips, problems): the clips that imported, and one message per file
     that did not. Clips listed in a manifest carry its labels. cache_dir: where imported clips are
     cached (default: `.import_cache/` beside a manifest; no cache for a folder without one, so that
-    shared data folders stay untouched); False imports afresh without caching."""
+    shared data folders stay untouched); False imports afresh without caching. progress: a stream to
+    show a progress bar on (None: no bar)."""
     path = Path(path_or_manifest)
     manifest_path = path / "manifest.json" if path.is_dir() and (path / "manifest.json").is_file() else path
     if manifest_path.is_file() and manifest_path.suffix.lower() == ".json":
@@ -316,7 +318,8 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None):
         cache_dir = folder / clip_cache.CACHE_DIR_NAME if manifest_path is not None else False  # ../shared/realmocap
     cache = Path(cache_dir) if cache_dir else None
     clips, problems = [], []
-    for entry in entries:
+    for entry in tqdm(entries, desc="clips", unit="clip", file=progress, disable=progress is None, leave=False,
+                      dynamic_ncols=True):
         file = folder / str(entry.get("file", ""))
         fps = float(entry.get("fps", expected_fps or default_fps))
         try:
@@ -344,15 +347,12 @@ def _no_library(path):
     return RLAnimateError(f"{path} does not exist: use a clip library's manifest.json or the folder that holds it.")
 
 
-def load_clip_set(manifest_path):
-    """The labelled clip library of `manifest_path` (or of the directory holding manifest.json).
-
-    Bad files are reported on stderr and in ClipSet.problems; raises RLAnimateError when none imports.
-    """
-    clips, problems = import_clip_directory(manifest_path)
-    for problem in problems:
-        print(f"clip_import: skipped: {problem}", file=sys.stderr)
+def load_clip_set(manifest_path, progress=None):
+    """The labelled clip library of `manifest_path` (or of the directory holding manifest.json), with a
+    progress bar on the stream `progress` (None: none). Bad files are listed in ClipSet.problems; raises
+    RLAnimateError when none imports."""
+    clips, problems = import_clip_directory(manifest_path, progress=progress)
     if not clips:
-        raise RLAnimateError(f"{manifest_path}: no clip could be imported ({len(problems)} problems). "
-                             "Regenerate the clip library.")
+        raise RLAnimateError(f"{manifest_path}: no clip could be imported ({len(problems)} problems: "
+                             f"{'; '.join(problems[:3])}). Regenerate the clip library.")
     return ClipSet(clips, problems)

@@ -1,21 +1,32 @@
 """A clip library loaded for training and evaluation: its clips (imported through Blender) and the bpy FK
 environment, loaded once and shared by the runs of an experiment."""
+import sys
+
 from trainer.agent.algorithm import ClipReferences
 from trainer.blender_io.clip_import import load_clip_set
 from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.rig_session import blender_output
 from trainer.motion.manifest import manifest_path
-from trainer.paths import SAMPLE_RIG_BLEND
+from trainer.paths import SAMPLE_RIG_BLEND, shown
 
 
 class LibrarySession:
     """What a run needs besides the trainer (trainer.agent.run.train's `session`): env, references,
     train_clips, test_clips, problems."""
 
-    def __init__(self, clips, rig_path=SAMPLE_RIG_BLEND):
+    def __init__(self, clips, rig_path=SAMPLE_RIG_BLEND, verbose=False):
+        """Load the library with a progress bar and Blender's own prints held back (shown with `verbose`),
+        then say in one line what was loaded, and name every file that was skipped."""
         self.manifest = manifest_path(clips)
-        self.clip_set = load_clip_set(self.manifest)
-        self.env = FKEnvironment(rig_path)
+        with blender_output(verbose) as terminal:
+            self.clip_set = load_clip_set(self.manifest, progress=terminal)
+            self.env = FKEnvironment(rig_path)
         self.references = ClipReferences(self.env)
+        problems = self.clip_set.problems
+        print(f"clips: {len(self.clip_set.clips)} from {shown(self.manifest)} ({len(self.train_clips)} training, "
+              f"{len(self.test_clips)} held out){f'; {len(problems)} skipped' if problems else ''}", file=sys.stderr)
+        for problem in problems:
+            print(f"  skipped: {problem}", file=sys.stderr)
 
     @property
     def train_clips(self):

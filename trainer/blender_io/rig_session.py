@@ -2,6 +2,10 @@
 
 The same under `blender -b -P` and under `python` with the bpy module.
 """
+import os
+import sys
+import tempfile
+from contextlib import contextmanager, redirect_stderr, redirect_stdout
 from pathlib import Path
 
 from rlanimate_addon.core import skeleton
@@ -20,6 +24,31 @@ def import_bpy():
         raise RLAnimateError("Blender's Python module is missing: run under `blender -b -P` or "
                              "`pip install bpy==5.0.1` into Python 3.11.") from error
     return bpy
+
+
+@contextmanager
+def blender_output(verbose=False):
+    """Send what Blender prints (its importers' `FBX version: 7400` per file on stdout, and any C-level output)
+    to a discarded temporary file, unless `verbose`. Python's sys.stderr (the trainer's own notes) still
+    reaches the terminal; the stream yielded is it, for progress bars."""
+    if verbose:
+        yield sys.stderr
+        return
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = {fd: os.dup(fd) for fd in (1, 2)}
+    terminal = os.fdopen(os.dup(saved[2]), "w")
+    with tempfile.TemporaryFile("w+") as sink, redirect_stdout(sink), redirect_stderr(terminal):
+        for fd in saved:
+            os.dup2(sink.fileno(), fd)
+        try:
+            yield terminal
+        finally:
+            sink.flush()
+            for fd, copy in saved.items():
+                os.dup2(copy, fd)
+                os.close(copy)
+            terminal.close()
 
 
 def new_empty_scene():

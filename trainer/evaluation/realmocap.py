@@ -32,7 +32,7 @@ from trainer.blender_io.clip_import import import_clip
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.procedural_ik import ProceduralIK
-from trainer.blender_io.rig_session import new_empty_scene
+from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines, scoring
 from trainer.motion import autolabel
 from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
@@ -173,8 +173,9 @@ def run_experiments(options):
     root = require_realmocap(options.realmocap)
     Path(options.results).mkdir(parents=True, exist_ok=True)
     cache = Path(options.runs) / "import_cache"
-    waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
-    env = FKEnvironment()
+    with blender_output():
+        waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
+        env = FKEnvironment()
     references = ClipReferences(env)
     command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {options.epochs} --preset {options.preset} "
                f"--seed {options.seed}")

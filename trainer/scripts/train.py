@@ -17,7 +17,7 @@ from trainer.agent.models import VARIANTS
 from trainer.agent.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.files import atomic_copy
-from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR
+from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.scripts.cli import run_main, script_args
 
 
@@ -45,6 +45,7 @@ def build_parser():
                              f"{defaults['eval_every']})")
     parser.add_argument("--checkpoint-every", type=int, default=1)
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--verbose", action="store_true", help="show what Blender prints while loading the clips")
     return parser
 
 
@@ -66,11 +67,13 @@ def install(output):
 def main(argv=None):
     args = build_parser().parse_args(script_args(argv))
     settings = resolve(run_settings(args))
-    report, _ = train(settings, LibrarySession(settings.clips))
+    report, _ = train(settings, LibrarySession(settings.clips, verbose=args.verbose))
+    print(f"trained: {report['epochs']} epochs, {report['episodes']} episodes, {report['train_seconds'] / 60:.1f} min; "
+          f"held-out score {report['held_out']['score']:.2f}, smoothness {report['held_out']['smoothness']:.2f}; "
+          f"outputs in {args.output}")
     if args.install:
         install(Path(settings.output))
-    print(f"held-out score {report['held_out']['score']:.2f}, smoothness {report['held_out']['smoothness']:.2f}; "
-          f"outputs in {args.output}")
+        print(f"installed: {shown(INSTALLED_AGENT)}, and the report in {shown(RESULTS_DIR)}")
     return 0
 
 

@@ -1,10 +1,35 @@
-"""A run's settings are checked before any work: each bad value is named with its fix, nothing is written."""
+"""A run's settings: checked before any work (each bad value named with its fix, nothing written); a new run
+takes the defaults, a resumed run its checkpoint's settings, and a conflicting value is refused naming it."""
 import pytest
 import torch
 
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
-from trainer.agent.run import RunSettings, resolve
+from trainer.agent.run import NEW_RUN_DEFAULTS, RunSettings, resolve
+
+
+SAVED = {"behaviour": "wave", "clips": "clips/manifest.json", "preset": "debug", "variant": "single_state",
+         "seed": 4, "eval_every": 3, "epochs": 7}
+
+
+def test_a_new_run_takes_the_defaults_and_keeps_what_is_given(tmp_path):
+    settings = resolve(RunSettings(output=str(tmp_path), seed=9))
+    assert settings.seed == 9 and settings.epochs is None
+    assert {name: getattr(settings, name) for name in NEW_RUN_DEFAULTS if name != "seed"} == \
+        {name: value for name, value in NEW_RUN_DEFAULTS.items() if name != "seed"}
+
+
+def test_a_resumed_run_takes_its_checkpoints_settings(tmp_path):
+    checkpoint.save(tmp_path / checkpoint.FILENAME, {"epoch": 0}, SAVED)
+    settings = resolve(RunSettings(output=str(tmp_path), resume=True, seed=4))  # the same seed is no conflict
+    assert {name: getattr(settings, name) for name in SAVED} == SAVED
+    assert resolve(RunSettings(output=str(tmp_path), resume=True, epochs=12)).epochs == 12  # run it longer
+
+
+def test_a_conflicting_value_on_resume_is_refused_naming_it(tmp_path):
+    checkpoint.save(tmp_path / checkpoint.FILENAME, {"epoch": 0}, SAVED)
+    with pytest.raises(RLAnimateError, match=r"--preset default \(the run has debug\), --seed 0 \(the run has 4\)"):
+        resolve(RunSettings(output=str(tmp_path), resume=True, seed=0, preset="default"))
 
 
 @pytest.mark.parametrize("values, message", [

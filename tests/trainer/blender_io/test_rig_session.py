@@ -1,4 +1,7 @@
 """The rig session: an empty scene, loading rigs, finding the armature."""
+import os
+import sys
+
 import pytest
 
 from rlanimate_addon.core import skeleton
@@ -56,3 +59,19 @@ def test_load_rig_rejects_missing_and_unknown_files(scene, tmp_path):
         (tmp_path / name).write_bytes(b"not a rig")
         with pytest.raises(RLAnimateError, match=name):
             rig_session.load_rig(tmp_path / name)
+
+
+def test_blender_output_holds_back_prints_but_not_the_terminal_stream(capfd):
+    with rig_session.blender_output() as terminal:
+        print("FBX version: 7400")
+        os.write(1, b"C-level noise\n")
+        terminal.write("progress\n")
+        print("clip_import: a note", file=sys.stderr)
+        sys.stderr.flush()
+    print("after")
+    out, err = capfd.readouterr()
+    assert "FBX version" not in out + err and "noise" not in out + err
+    assert "progress" in err and "a note" in err and "after" in out
+    with rig_session.blender_output(verbose=True):
+        print("FBX version: 7400")
+    assert "FBX version: 7400" in capfd.readouterr().out

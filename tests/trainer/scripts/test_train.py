@@ -3,19 +3,16 @@ outputs exist and load without torch."""
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
-from trainer.blender_io import rig_session
-from trainer.blender_io.clip_bake import bake_clip, export_fbx
+from trainer.blender_io.clip_bake import build_library
 from trainer.blender_io.clip_import import load_clip_set
-from trainer.motion.library_plan import manifest_entry, plan_library
-from trainer.motion.synthesis import synthesise
-from trainer.paths import REPO_ROOT, SAMPLE_RIG_BLEND
+from trainer.motion.library_plan import plan_library
+from trainer.paths import REPO_ROOT
 from trainer.scripts import cli, train
 
 
@@ -23,21 +20,10 @@ from trainer.scripts import cli, train
 def tiny_library(tmp_path_factory):
     """Two training and one held-out clip per behaviour, from the sample library's plan, as FBX + manifest."""
     folder = tmp_path_factory.mktemp("clips")
-    planned = [p for p in plan_library()]
-    chosen = [p for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
+    planned = plan_library()
+    chosen = [p.file for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
               for p in [q for q in planned if q.spec.behaviour == behaviour and q.split == split][:count]]
-    bpy = rig_session.import_bpy()
-    rig_session.new_empty_scene()
-    rig = rig_session.load_rig(SAMPLE_RIG_BLEND)
-    entries = []
-    for plan in chosen:
-        clip = synthesise(plan.spec)
-        action = bake_clip(rig, clip, Path(plan.file).stem)
-        export_fbx(bpy, rig, folder / plan.file, clip.frames)
-        rig.animation_data.action = None
-        bpy.data.actions.remove(action)
-        entries.append(manifest_entry(plan, clip.frames))
-    (folder / "manifest.json").write_text(json.dumps({"fps": 30, "clips": entries}))
+    build_library(folder, only=chosen, log=lambda line: None)
     return folder / "manifest.json"
 
 
@@ -68,11 +54,10 @@ def test_train_cli_writes_an_agent_report_and_plots_that_load(tiny_library, tmp_
     assert actions.shape == (len(clip.rotvecs), 45) and np.all((actions >= 0) & (actions <= 1))
 
 
-def test_unknown_preset_is_a_clear_error(tiny_library, tmp_path):
-    command = [sys.executable, str(REPO_ROOT / "trainer" / "train.py"), "--preset", "huge",
-               "--output", str(tmp_path / "run"), "--clips", str(tiny_library)]
-    result = subprocess.run(command, cwd=tmp_path, capture_output=True, text=True, timeout=300)
-    assert result.returncode == 2 and "--preset huge: unknown config preset; use one of debug" in result.stderr
+def test_unknown_preset_is_a_clear_error_before_any_clip_loads(tiny_library, tmp_path, capsys):
+    argv = ["train.py", "--preset", "huge", "--output", str(tmp_path / "run"), "--clips", str(tiny_library)]
+    assert cli.run_main(train.main, argv) == 2
+    assert "--preset huge: unknown config preset; use one of debug" in capsys.readouterr().err
     assert not (tmp_path / "run").exists()
 
 
