@@ -3,8 +3,7 @@
 Run: `nice -n 10 python benchmarks/agent_synthetic_check.py [VARIANT] [EPOCHS] [--no-portrayal-loss]`
 
 It trains the both-behaviour agent of the `default` preset with trainer/agent/algorithm.py, but plays
-actions through the numpy forward kinematics of the canonical skeleton (rlanimate_addon/core/
-kinematics.py) instead of the bpy FK environment, on the synthetic library of the trainer tests
+actions through the numpy FK environment (trainer/motion/fk.py) instead of the bpy one, on the synthetic library of the trainer tests
 (20 training clips per behaviour, one held-out clip per behaviour and arm). It prints held-out
 and seen score / smoothness and the losses every 10 epochs. It is a check of the models and losses
 in minutes, not the paper's experiment (that is trainer/train.py on the sample clip library).
@@ -14,35 +13,19 @@ import dataclasses
 import sys
 import time
 from pathlib import Path
-from types import SimpleNamespace
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO_ROOT))
 sys.path.insert(0, str(REPO_ROOT / "tests" / "trainer"))
 
-import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
 import synthetic_library  # noqa: E402
-from rlanimate_addon.core import kinematics, skeleton, spaces  # noqa: E402
-from trainer.evaluation import scoring  # noqa: E402
 from trainer.agent.algorithm import ClipReferences, Trainer  # noqa: E402
 from trainer.agent.config import load_preset  # noqa: E402
 from trainer.agent.models import VARIANTS, RLAnimateAgent  # noqa: E402
-
-
-class NumpyFKEnvironment:
-    """The FK environment's `evaluate` on the canonical skeleton, in numpy."""
-
-    def evaluate(self, rotvecs):
-        rotvecs = np.asarray(rotvecs)  # (P, 15, 3)
-        pose = kinematics.pose_matrices({j: rotvecs[:, k] for k, j in enumerate(skeleton.ACTION_JOINTS)})
-        heads = kinematics.head_positions(pose)  # (P, B, 3)
-        positions = {bone: heads[:, kinematics.bone_index(bone)] for bone in skeleton.BONE_NAMES}
-        eyes = {eye: pose[:, kinematics.bone_index(eye), :3, 1] for eye in ("LeftEye", "RightEye")}
-        descriptions = spaces.describe(positions, eyes)  # (P, 42)
-        return SimpleNamespace(descriptions=descriptions,
-                               joint_positions=spaces.description_joint_positions(descriptions))
+from trainer.evaluation import scoring  # noqa: E402
+from trainer.motion.fk import NumpyFKEnvironment  # noqa: E402
 
 
 def main():

@@ -1,7 +1,7 @@
 """Labels from motion, for clips that come without them (real capture, a user's own takes).
 
 Everything is measured on the canonical rig (numpy FK of the clip's (F, 15, 3) action rotations,
-core.kinematics), relative to the shoulder and in arm lengths L (rest shoulder-to-wrist distance),
+trainer/motion/fk.py), relative to the shoulder and in arm lengths L (rest shoulder-to-wrist distance),
 so the labels do not depend on the actor's height or where they stood.
 
 Arm: the one whose wrist travels further relative to its shoulder ("which hand moves more").
@@ -29,6 +29,7 @@ import numpy as np
 
 from rlanimate_addon.core import kinematics, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion import fk
 
 ELEVATION_PERCENTILE = 90
 RAISED_SHARE = 0.8
@@ -54,9 +55,7 @@ def arm_length(side="Left"):
 
 def joint_heads(rotvecs, bones):
     """{bone: (F, 3)} head positions, character frame, metres, of a (F, 15, 3) action clip."""
-    rotvecs = _checked(rotvecs)
-    pose = kinematics.pose_matrices({j: rotvecs[:, k] for k, j in enumerate(skeleton.ACTION_JOINTS)})
-    heads = kinematics.head_positions(pose)  # (F, B, 3)
+    heads = fk.bone_heads(_checked(rotvecs))  # (F, B, 3)
     return {bone: heads[:, kinematics.bone_index(bone)] for bone in bones}
 
 

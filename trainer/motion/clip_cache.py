@@ -18,7 +18,7 @@ IMPORT_VERSION = 1
 
 def file_hash(path):
     """Cache key of a clip file: its bytes, the importer version and the canonical skeleton it is
-    retargeted onto (a clip's local rotations are relative to the skeleton's rest frames)."""
+    canonicalised onto (a clip's local rotations are relative to the skeleton's rest frames)."""
     digest = hashlib.sha256(f"v{IMPORT_VERSION}:{skeleton.BONES!r}:".encode())
     with open(path, "rb") as handle:
         for block in iter(lambda: handle.read(1 << 20), b""):

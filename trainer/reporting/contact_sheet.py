@@ -13,7 +13,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from rlanimate_addon.core import kinematics, skeleton  # noqa: E402
+from rlanimate_addon.core import skeleton  # noqa: E402
+from trainer.motion import fk  # noqa: E402
 from trainer.motion.library_plan import DEFAULT_SEED, plan_library  # noqa: E402
 from trainer.motion.synthesis import synthesise  # noqa: E402
 from trainer.paths import CONTACT_SHEET  # noqa: E402
@@ -103,7 +104,8 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
     fig, axes = plt.subplots(2 * len(chosen), columns, figsize=(columns * 1.9, 2 * len(chosen) * 1.75), dpi=110)
     for row, (title, planned) in enumerate(chosen):
         clip = synthesise(planned.spec)
-        heads = kinematics.head_positions(kinematics.pose_matrices(clip.rotvecs))  # (F, B, 3)
+        fingers = {bone: rotvecs for bone, rotvecs in clip.rotvecs.items() if bone not in skeleton.ACTION_JOINTS}
+        heads = fk.bone_heads(clip.action_rotvecs(), fingers)  # (F, B, 3)
         side = skeleton.ARM_PREFIX[planned.spec.arm]
         trail = heads[:, _INDEX[side + "HandIndex1"]]
         target = ("ray", side) if planned.spec.behaviour == "POINT" else None

@@ -38,7 +38,7 @@ def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
                 ax.set_title(f"t = {fraction:.2f} N", fontsize=8)
             if c == 0:
                 ax.set_ylabel(title, fontsize=7)
-    figure.suptitle("Real capture, retargeted (grey, left) and RLAnimate (red, right), front view", fontsize=9)
+    figure.suptitle("Real capture on the sample rig (grey, left) and RLAnimate (red, right), front view", fontsize=9)
     figure.tight_layout()
     figure.savefig(path, dpi=110)
     plt.close(figure)
@@ -61,7 +61,7 @@ def realmocap_markdown(results):
                            f"{entry['seen']['smoothness']:.2f}", ""])
     bye = results["labels"]["bye"].items()
     lines = ["# Learning from real motion capture", "",
-             f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), retargeted onto the "
+             f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the "
              f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
              f"Preset `{results['preset']}`, {results['epochs']} epochs, seed {results['seed']}. "
              f"Regenerate: `{results['command']}`.", "",

@@ -1,4 +1,4 @@
-"""World-direction retargeting (trainer.retarget) and the real Bandai Namco capture through Blender's importer."""
+"""Canonicalisation by world bone directions, and the real Bandai Namco capture through Blender's importer."""
 
 import numpy as np
 import pytest
@@ -101,12 +101,12 @@ def test_missing_spine1_shares_the_bend_with_spine():
 def _bandai_clip():
     clips = sorted((REALMOCAP_DIR / "wave").glob("*.bvh")) if REALMOCAP_DIR.is_dir() else []
     if not clips:
-        pytest.skip(f"real motion capture not found at {REALMOCAP_DIR.resolve()}: the Bandai Namco retarget "
+        pytest.skip(f"real motion capture not found at {REALMOCAP_DIR.resolve()}: the Bandai Namco canonicalisation "
                     "test needs ../shared/realmocap/ beside the repository")
     return next(p for p in clips if "right-hand_active_002" in p.name)
 
 
-def test_retargeting_a_real_bandai_namco_wave_keeps_world_bone_directions():
+def test_canonicalising_a_real_bandai_namco_wave_keeps_world_bone_directions():
     pytest.importorskip("bpy")
     from trainer.blender_io import rig_session
     from trainer.blender_io import clip_import
