@@ -2,20 +2,24 @@
 
 A constraint on a keyed bone (an IK chain through it, Copy Rotation, Child Of, ...) replaces the
 rotation the gesture keys, so the bake would not play. Generate refuses, or, asked to, mutes each
-such constraint over the gesture's frames only, with a driver on its influence:
-`<influence> * ((frame < start) + (frame > end))`, one factor per gesture, so the constraint works as
-before everywhere else. Keys and drivers are the only per-frame mechanism that NLA strips outside
-their frames cannot leave stuck at the last value they set.
+such constraint over the gesture's frames only, fading it out as the gesture blends in and back in as
+it blends out: on every frame f of the gesture its influence is multiplied by 1 - w(f), w the
+gesture's blend weight (`gesture.blend_weights`). The values sit as linear keys on the F-curve of a
+driver whose expression is `frame`, so the influence follows the scene frame whatever the NLA does
+(a key on an NLA strip would leave the influence stuck at its last value outside the strip's frames),
+later gestures multiply in over their own frames, and it shows as an editable curve in the Drivers
+editor. Outside the gestures the constraint works as before, and at their ends the pose is the one
+the constraint made, so nothing jumps.
 """
-import re
+import numpy as np
 
 from ..core import gesture, skeleton
 from ..core.errors import RLAnimateError
 from . import action_adapter
 
 _CHAIN_TYPES = {"IK", "SPLINE_IK"}
-#: The driver expression a previous Generate put on an influence (a value times frame-range factors).
-_MUTE_EXPRESSION = re.compile(r"[-+0-9.e]+( \* \(\(frame < -?\d+\) \+ \(frame > -?\d+\)\))+")
+#: The driver expression that makes a driver's F-curve a curve over the scene frame.
+_FRAME_CURVE = "frame"
 
 
 def driven_bones(names, behaviour, arm):
@@ -88,18 +92,35 @@ def _influence_curve(obj, constraint):
 
 
 def _mutable(obj, constraint):
-    """Whether the influence is static, or driven by an earlier Generate's mute."""
+    """Whether the influence is static, or a frame curve of an earlier Generate's mute."""
     curve = _influence_curve(obj, constraint)
-    return curve is None or (getattr(curve, "driver", None) is not None
-                             and _MUTE_EXPRESSION.fullmatch(curve.driver.expression) is not None)
+    return curve is None or _is_frame_curve(curve)
+
+
+def _is_frame_curve(curve):
+    driver = getattr(curve, "driver", None)
+    return driver is not None and driver.type == "SCRIPTED" and driver.expression == _FRAME_CURVE \
+        and not driver.variables and not curve.modifiers and curve.extrapolation == "CONSTANT"
 
 
 def mute(obj, found, start, end):
-    """Mute each constraint found over frames start-end with a driver on its influence (see the module)."""
+    """Mute each constraint found over frames start-end, faded with the gesture's blend (see the module)."""
+    frames = np.arange(start, end + 1)
+    keep = 1.0 - gesture.blend_weights(len(frames))  # (N,) the influence's share left on each frame
     for _, constraint in found:
         curve = _influence_curve(obj, constraint)
         if curve is None:
+            value = constraint.influence
             curve = constraint.driver_add("influence")
-            curve.driver.type = "SCRIPTED"
-            curve.driver.expression = f"{constraint.influence:.6g}"
-        curve.driver.expression += f" * ((frame < {start}) + (frame > {end}))"
+            for modifier in list(curve.modifiers):  # Blender 4.2 adds a Generator, which would hide the keys
+                curve.modifiers.remove(modifier)
+            curve.driver.type, curve.driver.expression = "SCRIPTED", _FRAME_CURVE
+            curve.extrapolation = "CONSTANT"  # 5.0 makes new driver curves linear: the ends' values hold
+            kept, evaluate = {}, (lambda frame, value=value: value)
+        else:
+            kept, evaluate = {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}, curve.evaluate
+        keys = {f: v for f, v in kept.items() if not start <= f <= end}
+        keys.update({int(f): evaluate(float(f)) * k for f, k in zip(frames, keep)})
+        ordered = sorted(keys)
+        curve.keyframe_points.clear()
+        action_adapter.write_keys(curve, np.array(ordered, dtype=np.float64), np.array([keys[f] for f in ordered]))

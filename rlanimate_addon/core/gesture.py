@@ -198,12 +198,17 @@ def fold_spine(rotvecs, joints, present):
     return [joints[i] for i in kept], out[:, kept]
 
 
+def blend_ramp(count, fraction=BLEND_FRACTION):
+    """Frames of each of `blend_weights`' ramps for a gesture of `count` frames."""
+    return max(1, int(round(fraction * (count - 1))))
+
+
 def blend_weights(count, fraction=BLEND_FRACTION):
     """(count,) weights of the gesture against the pose underneath: 0 at both ends, 1 in the middle.
 
     Smoothstep ramps over `fraction` of the frames at each end keep velocity continuous.
     """
-    ramp = max(1, int(round(fraction * (count - 1))))
+    ramp = blend_ramp(count, fraction)
     t = np.arange(count, dtype=np.float64)
     rise = np.clip(t / ramp, 0.0, 1.0)
     fall = np.clip((count - 1 - t) / ramp, 0.0, 1.0)

@@ -4,6 +4,7 @@ import bpy
 import numpy as np
 import pytest
 
+from rlanimate_addon.core import gesture
 from test_generate import _assert_refused, _fcurves, _key_existing_animation, _state
 
 START, COUNT = 40, 41
@@ -28,31 +29,41 @@ def test_a_constraint_overriding_the_arm_is_refused_by_name_and_changes_nothing(
 def test_muting_keeps_the_constraint_outside_the_gesture_and_lets_the_gesture_play_inside(settings):
     rig, forearm, ik = _ik_rig()
     _key_existing_animation(rig)  # the gesture goes on an NLA strip, with no effect outside its frames
+    hand = helpers.rig_bone(rig, "RightHand")
     outside = [1, START - 1, START + COUNT, 200]
-    before = helpers.bone_heads(rig, [forearm.name, helpers.rig_bone(rig, "RightHand")], outside)
+    before = helpers.bone_heads(rig, [forearm.name, hand], outside)
     settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
     assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
-    after = helpers.bone_heads(rig, [forearm.name, helpers.rig_bone(rig, "RightHand")], outside)
-    assert np.abs(after - before).max() < 1e-5, "outside the gesture the constraint still acts"
+    after = helpers.bone_heads(rig, [forearm.name, hand], outside)
+    assert np.abs(after - before).max() < 1e-5, "outside the gesture the constraint acts as before"
     keyed = next(a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Right"))
     curves = sorted((f for f in _fcurves(keyed) if f'"{forearm.name}"' in f.data_path), key=lambda f: f.array_index)
-    for frame in (START, START + 20, START + COUNT - 1):
-        bpy.context.scene.frame_set(frame)
+    full = START + np.flatnonzero(gesture.blend_weights(COUNT) == 1.0)  # frames the gesture shows unblended
+    for frame in (full[0], full[len(full) // 2], full[-1]):
+        bpy.context.scene.frame_set(int(frame))
         assert ik.influence == 0.0
         # The forearm's evaluated rotation (constraints included) is the keyed one.
         evaluated = (forearm.parent.matrix.inverted() @ forearm.matrix).to_quaternion()
         rest = (forearm.parent.bone.matrix_local.inverted() @ forearm.bone.matrix_local).to_quaternion()
         keyed_rotation = rest @ type(rest)([f.evaluate(frame) for f in curves])
         assert abs(evaluated.dot(keyed_rotation)) == pytest.approx(1.0, abs=1e-5)
-    for frame in outside:
+    for frame in outside + [START, START + COUNT - 1]:
         bpy.context.scene.frame_set(frame)
-        assert ik.influence == pytest.approx(0.7, abs=1e-6)
+        assert ik.influence == pytest.approx(0.7, abs=1e-6), "the influence fades, from and back to its own value"
+    # The constraint fades out as the gesture blends in: the hand does not jump at either end (switched
+    # off at once, it jumped by the 10 cm between the constraint's pose and the keyed one).
+    for edge in (START - 1, START, START + COUNT - 2, START + COUNT - 1):
+        step = np.linalg.norm(np.diff(helpers.bone_heads(rig, [hand], [edge, edge + 1])[:, 0], axis=0))
+        assert step < 0.01, f"the hand jumps {step:.3f} m from frame {edge} to {edge + 1}"
 
     # A second gesture mutes it over its own frames as well, the first one's frames kept.
     settings.start_frame = 200
     assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
-    expression = rig.animation_data.drivers.find(ik.path_from_id("influence")).driver.expression
-    assert expression == "0.7 * ((frame < 40) + (frame > 80)) * ((frame < 200) + (frame > 240))"
+    curve = rig.animation_data.drivers.find(ik.path_from_id("influence"))
+    assert curve.driver.expression == "frame" and len(curve.keyframe_points) == 2 * COUNT
+    for frame, value in ((START + COUNT // 2, 0.0), (120, 0.7), (220, 0.0), (250, 0.7)):
+        bpy.context.scene.frame_set(frame)
+        assert ik.influence == pytest.approx(value, abs=1e-6)
 
 
 def test_a_constraint_with_an_animated_influence_is_not_overwritten(settings):
