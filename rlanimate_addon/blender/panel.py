@@ -1,4 +1,6 @@
 """The N-panel: View3D > Sidebar > RLAnimate."""
+import os
+
 import bpy
 
 from ..core import gesture
@@ -23,11 +25,29 @@ def _overriding_constraints(context, settings):
     obj = context.active_object
     if obj is None or obj.type != "ARMATURE":
         return []
+    return constraints.overriding(obj, constraints.driven_bones(_rig_roles(obj, settings.bone_map_file),
+                                                                settings.behaviour, settings.arm))
+
+
+_roles = {}
+
+
+def _rig_roles(obj, bone_map_file):
+    """The armature's roles as Generate finds them ({} when it cannot: Generate names why), remembered per
+    bone names and bone-map file version: detecting them takes about 1 ms, too long for every redraw."""
+    path = bpy.path.abspath(bone_map_file) if bone_map_file else ""
     try:
-        _, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
-    except RLAnimateError:  # Generate names the problem
-        return []
-    return constraints.overriding(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm))
+        version = os.stat(path).st_mtime_ns if path else None
+    except OSError:
+        version = None
+    key = (tuple(bone.name for bone in obj.data.bones), path, version)
+    if key not in _roles:
+        _roles.clear()
+        try:
+            _roles[key] = armature_io.rig_roles_of(obj, bone_map_file)[1]
+        except RLAnimateError:
+            _roles[key] = {}
+    return _roles[key]
 
 
 class VIEW3D_PT_rlanimate(bpy.types.Panel):
