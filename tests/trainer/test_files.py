@@ -4,6 +4,7 @@ import subprocess
 import sys
 
 from trainer import files
+from trainer.paths import REPO_ROOT
 
 
 def _dead_pid():
@@ -42,3 +43,24 @@ def test_the_file_and_its_folder_are_synced(tmp_path, monkeypatch):
     assert len(synced) == 2
     if os.path.isdir("/proc/self/fd"):
         assert synced[0].endswith(".tmp") and synced[1] == str((tmp_path / "cache").resolve())
+
+
+def test_writes_killed_half_way_do_not_pile_up(tmp_path):
+    """Real writers killed with SIGKILL mid-write, as a killed training run is: each write removes the
+    temporaries of the killed ones before it, and a finished write leaves only the file."""
+    target = tmp_path / "checkpoint.pt"
+    writer = ("import sys, time\nfrom trainer import files\n"
+              "with files.atomic_open(sys.argv[1]) as handle:\n"
+              "    handle.write(bytes(1 << 20)); handle.flush(); print('writing', flush=True); time.sleep(60)\n")
+    for _ in range(3):
+        process = subprocess.Popen([sys.executable, "-c", writer, str(target)], stdout=subprocess.PIPE, text=True,
+                                   cwd=REPO_ROOT)
+        assert process.stdout.readline().strip() == "writing"
+        process.kill()
+        process.wait()
+        process.stdout.close()
+        left = list(tmp_path.glob(".checkpoint.pt.*.tmp"))
+        assert [p.name for p in left] == [f".checkpoint.pt.{process.pid}.tmp"], "only the last killed write's"
+    with files.atomic_open(target) as handle:
+        handle.write(b"whole")
+    assert [p.name for p in tmp_path.iterdir()] == ["checkpoint.pt"] and target.read_bytes() == b"whole"
