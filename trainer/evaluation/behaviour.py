@@ -34,8 +34,9 @@ def class_lengths(training_clips):
 
 
 def clip_target(clip):
-    """(3,) the pointing target of a POINT clip in the character frame (None for a wave)."""
-    return None if clip.target is None else np.asarray(clip.target, dtype=np.float64)
+    """(3,) the pointing target of a POINT clip in the character frame (None for a wave, or a clip without one)."""
+    target = getattr(clip, "target", None)
+    return None if target is None else np.asarray(target, dtype=np.float64)
 
 
 def _answer(method, behaviour, arm, attributes, frames, target, exact_aim, seed=None):
@@ -124,8 +125,8 @@ def exaggeration_sweep(method, arm, frames, describe, exaggerations=EXAGGERATION
 
 
 def summarise(rows):
-    """{behaviour: summary} of request rows: means of the scores, medians (and extremes where a bound
-    applies) of the behaviour measures."""
+    """{behaviour: summary} of request rows: means of the scores present, medians (and extremes where a
+    bound applies) of the behaviour measures (pointing ones when the rows have them)."""
     summary = {}
     for behaviour in sorted({r["behaviour"] for r in rows}):
         group = [r for r in rows if r["behaviour"] == behaviour]
@@ -135,7 +136,8 @@ def summarise(rows):
 
         entry = {"requests": len(group)}
         for key in ("score", "score_class_length", "aligned_score", "smoothness"):
-            entry[key] = float(values(key).mean())
+            if key in group[0]:
+                entry[key] = float(values(key).mean())
         for key in ("elevation_first_error", "elevation_last_error"):
             entry[f"{key}_median"], entry[f"{key}_max"] = float(np.median(values(key))), float(values(key).max())
         if behaviour == "wave":
@@ -145,7 +147,7 @@ def summarise(rows):
                                                                   float(values("swing_ratio").max()))
             entry["cycles_min"], entry["cycles_median"] = float(values("cycles").min()), float(np.median(values("cycles")))
             entry["accepted_share"] = float(values("wave_accepted").mean())
-        else:
+        elif "pointing_angle" in group[0]:
             entry["pointing_angle_median"] = float(np.median(values("pointing_angle")))
             entry["pointing_angle_max"] = float(values("pointing_angle").max())
             entry["hold_ratio_median"] = float(np.median(values("hold_ratio")))

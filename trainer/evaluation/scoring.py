@@ -1,16 +1,20 @@
-"""Evaluation as in the paper's Section 4: score and smoothness of deterministic rollouts.
+"""Evaluation as in the paper's Section 4: score and smoothness of deterministic rollouts, with the
+behaviour metrics beside them.
 
 For each clip the agent is rolled out deterministically on the clip's objectives (a baseline answers
 the same request), the motions are played through the FK environment (all clips in one batch), and the
-10 description joints are compared with the FK of the clip's own motion by the one scorer,
-`score_positions`: `metrics.score(generated, reference)` and `metrics.smoothness(generated)`. A clip
-set's figures are the means over its clips.
+descriptions are compared with the FK of the clip's own motion by the one scorer, `score_descriptions`:
+`metrics.score(generated, reference)`, `metrics.smoothness(generated)`, the time-aligned score
+(`behaviour_metrics.aligned_score`) and the behaviour measures (`behaviour_metrics.compare`: wave, point,
+raise and lower). A clip set's scores are the means over its clips, its behaviour measures the medians
+and extremes of `evaluation.behaviour.summarise`.
 """
 import numpy as np
 
-from rlanimate_addon.core import metrics, spaces
+from rlanimate_addon.core import behaviour_metrics, metrics, spaces
 
 from trainer.agent.algorithm import clip_objective, rollout_actions
+from trainer.evaluation.behaviour import clip_target, summarise
 
 SEEN_CLIP_COUNT = 10
 
@@ -30,47 +34,56 @@ def select_clips(clips, behaviour, count=None):
     return chosen
 
 
-def generate_positions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-    """Deterministic rollouts for a list of (N_i, 7) objectives -> list of (N_i, 10, 3) joint positions."""
+def generate_descriptions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUNDS):
+    """Deterministic rollouts for a list of (N_i, 7) objectives -> list of (N_i, 42) descriptions."""
     actions = [rollout_actions(agent, objective, deterministic=True) for objective in objectives]
     rotvecs = spaces.decode_action(np.concatenate(actions), bounds)  # (sum N, 15, 3)
-    positions = np.asarray(env.evaluate(rotvecs).joint_positions)  # (sum N, 10, 3)
-    return np.split(positions, np.cumsum([len(a) for a in actions])[:-1])
+    descriptions = np.asarray(env.evaluate(rotvecs).descriptions)  # (sum N, 42)
+    return np.split(descriptions, np.cumsum([len(a) for a in actions])[:-1])
 
 
 def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-    """score_positions of `agent`'s deterministic rollouts on each clip's own request."""
+    """score_descriptions of `agent`'s deterministic rollouts on each clip's own request."""
     agent.eval()
-    generated = generate_positions(agent, env, [clip_objective(clip) for clip in clips], bounds)
-    return score_positions(clips, generated, references)
+    generated = generate_descriptions(agent, env, [clip_objective(clip) for clip in clips], bounds)
+    return score_descriptions(clips, generated, references)
 
 
 def score_motions(env, motions, clips, references):
-    """score_positions of generated (F_i, 15, 3) action rotations `motions`, one per clip of `clips` (the
+    """score_descriptions of generated (F_i, 15, 3) action rotations `motions`, one per clip of `clips` (the
     baselines' and the agents' answers alike), played through `env` in one batch."""
     ends = np.cumsum([len(m) for m in motions])[:-1]
-    positions = np.split(np.asarray(env.evaluate(np.concatenate(motions)).joint_positions), ends)
-    return score_positions(clips, positions, references)
+    descriptions = np.split(np.asarray(env.evaluate(np.concatenate(motions)).descriptions), ends)
+    return score_descriptions(clips, descriptions, references)
 
 
-def score_positions(clips, positions, references):
-    """The one scorer: {'score', 'smoothness', 'by_behaviour': {behaviour: {score, smoothness}},
-    'clips': [{name, behaviour, score, smoothness}]} of generated (F_i, 10, 3) joint `positions` against
-    each clip's own FK (references: algorithm.ClipReferences): means over the clips, per behaviour, per clip."""
-    rows = []
-    for clip, generated in zip(clips, positions):
-        _, reference = references.get(clip)
-        rows.append({"name": getattr(clip, "name", ""), "behaviour": clip.behaviour.lower(),
-                     "score": float(metrics.score(generated, reference)),
-                     "smoothness": float(metrics.smoothness(generated))})
-    by_behaviour = {}
-    for behaviour in sorted({r["behaviour"] for r in rows}):
-        group = [r for r in rows if r["behaviour"] == behaviour]
-        by_behaviour[behaviour] = {"score": float(np.mean([r["score"] for r in group])),
-                                   "smoothness": float(np.mean([r["smoothness"] for r in group]))}
+def clip_row(clip, generated, reference):
+    """One clip's figures from generated and reference descriptions (F, 42): name, behaviour, score,
+    smoothness, aligned_score and the behaviour measures (pointing ones only when the clip has a target)."""
+    behaviour = clip.behaviour.upper()
+    positions = spaces.description_joint_positions(generated)
+    reference_positions = spaces.description_joint_positions(reference)
+    row = {"name": getattr(clip, "name", ""), "behaviour": behaviour.lower(),
+           "score": float(metrics.score(positions, reference_positions)),
+           "smoothness": float(metrics.smoothness(positions)),
+           "aligned_score": behaviour_metrics.aligned_score(positions, reference_positions)}
+    target = clip_target(clip)
+    if behaviour == "WAVE" or target is not None:
+        row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm.upper(), target))
+    else:  # a pointing clip without a target (real capture): its elevation only
+        row.update({f"elevation_{k}": v for k, v in behaviour_metrics.raise_lower(
+            positions, reference_positions, clip.arm.upper()).items()})
+    return row
+
+
+def score_descriptions(clips, descriptions, references):
+    """The one scorer: {'score', 'smoothness', 'by_behaviour': {behaviour: summarise's entry}, 'clips':
+    [clip_row]} of generated (F_i, 42) `descriptions` against each clip's own FK (references:
+    algorithm.ClipReferences): means over the clips, per behaviour, per clip."""
+    rows = [clip_row(clip, generated, references.get(clip)[0]) for clip, generated in zip(clips, descriptions)]
     return {"score": float(np.mean([r["score"] for r in rows])),
             "smoothness": float(np.mean([r["smoothness"] for r in rows])),
-            "by_behaviour": by_behaviour, "clips": rows}
+            "by_behaviour": summarise(rows), "clips": rows}
 
 
 def evaluate_seen_unseen(trainer, session):
@@ -95,6 +108,7 @@ def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.
         result[behaviour] = {}
         for scale in scales:
             frames = max(2, int(round(scale * mean_length)))
-            generated = generate_positions(agent, env, [clip_objective(c, frames) for c in group], bounds)
-            result[behaviour][f"{scale:g}"] = float(np.mean([metrics.smoothness(p) for p in generated]))
+            generated = generate_descriptions(agent, env, [clip_objective(c, frames) for c in group], bounds)
+            result[behaviour][f"{scale:g}"] = float(np.mean([metrics.smoothness(spaces.description_joint_positions(d))
+                                                             for d in generated]))
     return result

@@ -27,6 +27,19 @@ def _scores(entry):
     return [_f(entry[k]) for k in ("score", "score_class_length", "aligned_score", "smoothness")]
 
 
+def behaviour_words(behaviour, entry):
+    """One line of a clip set's behaviour measures (an evaluation.behaviour.summarise entry)."""
+    elevation = f"elevation error <= {_f(max(entry['elevation_first_error_max'], entry['elevation_last_error_max']), 1)} deg"
+    if behaviour == "wave":
+        return (f"swing {_f(entry['swing_ratio_median'])}x, frequency {_f(entry['frequency_ratio_median'])}x, "
+                f"at least {entry['cycles_min']:.0f} cycles, {entry['accepted_share'] * entry['requests']:.0f} of "
+                f"{entry['requests']} waves accepted; {elevation}")
+    if "pointing_angle_median" in entry:
+        return (f"own aim {_f(entry['pointing_angle_median'], 1)} deg median, {_f(entry['pointing_angle_max'], 1)} "
+                f"max; {elevation}")
+    return elevation
+
+
 def wave_row(entry):
     return _scores(entry) + [
         f"{_f(entry['swing_ratio_median'])} ({_f(entry['swing_ratio_min'])}-{_f(entry['swing_ratio_max'])})",

@@ -3,6 +3,7 @@ import json
 from pathlib import Path
 
 from trainer.paths import shown
+from trainer.reporting.behaviour_report import behaviour_words
 from trainer.reporting.tables import markdown_table
 
 
@@ -13,17 +14,19 @@ def write_run_report(report, output):
     rows = []
     for label, key in (("held-out (unseen)", "held_out"), ("training (seen)", "training")):
         rows.append([label, len(report[key]["clips"]), f"{report[key]['score']:.2f}",
-                     f"{report[key]['smoothness']:.2f}"])
+                     f"{report[key]['smoothness']:.2f}", "", ""])
         for behaviour, entry in report[key]["by_behaviour"].items():
             count = sum(c["behaviour"] == behaviour for c in report[key]["clips"])
-            rows.append([f"{label}, {behaviour}", count, f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}"])
+            rows.append([f"{label}, {behaviour}", count, f"{entry['score']:.2f}", f"{entry['smoothness']:.2f}",
+                         f"{entry['aligned_score']:.2f}", behaviour_words(behaviour, entry)])
     lines = [f"# RLAnimate agent: {report['variant']}, {report['behaviour']}", "",
              f"Preset `{report['preset']}`, seed {report['seed']}, {report['epochs']} epochs (iterations of "
              f"Algorithm 1), {report['episodes']} sample episodes ({report['frames']} frames), "
              f"{report['train_seconds'] / 60:.1f} min of training (wall clock; {report['train_cpu_seconds'] / 60:.1f} "
              f"min of CPU time) with {report['torch_threads']} torch thread(s) on a machine shared with other jobs. "
              f"Clips: `{shown(report['clips']) if Path(report['clips']).exists() else report['clips']}`.", "",
-             *markdown_table(["clip set", "clips", "score", "smoothness"], rows), "", "Per held-out clip:", "",
+             *markdown_table(["clip set", "clips", "score", "smoothness", "score, DTW", "behaviour (docs/METRICS.md)"],
+                             rows), "", "Per held-out clip:", "",
              *markdown_table(["clip", "behaviour", "score", "smoothness"],
                              [[c["name"], c["behaviour"], f"{c['score']:.2f}", f"{c['smoothness']:.2f}"]
                               for c in report["held_out"]["clips"]])]

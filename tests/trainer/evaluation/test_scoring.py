@@ -58,6 +58,10 @@ def test_a_replayed_clip_scores_100_and_noise_lowers_score_and_smoothness(env, l
     assert [row["name"] for row in perfect["clips"]] == [c.name for c in clips]
     waves = [row["score"] for row in perfect["clips"] if row["behaviour"] == "wave"]
     assert perfect["by_behaviour"]["wave"]["score"] == pytest.approx(np.mean(waves))
+    for row in perfect["clips"]:  # the behaviour measures sit beside the score: a replay matches them all
+        assert row["aligned_score"] == pytest.approx(100.0, abs=1e-3)
+        assert row["elevation_first_error"] < 1e-3 and row["elevation_last_error"] < 1e-3
+        assert row["behaviour"] == "point" or row["swing_ratio"] == pytest.approx(1.0, abs=1e-3)
     noisy = scoring.evaluate_clips(ReplayAgent(clips, noise=0.03), env, clips, references)
     assert noisy["score"] < perfect["score"] - 0.5
     assert noisy["smoothness"] < perfect["smoothness"] - 0.5
@@ -76,6 +80,6 @@ def test_length_flexibility_rolls_out_each_scaled_length(env, library):
     waves = [c for c in library.test if c.behaviour == "WAVE"]
     mean_length = np.mean([len(c.rotvecs) for c in library.train if c.behaviour == "WAVE"])
     objectives = [clip_objective(c, int(round(1.5 * mean_length))) for c in waves]
-    positions = scoring.generate_positions(agent, env, objectives)
+    positions = [spaces.description_joint_positions(d) for d in scoring.generate_descriptions(agent, env, objectives)]
     assert [len(p) for p in positions] == [int(round(1.5 * mean_length))] * len(waves)
     assert result["wave"]["1.5"] == pytest.approx(np.mean([metrics.smoothness(p) for p in positions]))
