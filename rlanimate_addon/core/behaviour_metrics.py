@@ -138,8 +138,9 @@ def _refined(signal, frames):
 def wave_measures(positions, arm, fps=FPS):
     """What a wave shows, in absolute units:
     {'hand_up_s', 'strokes', 'cycles', 'swing' (m, the median stroke between two turning points, of
-    any stroke with fewer than 3; the run's side-to-side range when there is no stroke), 'frequency' (Hz, 0 with fewer than 2 strokes), 'hand_height' (m, the 90th
-    percentile over all frames of the wrist's height above where a hanging arm's wrist would be)}."""
+    any stroke with fewer than 3; the run's side-to-side range when there is no stroke), 'frequency'
+    (Hz, 0 with fewer than 2 strokes), 'hand_height' (m, the 90th percentile over all frames of the
+    wrist's height above where a hanging arm's wrist would be)}."""
     p, side = _positions(positions), _side(arm)
     wrist, shoulder = p[:, _JOINT[f"{side}_wrist"]], p[:, _JOINT[f"{side}_shoulder"]]
     length = arm_length(p, arm)
