@@ -12,8 +12,7 @@ import numpy as np
 
 from ..core import key_reduction, rig_roles
 from ..core.errors import RLAnimateError
-from ..core.gesture import RigState
-from ..core.rig import RigSkeleton
+from ..core.gesture import RigState, role_skeleton
 from . import action_adapter
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
@@ -42,12 +41,12 @@ def rig_roles_of(obj, bone_map_path=""):
     return family.name, roles
 
 
-def read_skeleton(obj):
-    """The armature's bones as a RigSkeleton (rest matrices in armature space, its units)."""
+def read_skeleton(obj, roles):
+    """The bones playing roles as a RigSkeleton (gesture.role_skeleton; rest matrices in armature space,
+    the rig's units)."""
     bones = obj.data.bones
-    return RigSkeleton([b.name for b in bones], [b.parent.name if b.parent else None for b in bones],
-                       np.array([b.matrix_local for b in bones], dtype=np.float64),
-                       [b.length for b in bones])
+    rest = {b: np.array(bones[b].matrix_local, dtype=np.float64) for b in roles.values()}
+    return role_skeleton(roles, rest, {b: bones[b].length for b in roles.values()})
 
 
 def _rotation_values(pose_bone):
@@ -57,8 +56,9 @@ def _rotation_values(pose_bone):
 def sample_rig(context, obj, roles, family, frames, target=None, target_bone=""):
     """(RigState, {bone: (N, C) rotation channel values underneath}, targets (N, 3)).
 
-    An animated rig is read at every frame (scene.frame_set), as its action, NLA and drivers play it;
-    a still one once. The target (an object, a bone of an armature when target_bone names one, or the
+    The bones playing roles are read (their basis and their evaluated pose, constraints included) at
+    every frame of an animated rig (scene.frame_set), as its action, NLA and drivers play it; a still
+    rig once. The target (an object, a bone of an armature when target_bone names one, or the
     3D cursor when target is None) is read in the rig's armature space at each frame where anything
     can move it. The caller restores the scene's frame.
     """
@@ -66,21 +66,22 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
     animated = action_adapter.is_animated(obj)
     target_moves = target is not None and (may_move(target) or (target_bone and action_adapter.is_animated(target)))
     moving = animated or may_move(obj) or target_moves
-    skeleton = read_skeleton(obj)
+    skeleton = read_skeleton(obj, roles)
     pose_bones = [obj.pose.bones[name] for name in skeleton.names]
-    role_bones = sorted(set(roles.values()))
-    under, values, targets = [], {b: [] for b in role_bones}, []
+    under, poses, values, targets = [], [], {b: [] for b in skeleton.names}, []
     for frame in (frames if moving else frames[:1]):
         if moving:
             scene.frame_set(int(frame))
+        # Copied now: mathutils wraps the pose's own memory, which the next frame overwrites.
         under.append(np.array([pb.matrix_basis for pb in pose_bones], dtype=np.float64))
-        for bone in role_bones:
-            values[bone].append(_rotation_values(obj.pose.bones[bone]))
+        poses.append(np.array([pb.matrix for pb in pose_bones], dtype=np.float64))
+        for pb in pose_bones:
+            values[pb.name].append(_rotation_values(pb))
         targets.append(_to_armature(obj, _world_point(target, target_bone, scene)))
     count = len(frames)
-    under = np.broadcast_to(np.array(under), (count,) + np.shape(under)[1:])
+    under, poses = (np.broadcast_to(np.array(m), (count,) + np.shape(m)[1:]) for m in (under, poses))
     values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
-    rig = RigState(obj.name, skeleton, roles, family, under, animated)
+    rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
     return rig, values, np.broadcast_to(np.array(targets), (count, 3))
 
 

@@ -64,10 +64,21 @@ class _Plan:
         self.worst = 0.0
 
 
+def check_fk_arm(obj, family, arm):
+    """RLAnimateError when a Rigify arm follows its IK controls: the gesture keys its FK controls."""
+    side = ".L" if arm == "LEFT" else ".R"
+    switch = obj.pose.bones.get("upper_arm_parent" + side)
+    if family == rig_roles.RIGIFY.name and switch is not None and switch.get("IK_FK", 1.0) < 1.0:
+        raise RLAnimateError(f"The {arm.lower()} arm of {obj.name!r} follows its IK controls (IK_FK "
+                             f"{switch['IK_FK']:.2f} on {switch.name}), so keys on its FK controls would not move "
+                             "it: set the arm's IK-FK slider to 1.0 (FK) in Rigify's panel, then generate.")
+
+
 def _check(obj, settings, start, end, mute_constraints):
     """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
+    check_fk_arm(obj, family, settings.arm)
     check_keepable(obj)
     overriding = constraints.overriding(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm))
     constraints.check(obj, overriding, start, end, mute_constraints)

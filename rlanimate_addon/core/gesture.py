@@ -156,22 +156,64 @@ def run_agent(agent, behaviour, objectives, seed=None):
 _CANONICAL_FRAMES = {bone.name: skeleton.rest_frame(bone) for bone in skeleton.BONES}
 
 
-def retarget_matrices(canonical_bones, rig_rest_frames, to_character):
-    """(B, 3, 3) C = F_can^-1 A F_rig for each named canonical bone.
+def retarget_matrices(canonical_bones, rig_rest_frames, to_character, swings=None):
+    """(B, 3, 3) C = F_can^-1 D A F_rig for each named canonical bone.
 
     rig_rest_frames: (B, 3, 3) armature-space rest rotations of the rig's bones (columns: local axes).
+    swings: (B, 3, 3) D, character-frame rotations that lay each rig bone's rest direction onto the
+    canonical one (`rest_swings`; identity when None).
     """
     canonical = np.stack([_CANONICAL_FRAMES[name] for name in canonical_bones])
-    return np.swapaxes(canonical, -1, -2) @ to_character @ np.asarray(rig_rest_frames, dtype=np.float64)
+    frames = to_character @ np.asarray(rig_rest_frames, dtype=np.float64)
+    if swings is not None:
+        frames = swings @ frames
+    return np.swapaxes(canonical, -1, -2) @ frames
 
 
-def retarget(canonical_rotvecs, conversions):
+def retarget(canonical_rotvecs, conversions, parent_conversions=None):
     """Canonical local rotation vectors (..., B, 3) -> the rig's local quaternions (..., B, 4).
 
-    R_rig = C^-1 R_can C per bone, with C from `retarget_matrices`.
+    R_rig = P^-1 R_can C per bone, with C from `retarget_matrices` and P the same built with the
+    parent's swing (P = C when the rig rests like the canonical T-pose).
     """
     rotations = rotvec_to_matrix(canonical_rotvecs)  # (..., B, 3, 3)
-    return matrix_to_quat(np.swapaxes(conversions, -1, -2) @ rotations @ conversions)
+    left = conversions if parent_conversions is None else parent_conversions
+    return matrix_to_quat(np.swapaxes(left, -1, -2) @ rotations @ conversions)
+
+
+#: Role whose rest head a bone's rest direction points to, for the bones whose rest pose differs
+#: between T- and A-pose rigs (the spine, neck and head rest upright in both).
+_DIRECTION_TO = {f"{side}{bone}": f"{side}{child}" for side in ("Left", "Right")
+                 for bone, child in (("Shoulder", "Arm"), ("Arm", "ForeArm"), ("ForeArm", "Hand"),
+                                     ("Hand", "HandMiddle1"))}
+
+
+def rest_swings(roles, rest_heads, to_character):
+    """{role: (3, 3)} D per role: the shortest rotation (character frame) taking the rig's rest
+    direction of the bone onto the canonical one. Bones without a direction of their own (the spine,
+    the fingers) take their parent's (identity at the root).
+
+    With it an A-pose rig plays the canonical rotations as a T-pose rig does: the arms hang, raise
+    and wave where the canonical skeleton's do, not 45 degrees lower.
+    """
+    swings = {}
+    for name in [n for n in skeleton.BONE_NAMES if n in roles]:  # parents first
+        parent = _parent_role(name, roles)
+        swings[name] = np.eye(3) if parent is None else swings[parent]
+        child = _DIRECTION_TO.get(name)
+        if child in rest_heads:
+            rig = to_character @ (np.asarray(rest_heads[child]) - np.asarray(rest_heads[name]))
+            canonical = np.subtract(skeleton.BONE_BY_NAME[child].head, skeleton.BONE_BY_NAME[name].head)
+            rig, canonical = rig / np.linalg.norm(rig), canonical / np.linalg.norm(canonical)
+            swings[name] = aim.rotation_between(rig[None], canonical[None])[0]
+    return swings
+
+
+def _parent_role(name, present):
+    parent = skeleton.BONE_BY_NAME[name].parent
+    while parent is not None and parent not in present:
+        parent = skeleton.BONE_BY_NAME[parent].parent
+    return parent
 
 
 def fold_spine(rotvecs, joints, present):
@@ -284,15 +326,16 @@ def finger_line_bones(roles, arm):
     return roles[prefix], roles[prefix]
 
 
-def aim_rig(rig, basis, arm, targets, weights):
+def aim_rig(rig, basis, changed, arm, targets, weights):
     """(N, 4, 4) basis matrices of the pointing Arm bone turned so the rig's finger line passes
     through targets (N, 3) by `weights` (N,) of the turn, solved against the posed rig.
 
-    basis: (N, B, 4, 4) every bone's basis as it will play (the gesture over the pose underneath).
+    basis: (N, B, 4, 4) every bone's basis as it will play: the gesture's on the bones at indices
+    `changed`, over the pose underneath.
     """
     arm_bone = rig.roles[skeleton.ARM_PREFIX[arm] + "Arm"]
     start, end = finger_line_bones(rig.roles, arm)
-    pose = rig.skeleton.pose_matrices(basis, only=(end,))
+    pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed)
     i = rig.skeleton.index[arm_bone]
     base = pose[:, rig.skeleton.index[start], :3, 3]
     finger = rig.skeleton.tails(pose, end) - base
@@ -327,21 +370,29 @@ def gesture_rotations(agent, request, rig):
         canonical = np.concatenate([canonical, hand[:, present]], axis=1)
     bones = [rig.roles[n] for n in names]
     columns = [rig.skeleton.index[b] for b in bones]
-    conversions = retarget_matrices(names, [rig.skeleton.rest_frame(b) for b in bones], character_frame(rest_heads))
-    under_basis = np.broadcast_to(rig.under, (request.frame_count,) + np.shape(rig.under)[-3:]).copy()
+    to_character = character_frame(rest_heads)
+    swings = rest_swings(rig.roles, rest_heads, to_character)
+    frames = [rig.skeleton.rest_frame(b) for b in bones]
+    conversions = retarget_matrices(names, frames, to_character, np.array([swings[n] for n in names]))
+    parents = [_parent_role(n, rig.roles) for n in names]
+    parent_swings = np.array([np.eye(3) if p is None else swings[p] for p in parents])
+    parent_conversions = retarget_matrices(names, frames, to_character, parent_swings)
+    under_basis = rig.under_at(request.frame_count).copy()
     under = matrix_to_quat(under_basis[:, columns, :3, :3])  # (N, D, 4)
     start = under
     if not rig.animated:  # bones at rest start from the standing pose, not the bind pose
-        standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions)  # (D, 4)
+        standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions,
+                            parent_conversions)  # (D, 4)
         at_rest = np.abs(under[..., 0]) > 1.0 - 1e-9
         start = np.where(at_rest[..., None], standing, under)
-    keyed = blend_from_pose(start, retarget(canonical, conversions), blend_weights(request.frame_count))
+    keyed = blend_from_pose(start, retarget(canonical, conversions, parent_conversions),
+                            blend_weights(request.frame_count))
     if request.behaviour == "POINT" and request.exact_aim:
         basis = under_basis
         basis[:, columns, :3, :3] = quat_to_matrix(keyed) * np.linalg.norm(basis[:, columns, :3, :3], axis=-2,
                                                                           keepdims=True)
         arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
-        aimed = aim_rig(rig, basis, request.arm, np.broadcast_to(request.targets, (request.frame_count, 3)),
+        aimed = aim_rig(rig, basis, columns, request.arm, np.broadcast_to(request.targets, (request.frame_count, 3)),
                         aim.pointing_phase(phase_base))
         keyed[:, arm_column] = matrix_to_quat(aimed[:, :3, :3] / np.linalg.norm(aimed[:, :3, :3], axis=-2,
                                                                                   keepdims=True))
@@ -369,20 +420,48 @@ class GestureRequest:
 class RigState:
     """The rig as the pipeline needs it.
 
-    skeleton: a core.rig.RigSkeleton; roles: {role: bone name} (core.rig_roles); family: the naming
-    it was matched by (for messages); under: (B, 4, 4) or (N, B, 4, 4) every bone's basis matrix as
-    the rig plays without the gesture, at each gesture frame; animated: whether `under` is animation
-    (when it is not, bones at rest start and end in the standing pose).
+    skeleton: a core.rig.RigSkeleton of the bones that play roles, each parented to the bone of its
+    nearest canonical ancestor's role; roles: {role: bone name} (core.rig_roles); family: the naming
+    it was matched by (for messages); under, under_pose: (B, 4, 4) or (N, B, 4, 4) each bone's basis
+    and armature-space pose matrices as the rig plays without the gesture, at each gesture frame (the
+    pose by forward kinematics when None); animated: whether they are animation (when not, bones at
+    rest start and end in the standing pose).
     """
 
-    def __init__(self, name, skeleton_, roles, family, under, animated):
+    def __init__(self, name, skeleton_, roles, family, under, animated, under_pose=None):
         self.name, self.skeleton, self.roles, self.family = name, skeleton_, dict(roles), family
         self.under, self.animated = np.asarray(under, dtype=np.float64), animated
+        if under_pose is None:
+            every = [skeleton_.names[i] for i in range(len(skeleton_.names))]
+            under_pose = skeleton_.pose_matrices(self.under, only=every)
+        self.under_pose = np.asarray(under_pose, dtype=np.float64)
+
+    def under_at(self, count):
+        """(N, B, 4, 4) basis matrices underneath at each of `count` frames."""
+        return np.broadcast_to(self.under, (count,) + self.under.shape[-3:])
+
+    def under_pose_at(self, count):
+        """(N, B, 4, 4) pose matrices underneath at each of `count` frames."""
+        return np.broadcast_to(self.under_pose, (count,) + self.under_pose.shape[-3:])
 
     @property
     def rest_heads(self):
         """{role: (3,) rest head in armature space}."""
         return {role: self.skeleton.rest_head(bone) for role, bone in self.roles.items()}
+
+
+def role_skeleton(roles, rest, lengths):
+    """A RigSkeleton of the bones playing `roles` ({role: bone}), each parented to the bone of its
+    nearest canonical ancestor that the rig has; rest: {bone: (4, 4)}, lengths: {bone: float}."""
+    ordered = [name for name in skeleton.BONE_NAMES if name in roles]  # canonical order: parents first
+    parents = []
+    for role in ordered:
+        parent = skeleton.BONE_BY_NAME[role].parent
+        while parent is not None and parent not in roles:
+            parent = skeleton.BONE_BY_NAME[parent].parent
+        parents.append(None if parent is None else roles[parent])
+    bones = [roles[r] for r in ordered]
+    return RigSkeleton(bones, parents, [rest[b] for b in bones], [lengths[b] for b in bones])
 
 
 def canonical_rig():

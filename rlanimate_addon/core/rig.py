@@ -2,6 +2,9 @@
 
 Blender's pose evaluation without constraints: pose = parent_pose @ parent_rest^-1 @ rest @ basis,
 with rest a bone's `matrix_local` and basis its `matrix_basis` (the keyed location, rotation, scale).
+`pose_after` predicts the pose of a rig whose bones follow one another through constraints or
+helper bones (Rigify's FK controls and the bones that copy them): from the pose Blender evaluated,
+a bone whose basis changes, or whose parent moves, moves rigidly with them.
 """
 import numpy as np
 
@@ -39,6 +42,28 @@ class RigSkeleton:
             chain.append(i)
             i = self.parents[i]
         return chain[::-1]
+
+    def pose_after(self, pose, basis, new_basis, changed):
+        """(N, B, 4, 4) pose matrices once the bones at indices `changed` take `new_basis`.
+
+        pose, basis: (N, B, 4, 4) the evaluated pose and basis matrices underneath; new_basis: (N, B, 4, 4)
+        (only the changed bones' are read). A changed bone, or one below a changed bone, keeps where it
+        sits relative to its parent and plays its new basis:
+        pose' = parent_pose' @ parent_pose^-1 @ pose @ basis^-1 @ basis'.
+        """
+        changed = set(changed)
+        out = np.array(pose, dtype=np.float64)
+        moved = np.zeros(len(self.names), dtype=bool)
+        for i in sorted(range(len(self.names)), key=lambda i: len(self.ancestors(self.names[i]))):
+            parent = self.parents[i]
+            follows = parent >= 0 and moved[parent]
+            if i not in changed and not follows:
+                continue
+            local = basis[:, i] if i not in changed else new_basis[:, i]
+            placed = pose[:, i] @ np.linalg.inv(basis[:, i]) @ local
+            out[:, i] = out[:, parent] @ np.linalg.inv(pose[:, parent]) @ placed if follows else placed
+            moved[i] = True
+        return out
 
     def pose_matrices(self, basis, only):
         """(..., B, 4, 4) armature-space pose matrices from (..., B, 4, 4) basis matrices.

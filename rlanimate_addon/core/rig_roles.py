@@ -43,10 +43,11 @@ MIXAMO = _family(
 
 _RIGIFY_FINGERS = _fingers("{finger}.0{k}{{s}}", {f: ("thumb" if f == "Thumb" else "f_" + f.lower()) for f in _FINGERS})
 
+#: Rigify's spine FK controls below its torso pivot (spine_fk, spine_fk.001) turn the hips, not the
+#: chest: the gesture's spine goes on the two above it (Spine2 folds into Spine1).
 RIGIFY = _family(
     "Rigify", (".L", ".R"),
-    {"Spine": ("spine_fk.001",), "Spine1": ("spine_fk.002",), "Spine2": ("spine_fk.003",),
-     "Neck": ("neck",), "Head": ("head",)},
+    {"Spine": ("spine_fk.002",), "Spine1": ("spine_fk.003",), "Neck": ("neck",), "Head": ("head",)},
     {"LeftShoulder": ("shoulder{s}",), "LeftArm": ("upper_arm_fk{s}",), "LeftForeArm": ("forearm_fk{s}",),
      "LeftHand": ("hand_fk{s}",)},
     _RIGIFY_FINGERS)

@@ -1,5 +1,6 @@
-"""Rig variants built from the sample character, as animators' characters come: each built once and saved
-as a .blend that a test appends into its own fresh scene.
+"""Rig variants built from the sample character, as animators' characters come, and Blender's own human
+metarig and a Rigify rig generated from it: each built once and saved as a .blend that a test appends
+into its own fresh scene.
 
 Each builder gets the sample character (armature and mesh) in an empty scene and returns the armature
 to save; `tmp` is a folder for the files an export and re-import go through.
@@ -158,10 +159,33 @@ def _quat(rotvec):
     return tuple(rotvec_to_quat(np.asarray(rotvec, dtype=np.float64)))
 
 
+def _blender_metarig():
+    import addon_utils
+
+    addon_utils.enable("rigify", default_set=True)
+    bpy.ops.object.armature_human_metarig_add()
+    return bpy.context.active_object
+
+
+def blender_human_metarig(rig, tmp):
+    """Blender's own human metarig (Add > Armature > Human (Meta-Rig)), not built from the sample."""
+    return _blender_metarig()
+
+
+def rigify_generated(rig, tmp):
+    """A real Rigify rig generated from Blender's human metarig, its arms switched to FK."""
+    _blender_metarig()
+    bpy.ops.pose.rigify_generate()
+    generated = bpy.context.active_object
+    for side in ("L", "R"):
+        generated.pose.bones["upper_arm_parent." + side]["IK_FK"] = 1.0
+    return generated
+
+
 BUILDERS = {f.__name__: f for f in (
     no_eyes_no_index4, numbered_prefix, glued_prefix, centimetre_fbx_automatic_orientation,
     centimetre_fbx_plain_orientation, gltf_blender_bones, gltf_temperance_bones, gltf_fortune_bones, euler_bones,
-    rigify_named, unreal_named, rotated_and_parented, idle_animation)}
+    rigify_named, unreal_named, rotated_and_parented, idle_animation, blender_human_metarig, rigify_generated)}
 
 
 def build(name, folder):
@@ -171,6 +195,7 @@ def build(name, folder):
     rig.name = "Variant"
     path = folder / f"{name}.blend"
     keep = {rig} | {o for o in bpy.data.objects if o.parent is rig} | ({rig.parent} if rig.parent else set())
+    keep |= {o for o in bpy.data.objects if o.name.startswith("WGT")}  # Rigify's control shapes
     bpy.data.libraries.write(str(path), keep, fake_user=True)
     helpers.disable_addon()
     return path

@@ -121,11 +121,12 @@ def _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=12
 
 
 def _lateral_wrist(rig, frames):
-    """(F,) the waving wrist's side-to-side position relative to its shoulder, in shoulder-to-head lengths."""
+    """(F,) the waving wrist's side-to-side position relative to its shoulder, in arm lengths (shoulder to
+    elbow to wrist at rest)."""
     roles = _roles(rig)
     heads = {r: np.array(rig.data.bones[b].head_local) for r, b in roles.items()}
     frame = gesture.character_frame(heads)
-    size = np.linalg.norm(heads["Head"] - heads["RightArm"])
+    size = np.linalg.norm(heads["RightForeArm"] - heads["RightArm"]) + np.linalg.norm(heads["RightHand"] - heads["RightForeArm"])
     out = []
     for f in frames:
         bpy.context.scene.frame_set(int(f))
@@ -179,3 +180,11 @@ def test_waves_keep_their_strokes_and_change_nothing_they_do_not_own(settings, v
     assert 0.8 < np.ptp(lateral[middle]) / np.ptp(sample_wave[middle]) < 1.25
     owned = {(b, 20) for b in _gesture_bones(_newest_gesture(), rig)}
     _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=150)
+
+
+def test_a_rigify_arm_in_ik_is_refused_by_name(settings, variant_files):
+    rig = rig_variants.load(variant_files["rigify_generated"])
+    rig.pose.bones["upper_arm_parent.R"]["IK_FK"] = 0.0
+    with pytest.raises(RuntimeError, match=r"right arm of 'Variant' follows its IK controls.*IK-FK slider to 1.0"):
+        helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT") == {"FINISHED"}

@@ -126,8 +126,7 @@ def _animated(rig, frames, scale=0.3):
     """The rig with a random pose underneath at every frame (as its own animation would play)."""
     under = np.tile(np.eye(4), (frames, len(skeleton.BONES), 1, 1))
     under[..., :3, :3] = rotvec_to_matrix(RNG.normal(scale=scale, size=(frames, len(skeleton.BONES), 3)))
-    rig.under, rig.animated = under, True
-    return rig
+    return gesture.RigState(rig.name, rig.skeleton, rig.roles, rig.family, under, animated=True)
 
 
 def test_pointing_adds_the_hand_shape_and_the_gesture_blends_from_and_to_the_pose_underneath():

@@ -38,7 +38,7 @@ def test_each_family_is_detected_from_its_own_names_with_every_gesture_role(fami
 
 def test_rigify_keys_the_fk_controls():
     _, roles = rig_roles.detect(_family_names(rig_roles.RIGIFY))
-    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == ("upper_arm_fk.L", "forearm_fk.R", "spine_fk.001")
+    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == ("upper_arm_fk.L", "forearm_fk.R", "spine_fk.002")
 
 
 def test_unreal_5_spine_keys_its_top_spine_bone():
