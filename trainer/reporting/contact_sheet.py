@@ -118,14 +118,8 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
                 ax.set_title(f"{frame / clip.fps:.2f}s" + (f"  {view}" if col == 0 else ""), fontsize=7, pad=2)
         axes[2 * row, 0].set_ylabel(f"{title}\n{planned.spec.arm.lower()} arm", fontsize=8)
         axes[2 * row + 1, 0].set_ylabel(label, fontsize=6)
-    fig.suptitle("RLAnimate sample clips: key frames (front / side; grey = index-base path, "
-                 "green dots = finger line)", fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 0.98))
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out)
-    plt.close(fig)
-    return out
+    return _save(fig, "RLAnimate sample clips: key frames (front / side; grey = index-base path, "
+                      "green dots = finger line)", 0.98, out)
 
 
 def generated_sheet(rows, out, title, fps=30):
@@ -140,8 +134,13 @@ def generated_sheet(rows, out, title, fps=30):
             ax.set_xticks([])
             ax.set_yticks([])
         row_axes[0].set_ylabel(row_title, fontsize=7)
+    return _save(fig, title, 0.97, out)
+
+
+def _save(fig, title, top, out):
+    """Title the sheet, leave `top` of the height to the plots, write it to `out` (a PNG) and return the path."""
     fig.suptitle(title, fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    fig.tight_layout(rect=(0, 0, 1, top))
     out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(out)
