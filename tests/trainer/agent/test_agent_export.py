@@ -1,7 +1,5 @@
 """Exporting an agent: one atomic, data-only .npz whose weights and metadata load back unchanged."""
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
@@ -12,7 +10,7 @@ from rlanimate_addon.core.agent_file import load_agent_file
 from trainer.agent.agent_export import export_agent
 from trainer.agent.config import load_preset
 from trainer.agent.models import VARIANTS, RLAnimateAgent
-from trainer.paths import INSTALLED_AGENT, REPO_ROOT
+from trainer.paths import INSTALLED_AGENT
 
 torch.set_num_threads(1)
 
@@ -64,16 +62,6 @@ def test_export_replaces_atomically_and_leaves_no_temporary_file(tmp_path):
     export_agent(RLAnimateAgent(load_preset("debug")[0], "single_dynamics"), path)
     assert load_agent_file(path)[1]["variant"] == "single_dynamics"
     assert [p.name for p in path.parent.iterdir()] == ["agent.npz"]
-
-
-def test_command_line_writes_an_untrained_default_agent_under_two_megabytes(tmp_path):
-    path = tmp_path / "default.npz"
-    subprocess.run([sys.executable, "-m", "trainer.scripts.export_untrained_agent", str(path)], check=True,
-                   capture_output=True, timeout=120, cwd=REPO_ROOT)
-    weights, metadata = load_agent_file(path)
-    assert path.stat().st_size < 2_000_000
-    assert metadata["agent_config"] == load_preset("default")[0].to_dict()
-    assert metadata["training"]["untrained"] is True
 
 
 def test_the_shipped_default_agent_loads():
