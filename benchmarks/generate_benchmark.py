@@ -66,7 +66,8 @@ def time_generate(rig, behaviour):
 def numpy_part(rig):
     """A callable timing the bpy-free part alone: objectives, agent rollout, aim, retarget and blend."""
     agent = preferences.selected_agent(bpy.context)
-    rig_pose = armature_io.read_rig_pose(rig, armature_io.check_rig(rig))
+    family, roles = armature_io.rig_roles_of(rig)
+    rig_pose = armature_io.sample_rig(bpy.context, rig, roles, family, np.arange(1, FRAMES + 1))[0]
     request = gesture.GestureRequest("POINT", "RIGHT", FRAMES, targets=np.tile([-1.2, -2.5, 1.7], (FRAMES, 1)))
 
     def timed():

@@ -335,7 +335,8 @@ def aim_rig(rig, basis, changed, arm, targets, weights):
     """
     arm_bone = rig.roles[skeleton.ARM_PREFIX[arm] + "Arm"]
     start, end = finger_line_bones(rig.roles, arm)
-    pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed)
+    pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed,
+                                   only=(end, arm_bone))
     i = rig.skeleton.index[arm_bone]
     base = pose[:, rig.skeleton.index[start], :3, 3]
     finger = rig.skeleton.tails(pose, end) - base

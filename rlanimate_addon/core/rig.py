@@ -9,6 +9,19 @@ a bone whose basis changes, or whose parent moves, moves rigidly with them.
 import numpy as np
 
 
+def inverse(matrices):
+    """Inverses of (..., 4, 4) affine matrices: by transposition where the 3x3 part is a rotation
+    (bones' pose matrices, unless scaled), else by np.linalg.inv."""
+    rotation = matrices[..., :3, :3]
+    if not np.allclose(np.swapaxes(rotation, -1, -2) @ rotation, np.eye(3), atol=1e-6):
+        return np.linalg.inv(matrices)
+    out = np.zeros_like(matrices)
+    out[..., :3, :3] = np.swapaxes(rotation, -1, -2)
+    out[..., :3, 3] = -np.einsum("...ji,...j->...i", rotation, matrices[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
 class RigSkeleton:
     """Bone names, parent names (None for a root), (B, 4, 4) rest matrices and (B,) rest lengths."""
 
@@ -43,25 +56,27 @@ class RigSkeleton:
             i = self.parents[i]
         return chain[::-1]
 
-    def pose_after(self, pose, basis, new_basis, changed):
+    def pose_after(self, pose, basis, new_basis, changed, only):
         """(N, B, 4, 4) pose matrices once the bones at indices `changed` take `new_basis`.
 
         pose, basis: (N, B, 4, 4) the evaluated pose and basis matrices underneath; new_basis: (N, B, 4, 4)
         (only the changed bones' are read). A changed bone, or one below a changed bone, keeps where it
         sits relative to its parent and plays its new basis:
         pose' = parent_pose' @ parent_pose^-1 @ pose @ basis^-1 @ basis'.
+        Only the bones named in `only` and their ancestors are updated; the others keep `pose`.
         """
         changed = set(changed)
         out = np.array(pose, dtype=np.float64)
         moved = np.zeros(len(self.names), dtype=bool)
-        for i in sorted(range(len(self.names)), key=lambda i: len(self.ancestors(self.names[i]))):
+        for i in sorted({i for name in only for i in self.ancestors(name)},
+                        key=lambda i: len(self.ancestors(self.names[i]))):
             parent = self.parents[i]
             follows = parent >= 0 and moved[parent]
             if i not in changed and not follows:
                 continue
             local = basis[:, i] if i not in changed else new_basis[:, i]
-            placed = pose[:, i] @ np.linalg.inv(basis[:, i]) @ local
-            out[:, i] = out[:, parent] @ np.linalg.inv(pose[:, parent]) @ placed if follows else placed
+            placed = pose[:, i] @ inverse(basis[:, i]) @ local
+            out[:, i] = out[:, parent] @ inverse(pose[:, parent]) @ placed if follows else placed
             moved[i] = True
         return out
 
