@@ -349,6 +349,36 @@ def aim_rig(rig, basis, changed, arm, targets, weights):
     return aimed
 
 
+def _rotation_part(matrices):
+    """(..., 3, 3) rotations of (..., 4, 4) matrices, scale removed."""
+    rotation = matrices[..., :3, :3]
+    return rotation / np.linalg.norm(rotation, axis=-2, keepdims=True)
+
+
+def look_at(rig, basis, changed, eye_bones, to_character, targets, weights):
+    """(N, E, 4) local quaternions turning each eye so it looks at targets (N, 3) by `weights` (N,).
+
+    An eye looks along the character's forward at rest, whatever its bone's axes; it is turned from
+    where the pose carries that direction (the head's gesture over the pose underneath) onto the target.
+    basis: (N, B, 4, 4) the bones' basis as they will play, the gesture's on the bones at `changed`.
+    """
+    pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed,
+                                   only=eye_bones)
+    forward = to_character.T @ np.array([0.0, -1.0, 0.0])  # armature space
+    out = []
+    for bone in eye_bones:
+        i = rig.skeleton.index[bone]
+        world = _rotation_part(pose[:, i])  # (N, 3, 3)
+        looking = world @ (rig.skeleton.rest_frame(bone).T @ forward)  # (N, 3)
+        wanted = targets - pose[:, i, :3, 3]
+        turn = aim.rotation_between(looking / np.linalg.norm(looking, axis=1, keepdims=True),
+                                    wanted / np.linalg.norm(wanted, axis=1, keepdims=True))
+        turn = rotvec_to_matrix(matrix_to_rotvec(turn) * np.asarray(weights)[:, None])
+        local = _rotation_part(basis[:, i]) @ np.swapaxes(world, -1, -2) @ turn @ world
+        out.append(matrix_to_quat(local))
+    return np.stack(out, axis=1)
+
+
 def gesture_rotations(agent, request, rig):
     """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
 
@@ -370,7 +400,7 @@ def gesture_rotations(agent, request, rig):
         names += [hand_names[i] for i in present]
         canonical = np.concatenate([canonical, hand[:, present]], axis=1)
     bones = [rig.roles[n] for n in names]
-    columns = [rig.skeleton.index[b] for b in bones]
+    columns = [rig.skeleton.index[b] for b in bones]  # the eyes, keyed for Point, come after these
     to_character = character_frame(rest_heads)
     swings = rest_swings(rig.roles, rest_heads, to_character)
     frames = [rig.skeleton.rest_frame(b) for b in bones]
@@ -388,15 +418,25 @@ def gesture_rotations(agent, request, rig):
         start = np.where(at_rest[..., None], standing, under)
     keyed = blend_from_pose(start, retarget(canonical, conversions, parent_conversions),
                             blend_weights(request.frame_count))
-    if request.behaviour == "POINT" and request.exact_aim:
-        basis = under_basis
+    if request.behaviour == "POINT":
+        phase = aim.pointing_phase(phase_base)
+        targets = np.broadcast_to(request.targets, (request.frame_count, 3))
+        basis = under_basis.copy()
         basis[:, columns, :3, :3] = quat_to_matrix(keyed) * np.linalg.norm(basis[:, columns, :3, :3], axis=-2,
                                                                           keepdims=True)
-        arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
-        aimed = aim_rig(rig, basis, columns, request.arm, np.broadcast_to(request.targets, (request.frame_count, 3)),
-                        aim.pointing_phase(phase_base))
-        keyed[:, arm_column] = matrix_to_quat(aimed[:, :3, :3] / np.linalg.norm(aimed[:, :3, :3], axis=-2,
-                                                                                  keepdims=True))
+        if request.exact_aim:
+            arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
+            aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
+            keyed[:, arm_column] = matrix_to_quat(_rotation_part(aimed))
+            basis[:, columns[arm_column]] = aimed
+        eyes = [role for role in ("LeftEye", "RightEye") if role in rig.roles]
+        if eyes:
+            eye_bones = [rig.roles[e] for e in eyes]
+            looking = look_at(rig, basis, columns, eye_bones, to_character, targets, phase)  # (N, E, 4)
+            bones += eye_bones
+            keyed = np.concatenate([keyed, looking], axis=1)
+            under = np.concatenate([under, matrix_to_quat(
+                under_basis[:, [rig.skeleton.index[b] for b in eye_bones], :3, :3])], axis=1)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
     broken = [bone for bone, ok in zip(bones, finite) if not ok]

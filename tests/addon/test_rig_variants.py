@@ -45,6 +45,27 @@ def finger_angle(rig, arm, target, frames):
     return np.array(angles), np.array(bases)
 
 
+def _eye_misses(rig, target, frame):
+    """Degrees by which each eye the rig has looks off the target at the frame; an eye looks along the
+    character's forward at rest."""
+    roles = _roles(rig)
+    heads = {r: np.array(rig.data.bones[b].head_local) for r, b in roles.items()}
+    forward = gesture.character_frame(heads).T @ np.array([0.0, -1.0, 0.0])
+    bpy.context.scene.frame_set(frame)
+    out = []
+    for eye in ("LeftEye", "RightEye"):
+        if eye not in roles:
+            continue
+        bone = rig.pose.bones[roles[eye]]
+        posed = np.array(bone.matrix.to_3x3().normalized()) @ np.array(
+            bone.bone.matrix_local.to_3x3().normalized()).T @ forward
+        world = np.array(rig.matrix_world.to_3x3()) @ posed
+        to_target = np.asarray(target) - _world(rig, bone.head)[:3]
+        cos = world @ to_target / np.linalg.norm(world) / np.linalg.norm(to_target)
+        out.append(float(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))))
+    return out
+
+
 def _sample_world_target(rig, arm):
     """A random unseen target, placed relative to the rig as random_target places it relative to the
     canonical character (the rig's own world transform and size applied)."""
@@ -86,7 +107,7 @@ def test_point_with_exact_aim_hits_and_changes_nothing_it_does_not_own(settings,
     rig = rig_variants.load(variant_files[variant])
     frames = np.arange(1, 640, 7)
     before, keys_before = _pose_snapshot(rig, frames), _all_keys()
-    owned, misses = set(), []
+    owned, misses, gaze = set(), [], []
     for k, start in enumerate(POINT_STARTS):
         arm = ("RIGHT", "LEFT")[k % 2]
         location = _sample_world_target(rig, arm)
@@ -94,9 +115,12 @@ def test_point_with_exact_aim_hits_and_changes_nothing_it_does_not_own(settings,
         assert helpers.generate(rig, settings, behaviour="POINT", arm=arm, target=target, start_frame=start,
                                 frame_count=120, exact_aim=True) == {"FINISHED"}, variant
         angles, bases = finger_angle(rig, arm, location, np.arange(start, start + 120))
-        misses.append(angles[int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))])
+        apex = int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))
+        misses.append(angles[apex])
+        gaze.extend(_eye_misses(rig, location, start + apex))
         owned |= {(b, start) for b in _gesture_bones(_newest_gesture(), rig)}
-    print(f"{variant}: apex misses {np.round(misses, 2)} deg")
+    print(f"{variant}: apex misses {np.round(misses, 2)} deg, eyes {np.round(gaze, 2)} deg")
+    assert all(g < 0.5 for g in gaze), f"{variant}: the eyes look {gaze} deg off the target at the apex"
     assert np.median(misses) <= MEDIAN_DEG and max(misses) <= WORST_DEG, f"{variant}: misses {misses}"
     _assert_unowned_unchanged(rig, before, keys_before, frames, owned)
 

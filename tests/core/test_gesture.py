@@ -136,7 +136,7 @@ def test_pointing_adds_the_hand_shape_and_the_gesture_blends_from_and_to_the_pos
     names, quats, under = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
     assert names[:15] == skeleton.ACTION_JOINTS
     assert {"RightHandMiddle2", "RightHandPinky1", "RightHandThumb1"} <= set(names[15:])
-    assert not any(n.startswith("Left") for n in names[15:])
+    assert not any(n.startswith("Left") for n in names[15:-2]) and names[-2:] == ("LeftEye", "RightEye")
     columns = [skeleton.BONE_NAMES.index(n) for n in names]
     expected = matrix_to_quat(rig.under[:, columns, :3, :3])
     assert np.allclose(np.abs(np.sum(under * expected, axis=-1)), 1.0)
@@ -180,6 +180,28 @@ def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underne
     angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
     phase = aim.pointing_phase(aim.finger_lines(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm)[1])
     assert angles[phase == 1.0].max() < 0.01, "at full weight the finger line must pass through the target"
+
+
+@pytest.mark.parametrize("animated", [False, True])
+def test_the_eyes_look_at_the_target_while_pointing(animated):
+    frames = 60
+    agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(frames, spaces.ACTION_SIZE)))
+    rig = _animated(gesture.canonical_rig(), frames, scale=0.1) if animated else gesture.canonical_rig()
+    target = np.array([-1.5, -2.5, 0.8])
+    names, quats, _ = gesture.gesture_rotations(agent, _request("POINT", "RIGHT", frames,
+                                                                targets=np.tile(target, (frames, 1))), rig)
+    basis = rig.under_at(frames).copy()
+    basis[:, [rig.skeleton.index[n] for n in names], :3, :3] = quat_to_matrix(quats)
+    pose = rig.skeleton.pose_matrices(basis, only=("LeftEye", "RightEye"))
+    phase = aim.pointing_phase(aim.finger_lines(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT")[1])
+    for eye in ("LeftEye", "RightEye"):
+        i = rig.skeleton.index[eye]
+        looking = pose[:, i, :3, :3] @ (skeleton.rest_frame(skeleton.BONE_BY_NAME[eye]).T @ [0.0, -1.0, 0.0])
+        wanted = target - pose[:, i, :3, 3]
+        cos = np.sum(looking * wanted, axis=1) / np.linalg.norm(wanted, axis=1)
+        angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
+        assert angles[phase == 1.0].max() < 0.01, f"{eye} must look at the target at full weight"
+        assert angles[0] > 5.0, "and only then: at the start it looks ahead"
 
 
 def test_a_missing_spine_bone_is_folded_into_the_one_below_and_the_neck_turns_the_same():
