@@ -182,10 +182,12 @@ def retarget(canonical_rotvecs, conversions, parent_conversions=None):
 
 
 #: Role whose rest head a bone's rest direction points to, for the bones whose rest pose differs
-#: between T- and A-pose rigs (the spine, neck and head rest upright in both).
+#: between rigs (T- or A-pose arms, relaxed or straight fingers); the spine, neck and head rest upright.
 _DIRECTION_TO = {f"{side}{bone}": f"{side}{child}" for side in ("Left", "Right")
                  for bone, child in (("Shoulder", "Arm"), ("Arm", "ForeArm"), ("ForeArm", "Hand"),
-                                     ("Hand", "HandMiddle1"))}
+                                     ("Hand", "HandMiddle1"))
+                 + tuple((f"Hand{finger}{k}", f"Hand{finger}{k + 1}")
+                         for finger in ("Thumb", "Index", "Middle", "Ring", "Pinky") for k in (1, 2))}
 
 
 def rest_swings(roles, rest_heads, to_character):
@@ -194,7 +196,8 @@ def rest_swings(roles, rest_heads, to_character):
     the fingers) take their parent's (identity at the root).
 
     With it an A-pose rig plays the canonical rotations as a T-pose rig does: the arms hang, raise
-    and wave where the canonical skeleton's do, not 45 degrees lower.
+    and wave where the canonical skeleton's do, not 45 degrees lower, and a rig whose fingers rest
+    curled points with a straight index finger.
     """
     swings = {}
     for name in [n for n in skeleton.BONE_NAMES if n in roles]:  # parents first
