@@ -77,6 +77,9 @@ class RecordingLayout:
     def prop(self, data, name, **kwargs):
         self.calls.append(("prop", data, name, kwargs))
 
+    def prop_search(self, data, name, search_data, search_name, **kwargs):
+        self.calls.append(("prop_search", data, name, search_data, search_name, kwargs))
+
     def operator(self, idname, **kwargs):
         self.calls.append(("operator", idname, kwargs))
         return kwargs.setdefault("properties", types.SimpleNamespace())
@@ -121,6 +124,18 @@ def test_panel_draw_uses_only_existing_properties_operators_and_icons(settings, 
     assert operators == ["rlanimate.save_bone_map", "rlanimate.generate_gesture", "rlanimate.export_fbx"]
     labels = " ".join(c[1].get("text", "") for c in calls if c[0] == "label")
     assert "supported" in labels, "the panel must show the supported length range"
+
+
+def test_panel_offers_the_bones_of_an_armature_target(settings):
+    settings.behaviour = "POINT"
+    settings.target = addon_helpers.build_rig("Other")
+    searches = [c for c in _draw(settings) if c[0] == "prop_search"]
+    assert len(searches) == 1
+    _, data, name, search_data, search_name, _ = searches[0]
+    assert name in data.bl_rna.properties and search_name in search_data.bl_rna.properties
+    assert (name, search_data, search_name) == ("target_bone", settings.target.data, "bones")
+    settings.target = addon_helpers.add_empty("Empty", (0.0, -2.0, 1.0))
+    assert not [c for c in _draw(settings) if c[0] == "prop_search"], "an object target has no bones to pick"
 
 
 def test_panel_names_a_damaged_agent_file_instead_of_failing(settings, tmp_path):
