@@ -80,6 +80,9 @@ def _check(obj, settings, start, end, mute_constraints):
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
     check_fk_arm(obj, family, settings.arm)
     check_keepable(obj)
+    # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
+    roles = {role: bone for role, bone in roles.items()
+             if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
     overriding = constraints.overriding(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm))
     constraints.check(obj, overriding, start, end, mute_constraints)
     return _Plan(obj, family, roles, overriding)

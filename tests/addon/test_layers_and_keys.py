@@ -123,3 +123,20 @@ def test_every_selected_armature_points_at_the_shared_target_or_none_is_touched(
     for rig in (first, second):
         angles, bases = finger_angles(rig, "LEFT", location, np.arange(1, 101))
         assert angles[int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))] < 0.05, rig.name
+
+
+def test_eyes_aimed_by_their_own_constraints_are_left_to_them(settings):
+    rig = helpers.load_sample_rig()
+    left, right = helpers.rig_bone(rig, "LeftEye"), helpers.rig_bone(rig, "RightEye")
+    track = rig.pose.bones[left].constraints.new("DAMPED_TRACK")
+    track.target = helpers.add_empty("EyeTarget", (0.0, -3.0, 1.6))
+    target = helpers.add_empty("Target", (-1.0, -2.5, 1.7))
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target) == {"FINISHED"}
+    keyed = _gesture_bones_of(rig.animation_data.action)
+    assert right in keyed and left not in keyed
+
+
+def _gesture_bones_of(action):
+    from test_rig_variants import _gesture_bones
+
+    return _gesture_bones(action, None)
