@@ -1,6 +1,7 @@
 """trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its
 outputs exist and load without torch."""
 import json
+import shutil
 import subprocess
 import sys
 
@@ -9,21 +10,22 @@ import pytest
 
 from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
-from trainer.blender_io.clip_bake import build_library
 from trainer.blender_io.clip_import import load_clip_set
-from trainer.motion.library_plan import plan_library
-from trainer.paths import REPO_ROOT
+from trainer.paths import CLIP_DIR, DEFAULT_MANIFEST, REPO_ROOT
 from trainer.scripts import cli, train
 
 
 @pytest.fixture(scope="module")
 def tiny_library(tmp_path_factory):
-    """Two training and one held-out clip per behaviour, from the sample library's plan, as FBX + manifest."""
+    """Two training and one held-out clip per behaviour of the sample library: its FBX files and their
+    manifest entries, in a folder of their own (so they are imported afresh)."""
     folder = tmp_path_factory.mktemp("clips")
-    planned = plan_library()
-    chosen = [p.file for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
-              for p in [q for q in planned if q.spec.behaviour == behaviour and q.split == split][:count]]
-    build_library(folder, only=chosen, log=lambda line: None)
+    entries = json.loads(DEFAULT_MANIFEST.read_text())["clips"]
+    chosen = [e for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
+              for e in [f for f in entries if f["behaviour"] == behaviour and f["split"] == split][:count]]
+    for entry in chosen:
+        shutil.copyfile(CLIP_DIR / entry["file"], folder / entry["file"])
+    (folder / "manifest.json").write_text(json.dumps({"fps": 30, "clips": chosen}))
     return folder / "manifest.json"
 
 
