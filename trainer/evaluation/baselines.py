@@ -115,7 +115,7 @@ class ClassMean:
 
 class TrainedAgentMethod:
     """A torch RLAnimate agent behind the baselines' generate() interface: the deterministic rollout
-    that trainer.evaluate scores, decoded to rotations with the trainer's bounds."""
+    that trainer.evaluation.scoring scores, decoded to rotations with the trainer's bounds."""
 
     def __init__(self, trainer, path):
         self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)

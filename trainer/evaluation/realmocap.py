@@ -61,7 +61,7 @@ def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_c
 
 
 class RealSession:
-    """What train.run needs (env, references, train_clips, test_clips, problems), over real clips (every one
+    """What trainer.agent.run.train needs (env, references, train_clips, test_clips, problems), over real clips (every one
     imported: a take that does not import stops the experiment)."""
 
     def __init__(self, env, references, train_clips, test_clips):
