@@ -4,13 +4,13 @@ from bpy_extras.io_utils import ExportHelper
 
 from ..core import rig_roles
 from ..core.errors import RLAnimateError
-from . import armature_io
+from . import armature_io, properties
 
 
 def save_bone_map(context, filepath):
     """Write the bone map of the active armature to filepath; returns a one-line summary."""
     obj = context.active_object
-    family, roles = armature_io.rig_roles_of(obj, context.scene.rlanimate.bone_map_file)
+    family, roles = armature_io.rig_roles_of(obj, properties.panel_settings(context).bone_map_file)
     path = bpy.path.abspath(filepath)
     try:
         with open(path, "w", encoding="utf-8") as handle:

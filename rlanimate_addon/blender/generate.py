@@ -4,7 +4,7 @@ import numpy as np
 
 from ..core import channels, gesture, key_reduction, rig_roles
 from ..core.errors import RLAnimateError
-from . import action_adapter, armature_io, constraints, preferences
+from . import armature_io, constraints, preferences, properties
 
 
 def _check_target(settings):
@@ -60,7 +60,7 @@ class _Plan:
 
     def __init__(self, obj, family, roles, overriding):
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
-        self.rig = self.bones = self.keys = self.blend_type = None
+        self.rig = self.bones = self.keys = self.blend_type = self.settings = None
         self.worst = 0.0
 
 
@@ -119,47 +119,58 @@ def _compute(context, plan, settings, agent, frames):
 
 
 def generate(context, settings, progress=lambda step: None, mute_constraints=False):
-    """Bake the gesture the settings describe onto the active armature and every other selected one
-    (one shared target); returns a summary, one line per armature.
+    """Bake a gesture onto the active armature and every other selected one; returns a summary, one line
+    per armature. Each armature uses its own settings where it has them switched on (Object.rlanimate),
+    else the shared `settings` (one target for all).
 
     Every check, for every armature, runs before the first write, so an RLAnimateError leaves the file
     as it was (the scene frame included). Constraints that would override the gesture are refused, or
     muted over its frames with mute_constraints (blender/constraints.py).
     """
-    frame_count, start = int(settings.frame_count), int(settings.start_frame)
-    end = start + frame_count - 1
-    plans = [_check(obj, settings, start, end, mute_constraints) for obj in selected_armatures(context, settings)]
+    plans = []
+    for obj in selected_armatures(context, settings):
+        own = properties.settings_for(obj, settings)
+        start = int(own.start_frame)
+        plan = _check(obj, own, start, start + int(own.frame_count) - 1, mute_constraints)
+        plan.settings = own
+        plans.append(plan)
     agent = preferences.selected_agent(context)
-    gesture.check_length(frame_count)
-    check_frames(start, frame_count)
-    _check_target(settings)
-    progress(1)
-    frames = start + np.arange(frame_count)
     for plan in plans:
-        _compute(context, plan, settings, agent, frames)
+        gesture.check_length(int(plan.settings.frame_count))
+        check_frames(int(plan.settings.start_frame), int(plan.settings.frame_count))
+        _check_target(plan.settings)
+    progress(1)
+    for plan in plans:
+        start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
+        _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
+    lines = [_write(plan, agent) for plan in plans]
+    progress(4)
+    return "\n".join(lines)
 
+
+def _write(plan, agent):
+    """Write one armature's planned gesture; returns its summary line."""
+    settings = plan.settings
+    start, count = int(settings.start_frame), int(settings.frame_count)
+    end = start + count - 1
     label = f"{settings.behaviour.title()} {settings.arm.title()}"
     note = ""
     shortest, longest = gesture.supported_length_range(agent.average_frames[settings.behaviour])
-    if not shortest <= frame_count <= longest:
+    if not shortest <= count <= longest:
         note += f" (time-scaled: the agent's range is {shortest}-{longest} frames)"
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
-    lines = []
-    for plan in plans:
-        action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type)
-        constraints.mute(plan.obj, plan.overriding, start, end)
-        muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
-        layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
-        editable = ""
-        if settings.editable_keys:
-            count = sum(len(kept) * values.shape[1] for _, values, kept in plan.keys.values())
-            editable = f"; editable: {count} Bezier keys, worst deviation {plan.worst:.2f} deg"
-        lines.append(f"Baked {label} on {plan.obj.name!r} ({plan.family} bones): {len(plan.bones)} bones, frames "
-                     f"{start}-{end}, action {action.name!r}{layer}{muted}{note}{editable}")
-    progress(4)
-    return "\n".join(lines)
+    action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type)
+    constraints.mute(plan.obj, plan.overriding, start, end)
+    muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
+    layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
+    editable = ""
+    if settings.editable_keys:
+        keys = sum(len(kept) * values.shape[1] for _, values, kept in plan.keys.values())
+        editable = f"; editable: {keys} Bezier keys, worst deviation {plan.worst:.2f} deg"
+    return (f"Baked {label} on {plan.obj.name!r} ({plan.family} bones): {len(plan.bones)} bones, frames "
+            f"{start}-{end}, action {action.name!r}{layer}{muted}{note}{editable}")
 
 
 class RLANIMATE_OT_generate_gesture(bpy.types.Operator):

@@ -5,7 +5,7 @@ import bpy
 
 from ..core import gesture
 from ..core.errors import RLAnimateError
-from . import armature_io, constraints, preferences
+from . import armature_io, constraints, preferences, properties
 
 
 def _agent_summary(context, behaviour):
@@ -58,7 +58,10 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
 
     def draw(self, context):
         layout = self.layout
-        settings = context.scene.rlanimate
+        settings = properties.panel_settings(context)
+        obj = context.active_object
+        if obj is not None and obj.type == "ARMATURE":
+            layout.prop(obj.rlanimate, "use_own_settings", text=f"Own Settings for {obj.name}")
         layout.prop(settings, "behaviour", expand=True)
         layout.prop(settings, "arm", expand=True)
         if settings.behaviour == "POINT":

@@ -68,3 +68,25 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     seed: bpy.props.IntProperty(
         name="Variation Seed", min=0, default=0,
         description="0 gives the agent's most likely gesture; other values give variations")
+
+
+class RLANIMATE_PG_object(bpy.types.PropertyGroup):
+    """`Object.rlanimate`: an armature's own gesture settings, used instead of the scene's when switched on
+    (so several selected characters can each get their own gesture in one Generate)."""
+    use_own_settings: bpy.props.BoolProperty(
+        name="Own Settings", default=False,
+        description="Generate this armature's gesture from its own settings instead of the scene's")
+    settings: bpy.props.PointerProperty(type=RLANIMATE_PG_settings)
+
+
+def settings_for(obj, shared):
+    """The settings Generate uses for an armature: its own when switched on, else the shared scene's."""
+    own = obj.rlanimate
+    return own.settings if own.use_own_settings else shared
+
+
+def panel_settings(context):
+    """The settings the panel edits: the active armature's own when switched on, else the scene's."""
+    obj = context.active_object
+    shared = context.scene.rlanimate
+    return shared if obj is None or obj.type != "ARMATURE" else settings_for(obj, shared)

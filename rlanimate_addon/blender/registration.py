@@ -1,4 +1,4 @@
-"""Registration in one place: the ordered class list and the one Scene property namespace."""
+"""Registration in one place: the ordered class list and the property namespaces (Scene and Object)."""
 import bpy
 
 from . import bone_map, export, generate, panel, preferences, properties
@@ -7,6 +7,7 @@ from . import bone_map, export, generate, panel, preferences, properties
 CLASSES = (
     preferences.RLANIMATE_AP_preferences,
     properties.RLANIMATE_PG_settings,
+    properties.RLANIMATE_PG_object,
     generate.RLANIMATE_OT_generate_gesture,
     export.RLANIMATE_OT_export_fbx,
     bone_map.RLANIMATE_OT_save_bone_map,
@@ -18,9 +19,11 @@ def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Scene.rlanimate = bpy.props.PointerProperty(type=properties.RLANIMATE_PG_settings)
+    bpy.types.Object.rlanimate = bpy.props.PointerProperty(type=properties.RLANIMATE_PG_object)
 
 
 def unregister():
+    del bpy.types.Object.rlanimate
     del bpy.types.Scene.rlanimate
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

@@ -140,3 +140,29 @@ def _gesture_bones_of(action):
     from test_rig_variants import _gesture_bones
 
     return _gesture_bones(action, None)
+
+
+def test_an_armature_with_its_own_settings_gets_its_own_gesture_beside_the_shared_one(settings):
+    shared = helpers.load_sample_rig()
+    own = helpers.build_rig("Own", prefix="mixamorig1:")
+    own.location = (1.5, 0.0, 0.0)
+    location = random_target("RIGHT", np.random.default_rng(12))
+    for key, value in dict(behaviour="POINT", arm="RIGHT", target=helpers.add_empty("Target", location),
+                           start_frame=1, frame_count=100).items():
+        setattr(settings, key, value)
+    own.rlanimate.use_own_settings = True
+    for key, value in dict(behaviour="WAVE", arm="LEFT", exaggeration=0.9, start_frame=11, frame_count=90).items():
+        setattr(own.rlanimate.settings, key, value)
+    for obj in (shared, own):
+        obj.select_set(True)
+    helpers.activate(shared)
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
+    assert shared.animation_data.action.name.startswith("RLAnimate Point Right")
+    action = own.animation_data.action
+    assert action.name.startswith("RLAnimate Wave Left") and tuple(action.frame_range) == (11.0, 100.0)
+    angles, bases = finger_angles(shared, "RIGHT", location, np.arange(1, 101))
+    assert angles[int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))] < 0.05
+    helpers.activate(own)
+    from rlanimate_addon.blender import properties
+
+    assert properties.panel_settings(bpy.context) == own.rlanimate.settings, "the panel edits the armature's own"

@@ -39,7 +39,7 @@ def test_register_and_unregister_twice():
         for cls in registration.CLASSES:
             assert cls.is_registered
         rlanimate_addon.unregister()
-        assert not hasattr(bpy.types.Scene, "rlanimate")
+        assert not hasattr(bpy.types.Scene, "rlanimate") and not hasattr(bpy.types.Object, "rlanimate")
         assert not any(cls.is_registered for cls in registration.CLASSES)
 
 
