@@ -23,18 +23,20 @@ from pathlib import Path
 
 import numpy as np
 
-from . import spaces
+from . import rhythm, spaces
 from .errors import RLAnimateError
 
 FORMAT_NAME = "rlanimate-agent"
-FORMAT_VERSION = 1
+#: 2: waves' objectives carry their rhythm (core/rhythm.py) and the file its `wave_rhythm` model.
+FORMAT_VERSION = 2
 METADATA_KEY = "__metadata__"
 VARIANTS = ("rlanimate", "single_state", "single_dynamics", "supervised")
 #: a_0, the previous action of a sequence's first frame (the middle of every channel's range): part
 #: of the agent's definition, shared by the torch model and the numpy runtime.
 INITIAL_ACTION = 0.5
 #: Metadata fields every agent file has.
-REQUIRED_METADATA = ("format", "format_version", "variant", "agent_config", "action_bounds", "average_frames")
+REQUIRED_METADATA = ("format", "format_version", "variant", "agent_config", "action_bounds", "average_frames",
+                     "wave_rhythm")
 _AGENT_SIZES = ("task_size", "behaviour_size", "stochastic_size", "hidden_size", "portrayal_hidden_size",
                 "hidden_layers")
 _AGENT_SCALARS = ("min_std", "concentration_floor", "concentration_scale")
@@ -231,6 +233,10 @@ def _parse_metadata(path, entry):
         raise _damaged(path, error) from error
     if not isinstance(metadata, dict) or metadata.get("format") != FORMAT_NAME:
         raise _not_an_agent(path)
+    if metadata.get("format_version") == 1:
+        raise RLAnimateError(f"The agent file {path} is format version 1, from before waves carried their rhythm "
+                             f"in the objective; this add-on reads version {FORMAT_VERSION}: retrain the agent "
+                             f"with this version's trainer (python trainer/train.py).")
     if not _is_int(metadata.get("format_version")) or metadata["format_version"] != FORMAT_VERSION:
         raise RLAnimateError(f"The agent file {path} is format version {metadata.get('format_version')!r}, but "
                              f"this add-on reads version {FORMAT_VERSION}: update the add-on, or re-export "
@@ -283,6 +289,8 @@ def _check_metadata_values(path, metadata):
         raise RLAnimateError(f"The agent file {path} has invalid average_frames (need a length of 2 to "
                              f"{MAX_AVERAGE_FRAMES:,} frames for each behaviour it was trained for, among "
                              f"{', '.join(spaces.BEHAVIOURS)}): re-export it.")
+    if metadata["wave_rhythm"] is not None:
+        rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
     return {name: tuple(shape) for name, shape in expected.items()}
 
 

@@ -103,8 +103,9 @@ def pointing_directions(arm, targets, rest_heads):
     return (offsets / norms[:, None]) @ character_frame(rest_heads).T
 
 
-def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5):
-    """(N, 7) objectives for a gesture: POINT needs targets (N, 3) and rest_heads; WAVE an exaggeration."""
+def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5, rhythm=None):
+    """(N, 7) objectives for a gesture: POINT needs targets (N, 3) and rest_heads; WAVE an exaggeration
+    and, for an agent trained with them, rhythm signals (N, 2) (GestureAgent.wave_rhythm)."""
     check_length(frame_count)
     if behaviour == "POINT":
         if targets is None:
@@ -112,7 +113,7 @@ def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=No
         attributes = pointing_directions(arm, targets, rest_heads)
     else:
         attributes = exaggeration
-    return spaces.make_objective(behaviour, arm, attributes, frame_count)
+    return spaces.make_objective(behaviour, arm, attributes, frame_count, rhythm if behaviour == "WAVE" else None)
 
 
 def resample(values, count):
@@ -392,8 +393,11 @@ def gesture_rotations(agent, request, rig):
     """
     rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
     rest_heads = rig.rest_heads
+    check_length(request.frame_count)
+    rhythm = (agent.wave_rhythm(request.exaggeration, request.frame_count, request.seed)
+              if request.behaviour == "WAVE" else None)
     objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=request.targets,
-                                  rest_heads=rest_heads, exaggeration=request.exaggeration)
+                                  rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
     phase_base = aim.finger_lines(canonical, request.arm)[1] if request.behaviour == "POINT" else None
     names, canonical = fold_spine(canonical, list(skeleton.ACTION_JOINTS), rig.roles)

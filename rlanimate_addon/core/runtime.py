@@ -15,7 +15,7 @@ the rollout runs on one BLAS thread (core/blas_threads.py).
 """
 import numpy as np
 
-from . import agent_file, blas_threads, spaces
+from . import agent_file, blas_threads, rhythm, spaces
 from .errors import RLAnimateError
 
 
@@ -89,6 +89,9 @@ class GestureAgent:
         #: Average gesture length in frames per behaviour (the UI's default length); a behaviour the
         #: agent was not trained for gets the mean of the others, so the UI always has a default.
         self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values())))) for b in spaces.BEHAVIOURS}
+        rhythm_values = metadata.get("wave_rhythm")
+        #: The training waves' rhythms (core/rhythm.py), or None for an agent trained on the paper's objective.
+        self.rhythm_model = None if rhythm_values is None else rhythm.RhythmModel.from_dict(rhythm_values)
         config = metadata["agent_config"]
         w = {name: np.asarray(array, dtype=np.float64) for name, array in weights.items()}
         layers = int(config["hidden_layers"])
@@ -118,6 +121,13 @@ class GestureAgent:
         self._from_e = np.hstack([cell_hidden, belief_e, animation_e])  # (E, 3E + 2 hidden)
         self._from_z = np.hstack([cell_z, animation_z])  # (Z, 3E + hidden)
         self._from_a = cell_a  # (A, 3E)
+
+    def wave_rhythm(self, exaggeration, frame_count, seed=None):
+        """(N, 2) rhythm signals for a wave's objectives (spaces.make_objective), drawn as core/rhythm.py
+        says (the training waves' mean for seed None), or None for an agent without a rhythm model."""
+        if self.rhythm_model is None:
+            return None
+        return rhythm.signals(self.rhythm_model.draw(exaggeration, seed), frame_count)
 
     def rollout(self, objectives, seed=None):
         """Objectives (N, 7) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""

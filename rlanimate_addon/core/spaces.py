@@ -4,7 +4,9 @@ Objective o_t (7): [type, left_arm, right_arm, attr_x, attr_y, attr_z, t/N]
     type is 1 for point and 2 for wave (Table 2). For point, the attributes are the unit vector
     from the pointing arm's rest shoulder joint to the target, in the character frame, so a finger
     laid along that line from the shoulder passes through the target whatever its distance. For wave,
-    they are the exaggeration in [0, 1], three times. t/N runs over 0..1 (t = 0..N-1, divided by N-1).
+    they are the exaggeration in [0, 1] and the wave's rhythm [A_t sin(phi_t), A_t cos(phi_t)]
+    (core/rhythm.py), or, for an agent trained on the paper's objective, the exaggeration three
+    times. t/N runs over 0..1 (t = 0..N-1, divided by N-1).
 Description d_t (42), in the character frame in metres:
     [0:12]  unit effector vectors: left eye, right eye, left index, right index (skeleton.EFFECTORS)
     [12:42] positions of skeleton.DESCRIPTION_JOINTS: collars, shoulders, elbows, wrists, index bases
@@ -56,11 +58,12 @@ DEFAULT_ACTION_BOUNDS = np.array(
     [[-_joint_bound(j), _joint_bound(j)] for j in skeleton.ACTION_JOINTS for _ in range(3)])
 
 
-def make_objective(behaviour, arm, attributes, frame_count):
+def make_objective(behaviour, arm, attributes, frame_count, rhythm=None):
     """(N, 7) objectives for a gesture of `frame_count` frames.
 
     `attributes` is, for POINT, a unit vector (3,) or one per frame (N, 3), so a moving target is
-    tracked; for WAVE, the exaggeration in [0, 1] (scalar or (N,)).
+    tracked; for WAVE, the exaggeration in [0, 1] (scalar or (N,)). `rhythm` (N, 2), WAVE only: the
+    swing signals of core/rhythm.py; None gives the paper's objective (the exaggeration three times).
     """
     if behaviour not in BEHAVIOURS:
         raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(BEHAVIOURS)}.")
@@ -82,6 +85,11 @@ def make_objective(behaviour, arm, attributes, frame_count):
         if not np.all(np.isfinite(exaggeration)) or np.any((exaggeration < 0) | (exaggeration > 1)):
             raise RLAnimateError("Exaggeration must be a number between 0 and 1.")
         attrs = np.repeat(exaggeration[:, None], 3, axis=1)
+        if rhythm is not None:
+            rhythm = np.asarray(rhythm, dtype=np.float64)
+            if rhythm.shape != (n, 2) or not np.all(np.isfinite(rhythm)):
+                raise RLAnimateError(f"The wave rhythm must be finite signals of shape ({n}, 2), got {rhythm.shape}.")
+            attrs[:, 1:] = rhythm
     objective = np.zeros((n, OBJECTIVE_SIZE))
     objective[:, OBJECTIVE_TYPE] = BEHAVIOUR_TYPE[behaviour]
     objective[:, OBJECTIVE_ARM] = (1.0, 0.0) if arm == "LEFT" else (0.0, 1.0)

@@ -71,6 +71,19 @@ def test_wrong_format_version(tmp_path, exported):
         load_agent_file(path)
 
 
+def test_a_version_1_file_from_before_the_wave_rhythm_is_refused_with_the_fix(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    old = {key: value for key, value in metadata.items() if key != "wave_rhythm"}
+    with pytest.raises(RLAnimateError, match="format version 1, from before waves carried their rhythm.*retrain"):
+        load_agent_file(rewrite(tmp_path / "v1.npz", weights, {**old, "format_version": 1}))
+
+
+def test_a_broken_wave_rhythm_is_refused(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    with pytest.raises(RLAnimateError, match="wave_rhythm metadata is invalid"):
+        load_agent_file(rewrite(tmp_path / "rhythm.npz", weights, {**metadata, "wave_rhythm": {"lines": {}}}))
+
+
 def test_wrong_array_shape(tmp_path, exported):
     weights, metadata = load_agent_file(exported)
     weights["animation.layers.0.weight"] = weights["animation.layers.0.weight"][:, :-1]

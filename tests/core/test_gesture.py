@@ -27,6 +27,9 @@ class ReplayAgent:
         self.calls.append((np.array(objectives), seed))
         return gesture.resample(self.actions, len(objectives))
 
+    def wave_rhythm(self, exaggeration, frame_count, seed=None):
+        return None  # the paper's wave objective
+
 
 def test_character_frame_is_identity_on_the_canonical_rig_and_undoes_a_rotated_armature_space():
     heads = gesture.canonical_rig().rest_heads

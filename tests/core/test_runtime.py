@@ -4,7 +4,7 @@ import pytest
 import torch
 
 from rlanimate_addon.core import runtime as runtime_module
-from rlanimate_addon.core import spaces
+from rlanimate_addon.core import rhythm, spaces
 from rlanimate_addon.core.runtime import GestureAgent, load_agent
 from trainer.agent.agent_export import export_agent
 from trainer.agent.config import load_preset
@@ -13,10 +13,16 @@ from trainer.agent.models import VARIANTS, RLAnimateAgent
 torch.set_num_threads(1)
 
 
+RHYTHM = rhythm.RhythmModel.fit([0.0, 0.5, 1.0], [rhythm.Rhythm(0.08, 0.3, 0.7, 0.2, 9.0),
+                                                   rhythm.Rhythm(0.075, 0.32, 0.66, -0.4, 9.0),
+                                                   rhythm.Rhythm(0.072, 0.33, 0.69, 0.5, 9.0)])
+
+
 def objectives_for_tests(frames=150):
     point = spaces.make_objective("POINT", "LEFT", [0.4, -0.8, 0.3], frames)
     wave = spaces.make_objective("WAVE", "RIGHT", 0.7, frames // 2)
-    return [point, wave]
+    swinging = spaces.make_objective("WAVE", "LEFT", 0.3, frames, rhythm.signals(RHYTHM.draw(0.3, 4), frames))
+    return [point, wave, swinging]
 
 
 def exported_agent(tmp_path, preset, variant, weight_gain=2.0, seed=0):
@@ -87,6 +93,19 @@ def test_seeded_rollout_varies_reproducibly_within_the_action_range(tmp_path, va
     assert np.abs(runtime.rollout(objectives, seed=6) - varied).max() > 1e-3
 
 
+def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with_one(tmp_path):
+    torch.manual_seed(0)
+    path = tmp_path / "rhythm.npz"
+    export_agent(RLAnimateAgent(load_preset("debug")[0]), path,
+                 {"average_frames": {"POINT": 80, "WAVE": 95}, "wave_rhythm": RHYTHM.to_dict()})
+    agent = load_agent(path)
+    assert np.array_equal(agent.wave_rhythm(0.4, 90), rhythm.signals(RHYTHM.draw(0.4), 90))
+    assert np.array_equal(agent.wave_rhythm(0.4, 90, seed=3), agent.wave_rhythm(0.4, 90, seed=3))
+    assert np.abs(agent.wave_rhythm(0.4, 90, seed=3) - agent.wave_rhythm(0.4, 90, seed=4)).max() > 0.5
+    _, plain = exported_agent(tmp_path, "debug", "rlanimate")
+    assert load_agent(plain).wave_rhythm(0.4, 90) is None  # the paper's objective
+
+
 def test_metadata_accessors(tmp_path):
     _, path = exported_agent(tmp_path, "debug", "rlanimate")
     runtime = load_agent(path)
@@ -123,7 +142,7 @@ def test_single_behaviour_agent_plays_only_its_behaviour(tmp_path):
     runtime = load_agent(path)
     assert runtime.behaviours == ("POINT",)
     assert runtime.average_frames == {"POINT": 116.0, "WAVE": 116.0}
-    point, wave = objectives_for_tests()
+    point, wave, _ = objectives_for_tests()
     assert runtime.rollout(point).shape == (len(point), spaces.ACTION_SIZE)
     with pytest.raises(RLAnimateError, match="trained for point only"):
         runtime.rollout(wave)

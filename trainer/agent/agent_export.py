@@ -24,7 +24,8 @@ def export_agent(agent, path, metadata=None):
 
     `metadata` may hold: "training" (provenance: clips, seed, epochs, ...; the git commit and date
     are added), "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each
-    behaviour trained, the mean length of its training clips), "action_bounds" ((45, 2), default the
+    behaviour trained, the mean length of its training clips), "wave_rhythm" (a
+    core.rhythm.RhythmModel's dict, or None: the paper's wave objective), "action_bounds" ((45, 2), default the
     spaces' bounds), and any other JSON-serialisable entries (kept as given).
     """
     extra = dict(metadata or {})
@@ -41,6 +42,7 @@ def export_agent(agent, path, metadata=None):
         "rig": {"convention": "mixamo", "bone_prefix": skeleton.PREFIX,
                 "required_bones": list(skeleton.REQUIRED_BONES)},
         "average_frames": {k: float(v) for k, v in extra.pop("average_frames", FALLBACK_AVERAGE_FRAMES).items()},
+        "wave_rhythm": extra.pop("wave_rhythm", None),
         "training": {"git_commit": _git_commit(), "date": _now(), **extra.pop("training", {})},
         **extra,
     }

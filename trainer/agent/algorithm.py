@@ -18,11 +18,12 @@ import time
 import numpy as np
 import torch
 
-from rlanimate_addon.core import spaces
+from rlanimate_addon.core import rhythm, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 
-from trainer.agent import checkpoint
+from trainer.agent import checkpoint, pointing
 from trainer.agent.buffer import EpisodeBuffer
+from trainer.motion import wave_rhythm
 
 BEHAVIOUR_CHOICES = ("point", "wave", "both")
 
@@ -38,10 +39,19 @@ def clips_for_behaviour(clips, behaviour):
     return groups
 
 
-def clip_objective(clip, frame_count=None):
-    """(N, 7) objectives for `clip`'s label, over its own length or `frame_count` frames."""
-    return spaces.make_objective(clip.behaviour.upper(), clip.arm.upper(), clip.attributes,
-                                 len(clip.rotvecs) if frame_count is None else frame_count)
+def clip_objective(clip, frame_count=None, rhythm_model=None, with_rhythm=True):
+    """(N, 7) objectives for `clip`'s label, over its own length or `frame_count` frames.
+
+    A wave's rhythm (core/rhythm.py) is the clip's own (what the task module knows in training), or,
+    given `rhythm_model`, the one it draws for the clip's exaggeration (a request without the clip,
+    as the add-on makes); with_rhythm=False gives the paper's wave objective.
+    """
+    frames = len(clip.rotvecs) if frame_count is None else frame_count
+    signals = None
+    if clip.behaviour.upper() == "WAVE" and with_rhythm:
+        drawn = wave_rhythm.clip_rhythm(clip) if rhythm_model is None else rhythm_model.draw(clip.attributes)
+        signals = rhythm.signals(drawn, frames)
+    return spaces.make_objective(clip.behaviour.upper(), clip.arm.upper(), clip.attributes, frames, signals)
 
 
 def rollout_actions(agent, objectives, deterministic=True, generator=None):
@@ -80,6 +90,11 @@ class Trainer:
         self.behaviour = behaviour
         self.bounds = np.asarray(bounds, dtype=np.float64)
         self.clip_groups = clips_for_behaviour(clips, behaviour)
+        waves = [clip for group in self.clip_groups for clip in group if clip.behaviour.upper() == "WAVE"]
+        #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
+        self.rhythm_model = (rhythm.RhythmModel.fit([c.attributes for c in waves],
+                                                    [wave_rhythm.clip_rhythm(c) for c in waves])
+                             if waves and train_config.wave_rhythm else None)
         self.references = references or ClipReferences(env)
         self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
         self.buffer = EpisodeBuffer()
@@ -99,17 +114,32 @@ class Trainer:
         return self.clip_groups[group_index][deck.pop()]
 
     def collect(self):
-        """Steps 1-2: draw a clip per group, roll the agent out, evaluate all frames in one FK batch."""
+        """Steps 1-2: draw a clip per group, roll the agent out, evaluate all frames in one FK batch.
+
+        With `random_targets`, each iteration also points at that many new targets: a direction drawn
+        uniformly within the training clips' range of azimuth and elevation, timed like a training
+        clip of the same arm (its length and hold frames). These episodes have no clip to imitate
+        ("imitate" 0); only the pointing term, and the dynamics terms L1 and L2, learn from them:
+        the objective is the reward, as the paper's RL framing has it."""
         drawn = [self.draw(k) for k in range(len(self.clip_groups))]
-        objectives = [clip_objective(clip) for clip in drawn]
+        objectives = [clip_objective(clip, with_rhythm=self.train_config.wave_rhythm) for clip in drawn]
+        imitated = [True] * len(drawn)
+        points = [clip for group in self.clip_groups for clip in group if clip.behaviour.upper() == "POINT"]
+        if points and self.agent.variant != "supervised":
+            for _ in range(self.train_config.random_targets):
+                clip = points[int(self.rng.integers(len(points)))]
+                drawn.append(clip)
+                objectives.append(spaces.make_objective("POINT", clip.arm.upper(),
+                                                        self._random_direction(clip.arm.upper()), len(clip.rotvecs)))
+                imitated.append(False)
         self.agent.eval()
         actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
                    for o in objectives]
         rotvecs = spaces.decode_action(np.concatenate(actions), self.bounds)  # (sum F, 15, 3)
         descriptions = np.asarray(self.env.evaluate(rotvecs).descriptions)  # (sum F, 42)
         ends = np.cumsum([len(a) for a in actions])[:-1]
-        for clip, objective, action, description in zip(drawn, objectives, actions,
-                                                        np.split(descriptions, ends)):
+        for clip, objective, imitate, action, description in zip(drawn, objectives, imitated, actions,
+                                                                 np.split(descriptions, ends)):
             motion_description, _ = self.references.get(clip)
             self.buffer.add({
                 "objective": objective,
@@ -117,8 +147,23 @@ class Trainer:
                 "description": description,
                 "motion": spaces.encode_action(clip.rotvecs, self.bounds),
                 "motion_description": motion_description,
+                "hold": pointing.hold_frames(clip_objective(clip), motion_description),
+                "imitate": np.full(len(objective), float(imitate)),
             })
         return drawn
+
+    def _random_direction(self, arm):
+        """A unit pointing direction for `arm`, uniform in azimuth and elevation over the range of the
+        arm's training clips."""
+        angles = np.array([pointing.azimuth_elevation(arm, clip.attributes) for group in self.clip_groups
+                           for clip in group if clip.behaviour.upper() == "POINT" and clip.arm.upper() == arm])
+        azimuth, elevation = self.rng.uniform(angles.min(axis=0), angles.max(axis=0))
+        return pointing.direction_from_angles(arm, azimuth, elevation)
+
+    def request_objective(self, clip, frame_count=None):
+        """(N, 7) objectives of a request like `clip` (its label and length) as the add-on builds
+        them: a wave's rhythm is drawn from the training waves', not read from the clip."""
+        return clip_objective(clip, frame_count, self.rhythm_model, self.train_config.wave_rhythm)
 
     def learning_rate(self):
         """This epoch's Adam step size: cosine from learning_rate down to learning_rate_final over the
@@ -139,7 +184,7 @@ class Trainer:
         totals = {}
         for _ in range(config.update_steps):
             batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng)
-            losses = self.agent.losses(batch, config)
+            losses = self.agent.losses(batch, config, self.bounds)
             self.optimizer.zero_grad(set_to_none=True)
             losses["total"].backward()
             if getattr(config, "grad_clip", None):

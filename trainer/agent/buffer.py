@@ -2,14 +2,22 @@
 
 An episode is a mapping of per-frame arrays that share their first (time) axis:
     objective (F, 7), action (F, 45), description (F, 42) (the real d'_t from the FK environment),
-    motion (F, 45) (the clip's pose in [0, 1]), motion_description (F, 42) (FK of the clip).
+    motion (F, 45) (the clip's pose in [0, 1]), motion_description (F, 42) (FK of the clip),
+    hold (F,) (1 where the clip holds its point on its objective's ray: trainer/agent/pointing.py),
+    imitate (F,) (1 where the episode imitates its clip; 0 for a pointing request at a random target,
+    which only borrows a clip's length and hold timing).
 `sample_chunks` draws C chunks of L consecutive frames, each from an episode chosen uniformly at
-random and starting at a uniformly random frame, and stacks them batch-major: (C, L, ...).
+random, starting at its first frame with probability FIRST_FRAME_SHARE and otherwise at a uniformly
+random frame, and stacks them batch-major: (C, L, ...). Uniform starts alone would show the agent a
+gesture's first frame, where the unroll starts from a_0 in the middle of every channel, in about one
+chunk in 85, and its rollouts started some 20 degrees off the neutral arm.
 """
 import numpy as np
 import torch
 
-EPISODE_KEYS = ("objective", "action", "description", "motion", "motion_description")
+#: Share of chunks that start at their episode's first frame.
+FIRST_FRAME_SHARE = 0.2
+EPISODE_KEYS = ("objective", "action", "description", "motion", "motion_description", "hold", "imitate")
 
 
 class EpisodeBuffer:
@@ -45,6 +53,8 @@ class EpisodeBuffer:
         for index in picks:
             episode = self.episodes[index]
             start = int(rng.integers(0, len(episode["objective"]) - length + 1))
+            if rng.random() < FIRST_FRAME_SHARE:
+                start = 0
             for key in EPISODE_KEYS:
                 chunks[key].append(episode[key][start:start + length])
         return {key: torch.from_numpy(np.stack(chunks[key])) for key in EPISODE_KEYS}

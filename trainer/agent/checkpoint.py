@@ -13,7 +13,8 @@ import torch
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.files import atomic_open
 
-FORMAT_VERSION = 1
+#: 2: episodes hold the pointing term's "hold" frames (trainer/agent/buffer.py).
+FORMAT_VERSION = 2
 FILENAME = "checkpoint.pt"
 
 

@@ -51,7 +51,10 @@ class TrainConfig:
     pose_scale: float = 100.0  # the paper's L3: Huber to the clip's pose, summed over the 45 channels
     portrayal_direct_loss: bool = True  # also fit the self-description to the clip's description
     portrayal_scale: float = 1.0  # ... with this scale (MSE, summed over the 42 numbers)
+    random_targets: int = 1  # pointing requests at random targets per iteration (pointing term only)
+    pointing_scale: float = 100.0  # the finger line against the objective's ray at the hold (squared radians)
     policy_scale: float = 0.01  # Beta concentrations fitted by NLL of the clip's pose (mean detached)
+    wave_rhythm: bool = True  # waves' objectives carry their rhythm (core/rhythm.py); False: the paper's
 
     def to_dict(self):
         return asdict(self)

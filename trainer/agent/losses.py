@@ -7,10 +7,14 @@ On a batch of C chunks of L frames (batch-major, from trainer/agent/buffer.py):
                  trains the prior, the rest the posterior) and free nats (each side's mean KL per frame
                  is clamped from below at `free_nats`, so a KL already that small is not pushed further);
     pose         the paper's L3: Huber(M_t, mean of the animation model's Beta), summed over the 45
-                 channels. It flows back through the behaviour model into the portrayal model, because
+                 channels, over the frames that imitate a clip (not the random-target pointing
+                 requests). It flows back through the behaviour model into the portrayal model, because
                  the posterior is conditioned on the portrayal's self-description, as at inference;
     portrayal    optional direct MSE of the self-description toward the clip's description (summed
                  over the 42 numbers), when `portrayal_direct_loss`;
+    pointing     the agent's own finger line against the objective's ray at the frames where the clip
+                 holds its point (trainer/agent/pointing.py), through differentiable forward kinematics
+                 of the Beta's mean pose; on when the action bounds are given;
     policy       negative log-likelihood of the clip's pose under the Beta with its mean held fixed, so
                  only the concentrations learn: the spread of stochastic rollouts tracks the agent's
                  remaining error instead of staying at its initial value;
@@ -24,13 +28,15 @@ import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
 from rlanimate_addon.core.agent_file import INITIAL_ACTION
+from trainer.agent import pointing
 
 #: Clip poses are kept this far inside (0, 1) for the Beta's log-likelihood.
 POSE_MARGIN = 1e-3
 
 
-def agent_losses(agent, batch, config):
-    """{"description", "kl", "pose", "portrayal", "policy", "total"}: scalar tensors for `agent` on `batch`."""
+def agent_losses(agent, batch, config, bounds=None):
+    """{"description", "kl", "pose", "portrayal", "pointing", "policy", "total"}: scalar tensors for
+    `agent` on `batch`; the pointing term is zero without the action `bounds` (45, 2) or the batch's "hold"."""
     objective, motion = batch["objective"], batch["motion"]  # (C, L, 7), (C, L, 45)
     supervised = agent.variant == "supervised"
     played = motion if supervised else batch["action"]  # (C, L, 45)
@@ -44,17 +50,27 @@ def agent_losses(agent, batch, config):
     terms = {"description": squared_error(agent.decode(features), description_target)}  # the paper's L1
     terms["kl"] = (torch.zeros((), dtype=objective.dtype) if supervised else  # L2
                    balanced_kl(unrolled["posterior"], unrolled["prior"], config.kl_balance, config.free_nats))
+    imitate = batch.get("imitate", torch.ones_like(objective[..., 0]))  # (C, L): 0 on random-target requests
     policy = agent.policy(features)
     pose_error = F.huber_loss(policy.mean, motion, reduction="none", delta=config.huber_delta)  # (C, L, 45)
-    terms["pose"] = pose_error.sum(-1).mean()  # L3
-    terms["portrayal"] = (squared_error(described, batch["motion_description"])
+    terms["pose"] = masked_mean(pose_error.sum(-1), imitate)  # L3
+    terms["portrayal"] = (masked_mean((described - batch["motion_description"]).pow(2).sum(-1), imitate)
                           if described is not None and config.portrayal_direct_loss
                           else torch.zeros((), dtype=objective.dtype))
-    terms["policy"] = concentration_nll(policy, motion)
+    terms["pointing"] = torch.zeros((), dtype=objective.dtype)
+    if bounds is not None and "hold" in batch and float(batch["hold"].sum()) > 0:
+        errors = pointing.pointing_error(policy.mean, objective, torch.as_tensor(bounds, dtype=objective.dtype))
+        terms["pointing"] = (errors * batch["hold"]).sum() / batch["hold"].sum()
+    terms["policy"] = masked_mean(concentration_nll(policy, motion), imitate)
     scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
-              "portrayal": config.portrayal_scale, "policy": config.policy_scale}
+              "portrayal": config.portrayal_scale, "pointing": config.pointing_scale, "policy": config.policy_scale}
     terms["total"] = sum(scales[name] * value for name, value in terms.items())
     return terms
+
+
+def masked_mean(values, mask):
+    """Mean of values (C, L) over the frames where mask (C, L) is 1 (0 when there are none)."""
+    return (values * mask).sum() / mask.sum().clamp(min=1.0)
 
 
 def squared_error(prediction, target):
@@ -73,9 +89,9 @@ def balanced_kl(posterior, prior, balance, free_nats):
 
 
 def concentration_nll(policy, motion):
-    """-log Beta(M_t) with the Beta's mean detached: trains only its concentration alpha + beta."""
+    """(C, L) -log Beta(M_t) with the Beta's mean detached: trains only its concentration alpha + beta."""
     alpha, beta = policy.base_dist.concentration1, policy.base_dist.concentration0
     concentration = alpha + beta
     mean = (alpha / concentration).detach()
     fixed_mean = Beta(mean * concentration, (1.0 - mean) * concentration)
-    return -fixed_mean.log_prob(motion.clamp(POSE_MARGIN, 1.0 - POSE_MARGIN)).sum(-1).mean()
+    return -fixed_mean.log_prob(motion.clamp(POSE_MARGIN, 1.0 - POSE_MARGIN)).sum(-1)

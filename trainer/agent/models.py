@@ -182,6 +182,7 @@ class RLAnimateAgent(nn.Module):
                 "prior": self.prior_belief(e),
                 "posterior": Independent(Normal(torch.stack(means, 1), torch.stack(stds, 1)), 1)}
 
-    def losses(self, batch, train_config):
-        """Per-term scalar losses and their weighted "total" on a batch of chunks (trainer/agent/losses.py)."""
-        return loss_terms.agent_losses(self, batch, train_config)
+    def losses(self, batch, train_config, bounds=None):
+        """Per-term scalar losses and their weighted "total" on a batch of chunks (trainer/agent/losses.py);
+        `bounds` (45, 2), the action bounds, turn on the pointing term."""
+        return loss_terms.agent_losses(self, batch, train_config, bounds)

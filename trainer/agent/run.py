@@ -214,6 +214,7 @@ def _agent_metadata(report, trainer):
             "train_config": trainer.train_config,
             "action_bounds": trainer.bounds,
             "average_frames": {name: float(np.mean(values)) for name, values in lengths.items()},
+            "wave_rhythm": None if trainer.rhythm_model is None else trainer.rhythm_model.to_dict(),
             "evaluation": {"held_out_score": report["held_out"]["score"],
                            "held_out_smoothness": report["held_out"]["smoothness"]}}
 

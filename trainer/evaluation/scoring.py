@@ -42,10 +42,12 @@ def generate_descriptions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_B
     return np.split(descriptions, np.cumsum([len(a) for a in actions])[:-1])
 
 
-def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-    """score_descriptions of `agent`'s deterministic rollouts on each clip's own request."""
+def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS, objective=clip_objective):
+    """score_descriptions of `agent`'s deterministic rollouts on each clip's request: objective(clip,
+    frame_count=None) -> (N, 7) (Trainer.request_objective plays a wave at the rhythm the agent draws
+    for it, as the add-on does)."""
     agent.eval()
-    generated = generate_descriptions(agent, env, [clip_objective(clip) for clip in clips], bounds)
+    generated = generate_descriptions(agent, env, [objective(clip) for clip in clips], bounds)
     return score_descriptions(clips, generated, references)
 
 
@@ -90,11 +92,13 @@ def evaluate_seen_unseen(trainer, session):
     """Held-out (unseen) and SEEN_CLIP_COUNT training (seen) clips of the trainer's behaviour(s)."""
     unseen = select_clips(session.test_clips, trainer.behaviour)
     seen = select_clips(session.train_clips, trainer.behaviour, SEEN_CLIP_COUNT)
-    return {"unseen": evaluate_clips(trainer.agent, session.env, unseen, session.references, trainer.bounds),
-            "seen": evaluate_clips(trainer.agent, session.env, seen, session.references, trainer.bounds)}
+    return {split: evaluate_clips(trainer.agent, session.env, clips, session.references, trainer.bounds,
+                                  trainer.request_objective)
+            for split, clips in (("unseen", unseen), ("seen", seen))}
 
 
-def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.DEFAULT_ACTION_BOUNDS):
+def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.DEFAULT_ACTION_BOUNDS,
+                       objective=clip_objective):
     """Section 4.4: mean smoothness of each clip's gesture time-scaled to `scale` x the average
     length of its behaviour's training clips -> {behaviour: {scale: smoothness}} for each scale."""
     agent.eval()
@@ -108,7 +112,7 @@ def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.
         result[behaviour] = {}
         for scale in scales:
             frames = max(2, int(round(scale * mean_length)))
-            generated = generate_descriptions(agent, env, [clip_objective(c, frames) for c in group], bounds)
+            generated = generate_descriptions(agent, env, [objective(c, frames) for c in group], bounds)
             result[behaviour][f"{scale:g}"] = float(np.mean([metrics.smoothness(spaces.description_joint_positions(d))
                                                              for d in generated]))
     return result

@@ -6,7 +6,7 @@ import torch
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
 from trainer.agent.algorithm import ClipReferences, Trainer, clip_objective, clips_for_behaviour
-from trainer.agent.buffer import EPISODE_KEYS, EpisodeBuffer
+from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
 from trainer.motion.fk import NumpyFKEnvironment
@@ -18,7 +18,8 @@ def _episode(frames, offset):
     """Episode whose every value encodes its frame index + offset, so chunks reveal where they came from."""
     stamp = (np.arange(frames) + offset).astype(np.float64)[:, None]
     sizes = {"objective": 7, "action": 45, "description": 42, "motion": 45, "motion_description": 42}
-    return {key: np.repeat(stamp, sizes[key], axis=1) for key in EPISODE_KEYS}
+    episode = {key: np.repeat(stamp, sizes[key], axis=1) for key in sizes}
+    return {**episode, "hold": stamp[:, 0], "imitate": stamp[:, 0]}
 
 
 def test_chunks_are_contiguous_slices_of_one_episode_and_reproducible():
@@ -29,10 +30,19 @@ def test_chunks_are_contiguous_slices_of_one_episode_and_reproducible():
     assert chunks["action"].shape == (16, 10, 45) and chunks["description"].shape == (16, 10, 42)
     stamps = chunks["objective"][:, :, 0].numpy()  # (C, L)
     assert np.all(np.diff(stamps, axis=1) == 1)  # consecutive frames of one episode
-    assert all(np.all(chunks[key][:, :, 0].numpy() == stamps) for key in EPISODE_KEYS)  # keys stay aligned
+    assert all(np.all(chunks[key].reshape(16, 10, -1)[:, :, 0].numpy() == stamps) for key in EPISODE_KEYS)  # aligned
     assert {bool(s[0] >= 1000) for s in stamps} == {False, True}  # both episodes drawn
     again = buffer.sample_chunks(16, 10, np.random.default_rng(7))
     assert torch.equal(again["objective"], chunks["objective"])
+
+
+def test_a_share_of_chunks_starts_at_the_first_frame():
+    buffer = EpisodeBuffer()
+    buffer.add(_episode(200, 0))
+    starts = buffer.sample_chunks(2000, 10, np.random.default_rng(3))["objective"][:, 0, 0].numpy()
+    uniform = (1.0 - FIRST_FRAME_SHARE) / 191
+    assert abs(np.mean(starts == 0) - (FIRST_FRAME_SHARE + uniform)) < 0.03
+    assert len(np.unique(starts)) > 150  # the others anywhere
 
 
 def test_chunk_length_is_capped_at_the_shortest_episode():
@@ -70,9 +80,18 @@ def test_collect_stores_real_descriptions_and_clip_motion(env, library):
     torch.manual_seed(0)
     trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "both", seed=1)
     drawn = trainer.collect()
-    assert len(trainer.buffer) == 2 and [c.behaviour for c in drawn] == ["POINT", "WAVE"]
-    for clip, episode in zip(drawn, trainer.buffer.episodes):
-        np.testing.assert_allclose(episode["objective"], clip_objective(clip), atol=1e-6)
+    assert len(trainer.buffer) == 2 + train_config.random_targets
+    assert [c.behaviour for c in drawn] == ["POINT", "WAVE"] + ["POINT"] * train_config.random_targets
+    for k, (clip, episode) in enumerate(zip(drawn, trainer.buffer.episodes)):
+        imitated = k < 2
+        assert np.all(episode["imitate"] == float(imitated))
+        if imitated:
+            np.testing.assert_allclose(episode["objective"], clip_objective(clip), atol=1e-6)
+        else:  # a random target, timed like the clip
+            assert len(episode["objective"]) == len(clip.rotvecs) and np.all(episode["objective"][:, 0] == 1.0)
+            direction = episode["objective"][0, 3:6]
+            assert np.isclose(np.linalg.norm(direction), 1.0, atol=1e-6)
+            assert not np.allclose(direction, clip.attributes, atol=1e-3)
         np.testing.assert_allclose(episode["motion"], spaces.encode_action(clip.rotvecs), atol=1e-6)
         real = env.evaluate(spaces.decode_action(episode["action"].astype(np.float64))).descriptions
         np.testing.assert_allclose(episode["description"], real, atol=1e-4)
@@ -97,7 +116,7 @@ def test_debug_preset_trains_end_to_end_and_its_loss_falls(env, library):
     before = probe_loss()
     for _ in range(15):
         metrics = trainer.run_epoch()
-    assert metrics["epoch"] == 15 and metrics["episodes"] == 2 + 15 * 2
+    assert metrics["epoch"] == 15 and metrics["episodes"] == (1 + 15) * (2 + train_config.random_targets)
     assert all(np.isfinite(v) for k, v in metrics.items() if k.startswith("loss/"))
     assert probe_loss() < 0.8 * before
 

@@ -68,7 +68,7 @@ def test_sampled_rollout_is_reproducible_from_its_generator_alone():
 def test_losses_report_every_term_as_a_finite_scalar():
     config, train = load_preset("debug")
     losses = RLAnimateAgent(config).losses(synthetic_batch(4, 8), train)
-    assert set(losses) == {"description", "kl", "pose", "portrayal", "policy", "total"}
+    assert set(losses) == {"description", "kl", "pose", "portrayal", "pointing", "policy", "total"}
     for value in losses.values():
         assert value.shape == () and torch.isfinite(value)
     scales = {"description": train.description_scale, "kl": train.kl_scale, "pose": train.pose_scale,

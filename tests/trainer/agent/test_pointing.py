@@ -1,0 +1,47 @@
+import numpy as np
+import torch
+
+from rlanimate_addon.core import aim, kinematics, skeleton, spaces
+from trainer.agent import pointing
+from trainer.motion import synthesis as gs
+
+
+def test_the_torch_finger_matches_the_numpy_forward_kinematics():
+    rotvecs = np.random.default_rng(0).normal(0.0, 0.5, (6, 15, 3))
+    for arm in skeleton.ARMS:
+        base, finger = pointing.FINGERS.finger(torch.tensor(rotvecs), arm)
+        _, expected_base, expected_finger, _ = aim.finger_lines(rotvecs, arm)
+        assert np.allclose(base.numpy(), expected_base, atol=1e-9)
+        assert np.allclose(finger.numpy(), expected_finger, atol=1e-9)
+
+
+def _pointing_clip(arm, target, seed=4):
+    clip = gs.synthesise(gs.GestureSpec("POINT", arm, target=target, seed=seed))
+    objective = spaces.make_objective("POINT", arm, spaces.pointing_direction(arm, target), clip.frames)
+    return clip, objective
+
+
+def test_a_clip_is_on_target_exactly_where_it_holds_and_a_turned_arm_misses_by_its_turn():
+    arm, target = "RIGHT", (-1.2, -2.5, 1.9)
+    clip, objective = _pointing_clip(arm, target)
+    rotvecs = clip.action_rotvecs()
+    hold = pointing.hold_frames(objective, kinematics.describe(rotvecs))
+    first, last = clip.phases["hold"]
+    assert hold[first:last + 1].all() and not hold[:5].any() and not hold[-5:].any()
+    actions = torch.tensor(spaces.encode_action(rotvecs))
+    bounds = torch.tensor(spaces.DEFAULT_ACTION_BOUNDS)
+    errors = pointing.pointing_error(actions, torch.tensor(objective), bounds).numpy()
+    assert errors[first:last + 1].max() < 1e-8
+    turned = rotvecs.copy()
+    turned[:, skeleton.ACTION_JOINTS.index("RightArm")] += (0.0, 0.0, 0.05)  # about 3 degrees
+    off = pointing.pointing_error(torch.tensor(spaces.encode_action(turned)), torch.tensor(objective), bounds).numpy()
+    assert 0.3 * 0.05 ** 2 < np.median(off[first:last + 1]) < 3 * 0.05 ** 2
+
+
+def test_a_wave_has_no_hold_and_the_error_has_a_gradient():
+    objective = spaces.make_objective("WAVE", "LEFT", 0.5, 20)
+    assert not pointing.hold_frames(objective, np.zeros((20, spaces.DESCRIPTION_SIZE))).any()
+    _, point = _pointing_clip("LEFT", (1.5, -2.0, 1.0))
+    actions = torch.full((len(point), spaces.ACTION_SIZE), 0.5, dtype=torch.float64, requires_grad=True)
+    pointing.pointing_error(actions, torch.tensor(point), torch.tensor(spaces.DEFAULT_ACTION_BOUNDS)).sum().backward()
+    assert torch.isfinite(actions.grad).all() and actions.grad.abs().sum() > 0

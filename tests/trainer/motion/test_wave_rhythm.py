@@ -1,0 +1,33 @@
+import numpy as np
+import pytest
+
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion import synthesis as gs
+from trainer.motion import wave_rhythm
+from trainer.motion.clip import MotionClip
+
+
+def _clip(spec):
+    synthesised = gs.synthesise(spec)
+    clip = MotionClip(name="w", source="", fps=synthesised.fps, rotvecs=synthesised.action_rotvecs(),
+                      behaviour=spec.behaviour, arm=spec.arm)
+    return clip, synthesised
+
+
+@pytest.mark.parametrize("arm, exaggeration, seed", [("LEFT", 0.1, 3), ("RIGHT", 0.8, 11)])
+def test_the_rhythm_read_from_a_synthesised_wave_matches_how_it_was_made(arm, exaggeration, seed):
+    clip, synthesised = _clip(gs.GestureSpec("WAVE", arm, exaggeration=exaggeration, seed=seed))
+    style = gs.draw_style(seed)
+    made_hz = style.wave_frequency - 0.2 * exaggeration
+    read = wave_rhythm.clip_rhythm(clip)
+    assert read.frequency * clip.fps == pytest.approx(made_hz, rel=0.1)
+    first, last = synthesised.phases["wave"]
+    span = clip.frames - 1
+    assert abs(read.start * span - first) <= 6 and abs(read.stop * span - last) <= 6  # within 0.2 s
+
+
+def test_a_clip_without_a_swing_is_refused():
+    clip, _ = _clip(gs.GestureSpec("WAVE", "LEFT", exaggeration=0.5, seed=1))
+    clip.rotvecs = np.repeat(clip.rotvecs[:1], clip.frames, axis=0)  # the first pose, held
+    with pytest.raises(RLAnimateError, match="no side-to-side swing"):
+        wave_rhythm.clip_rhythm(clip)
