@@ -233,7 +233,7 @@ def _parse_metadata(path, entry):
         raise _damaged(path, error) from error
     if not isinstance(metadata, dict) or metadata.get("format") != FORMAT_NAME:
         raise _not_an_agent(path)
-    if metadata.get("format_version") == 1:
+    if _is_int(metadata.get("format_version")) and metadata["format_version"] == 1:
         raise RLAnimateError(f"The agent file {path} is format version 1, from before waves carried their rhythm "
                              f"in the objective; this add-on reads version {FORMAT_VERSION}: retrain the agent "
                              f"with this version's trainer (python trainer/train.py).")

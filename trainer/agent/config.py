@@ -6,9 +6,12 @@
     paper    the paper gives no sizes; it follows PlaNet (Hafner et al. 2019), so this preset uses
              PlaNet's (200 deterministic / 30 stochastic units, 50 chunks of 50 frames, free nats 3,
              Adam 1e-3, gradient clip 1000). It is slow on a CPU.
+    paper_wave_objective, reference_posterior, no_random_targets, no_pointing_term
+             the default with one of issue 10's choices undone (docs/AGENT.md); reference_posterior
+             is meant for the single_state variant (the stochastic behaviour state carries the wave).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, replace
 
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -54,6 +57,7 @@ class TrainConfig:
     random_targets: int = 1  # pointing requests at random targets per iteration (pointing term only)
     pointing_scale: float = 100.0  # the finger line against the objective's ray at the hold (squared radians)
     policy_scale: float = 0.01  # Beta concentrations fitted by NLL of the clip's pose (mean detached)
+    posterior_on_reference: bool = False  # single_state: condition the posterior on the clip's description
     wave_rhythm: bool = True  # waves' objectives carry their rhythm (core/rhythm.py); False: the paper's
 
     def to_dict(self):
@@ -69,14 +73,19 @@ def _known_fields(cls, values):
     return {key: value for key, value in dict(values).items() if key in names}
 
 
+_DEFAULT_TRAIN = TrainConfig(update_steps=120, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4)
 PRESETS = {
     "debug": (
         AgentConfig(task_size=8, behaviour_size=8, stochastic_size=4, hidden_size=8,
                     portrayal_hidden_size=8, hidden_layers=1),
         TrainConfig(epochs_single=2, epochs_both=2, update_steps=3, chunk_count=4, chunk_length=8),
     ),
-    "default": (AgentConfig(), TrainConfig(update_steps=60, chunk_count=32, learning_rate=3e-3,
-                                           learning_rate_final=1e-4)),
+    "default": (AgentConfig(), _DEFAULT_TRAIN),
+    # Ablations of issue 10's choices (docs/AGENT.md, "Waving, pointing, raising"), each the default but:
+    "paper_wave_objective": (AgentConfig(), replace(_DEFAULT_TRAIN, wave_rhythm=False)),  # no rhythm in waves
+    "reference_posterior": (AgentConfig(), replace(_DEFAULT_TRAIN, wave_rhythm=False, posterior_on_reference=True)),
+    "no_random_targets": (AgentConfig(), replace(_DEFAULT_TRAIN, random_targets=0)),
+    "no_pointing_term": (AgentConfig(), replace(_DEFAULT_TRAIN, random_targets=0, pointing_scale=0.0)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

@@ -42,7 +42,10 @@ def agent_losses(agent, batch, config, bounds=None):
     played = motion if supervised else batch["action"]  # (C, L, 45)
     previous = torch.cat([torch.full_like(played[:, :1], INITIAL_ACTION), played[:, :-1]], 1)  # a_{t-1}
     described = agent.self_description(objective)  # (C, L, 42) or None
-    conditions = batch["description"] if described is None else described
+    # The posterior's input: the self-description, or in single_state the real description d'_t, or
+    # with posterior_on_reference the clip's own description (the prior is what the rollout plays).
+    conditions = described if described is not None else \
+        batch["motion_description"] if config.posterior_on_reference else batch["description"]
     unrolled = agent.observe(objective, previous, conditions)
     features = unrolled["features"]  # (C, L, F)
 

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import rotations, skeleton, spaces
+from rlanimate_addon.core import rhythm, rotations, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 
@@ -119,15 +119,19 @@ class TrainedAgentMethod:
 
     def __init__(self, trainer, path):
         self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)
+        self.rhythm_model = trainer.rhythm_model
 
     def generate(self, behaviour, arm, attributes, frame_count, seed=None):
-        """Deterministic without `seed`; with one, a sampled rollout from a generator seeded with it."""
+        """Deterministic without `seed`; with one, a sampled rollout from a generator seeded with it (and
+        a wave's rhythm drawn with it, core/rhythm.py)."""
         import torch
 
         from trainer.agent.algorithm import rollout_actions
         self.agent.eval()
         generator = None if seed is None else torch.Generator().manual_seed(int(seed))
-        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count),
+        signals = (rhythm.signals(self.rhythm_model.draw(attributes, seed), frame_count)
+                   if behaviour == "WAVE" and self.rhythm_model is not None else None)
+        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count, signals),
                                   deterministic=seed is None, generator=generator)
         return spaces.decode_action(actions, self.bounds)
 
@@ -142,8 +146,10 @@ class AgentMethod:
         self.agent = runtime.load_agent(self.path)
 
     def generate(self, behaviour, arm, attributes, frame_count, seed=None):
-        """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed)."""
-        objectives = spaces.make_objective(behaviour, arm, attributes, frame_count)
+        """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed), and for
+        a wave the rhythm the agent draws for the seed."""
+        signals = self.agent.wave_rhythm(attributes, frame_count, seed) if behaviour == "WAVE" else None
+        objectives = spaces.make_objective(behaviour, arm, attributes, frame_count, signals)
         return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
 
 

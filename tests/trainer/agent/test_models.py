@@ -131,7 +131,8 @@ def test_supervised_variant_clones_the_clip_without_kl():
 
 
 def test_presets_and_config_round_trip():
-    assert set(PRESETS) == {"debug", "default", "paper"}
+    assert set(PRESETS) == {"debug", "default", "paper", "paper_wave_objective", "reference_posterior",
+                            "no_random_targets", "no_pointing_term"}
     for name in PRESETS:
         agent_config, train_config = load_preset(name)
         assert AgentConfig.from_dict(agent_config.to_dict()) == agent_config
@@ -151,3 +152,30 @@ def test_default_agent_fits_in_two_megabytes_of_float32():
     agent = RLAnimateAgent(load_preset("default")[0])
     assert 4 * sum(p.numel() for p in agent.parameters()) < 2e6
     assert all(torch.isfinite(p.detach()).all() for p in agent.parameters())
+
+
+def test_the_reference_posterior_sees_the_clips_description_and_not_the_rollouts():
+    config, train = load_preset("debug")
+    torch.manual_seed(0)
+    agent = RLAnimateAgent(config, "single_state")
+    batch = synthetic_batch(4, 8)
+    moved = dict(batch, motion_description=batch["motion_description"] + 0.5)
+    reference = dataclasses.replace(train, posterior_on_reference=True)
+
+    def kl(settings, chunks):
+        torch.manual_seed(3)
+        return float(agent.losses(chunks, settings)["kl"])
+
+    assert kl(reference, moved) != kl(reference, batch)
+    assert kl(train, moved) == kl(train, batch)  # single_state's own posterior: the rollout's d'_t
+
+
+def test_the_ablation_presets_undo_one_choice_each():
+    default = PRESETS["default"][1]
+    changed = {name: {f.name for f in dataclasses.fields(TrainConfig)
+                      if getattr(PRESETS[name][1], f.name) != getattr(default, f.name)}
+               for name in ("paper_wave_objective", "reference_posterior", "no_random_targets", "no_pointing_term")}
+    assert changed == {"paper_wave_objective": {"wave_rhythm"},
+                       "reference_posterior": {"wave_rhythm", "posterior_on_reference"},
+                       "no_random_targets": {"random_targets"},
+                       "no_pointing_term": {"random_targets", "pointing_scale"}}

@@ -1,0 +1,143 @@
+"""Issue 10's choices for the agent, measured against the alternatives: one-behaviour agents trained
+with each, their behaviour measures on the held-out requests -> docs/results/agent_ablation.{json,md}.
+
+    nice -n 10 python -m trainer.scripts.agent_ablation [--runs runs/agent_ablation] [--results docs/results]
+
+Waves: the rhythm in the objective (the default), the paper's objective (exaggeration only), and the
+stochastic behaviour state carrying the wave (single_state, its posterior on the clip's description
+during updates, its prior at play). Points: the pointing term with random targets (the default),
+without the random targets, and with neither. Runs that already finished are not trained again.
+"""
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from rlanimate_addon.core import kinematics
+from trainer.agent.run import RunSettings, train
+from trainer.blender_io.clip_session import LibrarySession
+from trainer.evaluation import behaviour
+from trainer.evaluation.baselines import AgentMethod
+from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, shown
+from trainer.reporting.tables import markdown_table
+from trainer.scripts.cli import run_main, script_args
+
+#: name: (behaviour, preset, variant, label)
+ABLATIONS = {
+    "wave_rhythm": ("wave", "default", "rlanimate", "rhythm in the objective (chosen)"),
+    "wave_paper_objective": ("wave", "paper_wave_objective", "rlanimate", "the paper's objective"),
+    "wave_reference_posterior": ("wave", "reference_posterior", "single_state",
+                                 "behaviour state on the clip, prior at play"),
+    "point_random_targets": ("point", "default", "rlanimate", "pointing term and random targets (chosen)"),
+    "point_no_random_targets": ("point", "no_random_targets", "rlanimate", "pointing term only"),
+    "point_no_pointing_term": ("point", "no_pointing_term", "rlanimate", "neither"),
+}
+TARGET_SEED = 2024
+SEEDS = (1, 2, 3)
+
+
+def describe(rotvecs):
+    return kinematics.describe(np.asarray(rotvecs, dtype=np.float64))
+
+
+def measure(path, behaviour_name, session, target_count):
+    """The behaviour measures of the agent at `path` on the held-out requests of its behaviour."""
+    method = AgentMethod(path)
+    lengths = behaviour.class_lengths(session.train_clips)
+    clips = [c for c in session.test_clips if c.behaviour.lower() == behaviour_name]
+    rows = behaviour.request_rows(method, clips, session.references, describe, lengths)
+    result = {"held_out": behaviour.summarise(rows)[behaviour_name]}
+    if behaviour_name == "wave":
+        result["seeded"] = behaviour.summarise(sum(([dict(row, seed=seed) for row in _seeded_rows(
+            method, clips, session, seed)] for seed in SEEDS), []))["wave"]
+        result["sweep"] = {arm.lower(): behaviour.exaggeration_sweep(method, arm, lengths["WAVE"], describe)
+                           for arm in ("LEFT", "RIGHT")}
+        result["variation"] = float(np.median([r["variation"] for r in behaviour.seed_variation(
+            method, clips, describe, SEEDS)]))
+    else:
+        rng = np.random.default_rng(TARGET_SEED)
+        result["random_targets"] = {arm.lower(): behaviour.pointing_sweep(
+            method, arm, behaviour.random_targets(rng, arm, target_count), lengths["POINT"], describe)
+            for arm in ("LEFT", "RIGHT")}
+    return result
+
+
+def _seeded_rows(method, clips, session, seed):
+    """request_rows of the method's answers for one variation seed."""
+    class Seeded:
+        def generate(self, behaviour_name, arm, attributes, frame_count):
+            return method.generate(behaviour_name, arm, attributes, frame_count, seed=seed)
+
+    return behaviour.request_rows(Seeded(), clips, session.references, describe,
+                                  behaviour.class_lengths(session.train_clips))
+
+
+def markdown(results, command):
+    lines = ["# Issue 10's agent choices against their alternatives", "",
+             "One-behaviour agents (preset `default` or the named ablation preset, seed 0, 50 epochs), measured with "
+             "`core.behaviour_metrics` (docs/METRICS.md) on the sample library's held-out requests at each clip's "
+             "own length, deterministic rollouts of the numpy runtime; seeded = variation seeds "
+             f"{', '.join(map(str, SEEDS))}. Regenerate: `{command}`.", "", "## Wave (4 held-out requests)", ""]
+    rows = []
+    for name, result in results.items():
+        if ABLATIONS[name][0] != "wave":
+            continue
+        held, seeded = result["held_out"], result["seeded"]
+        rows.append([ABLATIONS[name][3], f"{held['accepted_share'] * 4:.0f} / 4",
+                     f"{seeded['accepted_share'] * 4 * len(SEEDS):.0f} / {4 * len(SEEDS)}",
+                     f"{held['swing_ratio_min']:.2f} / {held['swing_ratio_median']:.2f} / {held['swing_ratio_max']:.2f}",
+                     f"{held['frequency_ratio_median']:.2f}", f"{held['cycles_min']:.0f} / {held['cycles_median']:.1f}",
+                     "yes" if all(s["swing_rising"] for s in result["sweep"].values()) else "no",
+                     f"{100 * result['variation']:.1f}", f"{held['elevation_first_error_max']:.1f}",
+                     f"{held['elevation_last_error_max']:.1f}", f"{held['score']:.2f}", f"{held['smoothness']:.2f}"])
+    lines += markdown_table(["method", "accepted", "accepted, seeded", "swing ratio min / median / max",
+                             "frequency ratio", "cycles min / median", "swing rises with exaggeration",
+                             "seed variation (cm)", "first-frame elevation error (deg, max)",
+                             "last-frame error (deg, max)", "score", "smoothness"], rows)
+    lines += ["", "## Point (6 held-out requests; 100 random targets 1.5-4 m per arm)", ""]
+    rows = []
+    for name, result in results.items():
+        if ABLATIONS[name][0] != "point":
+            continue
+        held, random = result["held_out"], result["random_targets"]
+        rows.append([ABLATIONS[name][3], f"{held['pointing_angle_median']:.2f} / {held['pointing_angle_max']:.2f}",
+                     f"{random['left']['median_angle']:.2f} / {random['left']['max_angle']:.2f}",
+                     f"{random['right']['median_angle']:.2f} / {random['right']['max_angle']:.2f}",
+                     f"{held['elevation_first_error_max']:.1f}", f"{held['score']:.2f}", f"{held['smoothness']:.2f}"])
+    lines += markdown_table(["method", "raw angle held out (deg, median / max)", "random left", "random right",
+                             "first-frame elevation error (deg, max)", "score", "smoothness"], rows)
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.agent_ablation",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("--runs", default=str(REPO_ROOT / "runs" / "agent_ablation"))
+    parser.add_argument("--results", default=str(RESULTS_DIR))
+    parser.add_argument("--targets", type=int, default=100, help="random pointing targets per arm")
+    parser.add_argument("--only", nargs="*", choices=sorted(ABLATIONS), help="train and measure only these")
+    options = parser.parse_args(script_args(argv))
+    torch.set_num_threads(1)
+    session = LibrarySession(DEFAULT_MANIFEST)
+    results = {}
+    for name in options.only or ABLATIONS:
+        behaviour_name, preset, variant, _ = ABLATIONS[name]
+        output = Path(options.runs) / name
+        if not (output / "report.json").is_file():
+            train(RunSettings(str(output), behaviour=behaviour_name, preset=preset, variant=variant, eval_every=0,
+                              progress=False), session)
+        results[name] = measure(output / "agent.npz", behaviour_name, session, options.targets)
+        print(name, json.dumps(results[name]["held_out"]), flush=True)
+    command = f"nice -n 10 python -m trainer.scripts.agent_ablation --runs {shown(options.runs)}"
+    results_dir = Path(options.results)
+    results_dir.mkdir(parents=True, exist_ok=True)
+    (results_dir / "agent_ablation.json").write_text(json.dumps(results, indent=1) + "\n")
+    (results_dir / "agent_ablation.md").write_text(markdown(results, command))
+    print((results_dir / "agent_ablation.md").read_text())
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))
