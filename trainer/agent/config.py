@@ -73,7 +73,7 @@ def _known_fields(cls, values):
     return {key: value for key, value in dict(values).items() if key in names}
 
 
-_DEFAULT_TRAIN = TrainConfig(update_steps=120, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4)
+_DEFAULT_TRAIN = TrainConfig(update_steps=160, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4)
 PRESETS = {
     "debug": (
         AgentConfig(task_size=8, behaviour_size=8, stochastic_size=4, hidden_size=8,

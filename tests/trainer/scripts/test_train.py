@@ -10,6 +10,7 @@ import pytest
 
 from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
+from trainer.agent.config import load_preset
 from trainer.blender_io.clip_import import load_clip_set
 from trainer.paths import CLIP_DIR, DEFAULT_MANIFEST, REPO_ROOT
 from trainer.scripts import cli, train
@@ -46,7 +47,8 @@ def test_train_cli_writes_an_agent_report_and_plots_that_load(tiny_library, tmp_
     metrics = [json.loads(line) for line in (output / "metrics.jsonl").read_text().splitlines()]
     assert [m["epoch"] for m in metrics] == [1, 2, 3] and "unseen/score" in metrics[1]
     report = json.loads((output / "report.json").read_text())
-    assert report["episodes"] == 3 * 2 and len(report["held_out"]["clips"]) == 2
+    random_targets = load_preset("debug")[1].random_targets  # pointing requests at new targets per epoch
+    assert report["episodes"] == 3 * (2 + random_targets) and len(report["held_out"]["clips"]) == 2
     assert len(report["training"]["clips"]) == 4  # the 10 seen clips, capped at the library's 4
     assert (output / "training_curves.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
