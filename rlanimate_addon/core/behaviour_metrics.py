@@ -189,8 +189,8 @@ def pointing_angles(finger_base, finger_direction, target):
 
 
 def hold_run(positions, arm, fps=FPS):
-    """(first, last) frame of the pointing hold (see the module docstring): a still arm holds
-    throughout."""
+    """(first, last) frame of the pointing hold (see the module docstring), or None for a finger that
+    never slows down past half its travel; a still arm holds throughout."""
     p, side = _positions(positions), _side(arm)
     base = p[:, _JOINT[f"{side}_index_base"]]  # (F, 3)
     travel = np.linalg.norm(base - base[0], axis=1)
@@ -202,9 +202,13 @@ def point_measures(positions, finger_direction, arm, target, fps=FPS):
     """{'angle' (degrees, median over the hold of `pointing_angles`), 'hold_s'} of a pointing
     gesture; finger_direction (F, 3): the arm's index-finger direction (base to tip) per frame."""
     p, side = _positions(positions), _side(arm)
-    first, last = hold_run(p, arm, fps)
-    base = p[first:last + 1, _JOINT[f"{side}_index_base"]]
-    angles = pointing_angles(base, np.asarray(finger_direction)[first:last + 1], target)
+    hold = hold_run(p, arm, fps)
+    base = p[:, _JOINT[f"{side}_index_base"]]  # (F, 3)
+    angles = pointing_angles(base, finger_direction, target)  # (F,)
+    if hold is None:  # no hold: the angle at the apex, where the finger base is farthest out
+        return {"angle": float(angles[np.argmax(np.linalg.norm(base - base[0], axis=1))]), "hold_s": 0.0}
+    first, last = hold
+    angles = angles[first:last + 1]
     return {"angle": float(np.median(angles)), "hold_s": (last - first + 1) / fps}
 
 

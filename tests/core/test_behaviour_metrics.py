@@ -159,6 +159,15 @@ def test_pointing_angle_and_hold():
     assert missed["angle"] == pytest.approx(5.0, abs=1e-6)
 
 
+def test_a_point_that_never_holds_is_measured_at_its_apex():
+    frames = 20  # rises and falls straight away: the finger never slows down past half its travel
+    clip, finger, target = pointing_clip(frames)
+    swept = 20.0 * np.sin(np.linspace(0.0, np.pi, frames)) + 3.0  # the arm sweeps fast through the apex
+    measures = bm.point_measures(clip + swept[:, None, None] * (1.0, 0.0, 0.0), finger, "RIGHT", target)
+    assert measures["hold_s"] == 0.0
+    assert 0.0 < measures["angle"] < 180.0
+
+
 def test_still_arm_has_no_short_hold_and_points_down():
     _, _, target = pointing_clip()
     still = hanging_arm(60)
