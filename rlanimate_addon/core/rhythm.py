@@ -69,7 +69,8 @@ class RhythmModel:
         """From the training clips' exaggerations (K,) and their Rhythms (K)."""
         e = np.asarray(exaggerations, dtype=np.float64)
         if len(e) < 2:
-            raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips: add wave clips.")
+            raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
+                                 "side: add such wave clips.")
         design = np.stack([np.ones_like(e), e], axis=1)
         lines = {}
         for name in PARAMETERS:

@@ -44,13 +44,14 @@ def clip_objective(clip, frame_count=None, rhythm_model=None, with_rhythm=True):
 
     A wave's rhythm (core/rhythm.py) is the clip's own (what the task module knows in training), or,
     given `rhythm_model`, the one it draws for the clip's exaggeration (a request without the clip,
-    as the add-on makes); with_rhythm=False gives the paper's wave objective.
+    as the add-on makes); with_rhythm=False gives the paper's wave objective. A clip whose hand does
+    not swing gets zero rhythm signals: no swing.
     """
     frames = len(clip.rotvecs) if frame_count is None else frame_count
     signals = None
     if clip.behaviour.upper() == "WAVE" and with_rhythm:
         drawn = wave_rhythm.clip_rhythm(clip) if rhythm_model is None else rhythm_model.draw(clip.attributes)
-        signals = rhythm.signals(drawn, frames)
+        signals = np.zeros((frames, 2)) if drawn is None else rhythm.signals(drawn, frames)
     return spaces.make_objective(clip.behaviour.upper(), clip.arm.upper(), clip.attributes, frames, signals)
 
 
@@ -92,9 +93,10 @@ class Trainer:
         self.clip_groups = clips_for_behaviour(clips, behaviour)
         waves = [clip for group in self.clip_groups for clip in group if clip.behaviour.upper() == "WAVE"]
         #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
-        self.rhythm_model = (rhythm.RhythmModel.fit([c.attributes for c in waves],
-                                                    [wave_rhythm.clip_rhythm(c) for c in waves])
-                             if waves and train_config.wave_rhythm else None)
+        self.rhythm_model = None
+        if waves and train_config.wave_rhythm:
+            swinging = [(c.attributes, r) for c, r in ((c, wave_rhythm.clip_rhythm(c)) for c in waves) if r is not None]
+            self.rhythm_model = rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])
         self.references = references or ClipReferences(env)
         self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
         self.buffer = EpisodeBuffer()

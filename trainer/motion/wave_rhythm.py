@@ -33,7 +33,8 @@ def swing_signal(rotvecs, arm):
 
 
 def clip_rhythm(clip):
-    """The Rhythm of a wave clip (a MotionClip with rotvecs, arm and fps)."""
+    """The Rhythm of a wave clip (a MotionClip with rotvecs, arm and fps), or None for a wave whose hand
+    does not swing side to side (real takes have them: a raised, still hand)."""
     fps = clip.fps
     x = swing_signal(np.asarray(clip.rotvecs, dtype=np.float64), clip.arm.upper())
     frames = len(x)
@@ -43,16 +44,14 @@ def clip_rhythm(clip):
     analytic = signal.hilbert(x - signal.savgol_filter(x, window, 3))
     amplitude = np.abs(analytic)
     if amplitude.max() < MIN_SWING:
-        raise RLAnimateError(f"A wave clip has no side-to-side swing of the hand (under {100 * MIN_SWING:.0f} cm): "
-                             f"check its label, or leave it out of the wave clips.")
+        return None
     above = amplitude >= 0.5 * amplitude.max()
     peak = int(np.argmax(amplitude))  # the swing: the run of frames above half amplitude around the peak
     first = peak - np.argmin(above[peak::-1]) + 1 if not above[:peak + 1].all() else 0
     last = peak + np.argmin(above[peak:]) - 1 if not above[peak:].all() else frames - 1
     active = np.arange(first, last + 1)
     if len(active) < 4:
-        raise RLAnimateError("A wave clip has no side-to-side swing of the hand (under 4 frames): check its label, "
-                             "or leave it out of the wave clips.")
+        return None
     ramp = RAMP_SECONDS * fps
     start, stop = active[0] - 0.5 * ramp, active[-1] + 0.5 * ramp
     phase = np.unwrap(np.angle(analytic))

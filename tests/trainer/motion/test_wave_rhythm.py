@@ -1,7 +1,8 @@
 import numpy as np
 import pytest
 
-from rlanimate_addon.core.errors import RLAnimateError
+from rlanimate_addon.core import spaces
+from trainer.agent.algorithm import clip_objective
 from trainer.motion import synthesis as gs
 from trainer.motion import wave_rhythm
 from trainer.motion.clip import MotionClip
@@ -26,8 +27,10 @@ def test_the_rhythm_read_from_a_synthesised_wave_matches_how_it_was_made(arm, ex
     assert abs(read.start * span - first) <= 6 and abs(read.stop * span - last) <= 6  # within 0.2 s
 
 
-def test_a_clip_without_a_swing_is_refused():
+def test_a_clip_without_a_swing_has_no_rhythm_and_a_still_objective():
     clip, _ = _clip(gs.GestureSpec("WAVE", "LEFT", exaggeration=0.5, seed=1))
     clip.rotvecs = np.repeat(clip.rotvecs[:1], clip.frames, axis=0)  # the first pose, held
-    with pytest.raises(RLAnimateError, match="no side-to-side swing"):
-        wave_rhythm.clip_rhythm(clip)
+    clip.attributes = 0.5
+    assert wave_rhythm.clip_rhythm(clip) is None
+    objective = clip_objective(clip)
+    assert np.all(objective[:, spaces.OBJECTIVE_ATTRIBUTES][:, 1:] == 0.0)  # the rhythm signals: no swing
