@@ -48,7 +48,8 @@ def measure(path, behaviour_name, session, target_count):
     lengths = behaviour.class_lengths(session.train_clips)
     clips = [c for c in session.test_clips if c.behaviour.lower() == behaviour_name]
     rows = behaviour.request_rows(method, clips, session.references, describe, lengths)
-    result = {"held_out": behaviour.summarise(rows)[behaviour_name]}
+    result = {"held_out": behaviour.summarise(rows)[behaviour_name],
+              "update_steps": method.agent.metadata["train_config"]["update_steps"]}
     if behaviour_name == "wave":
         result["seeded"] = behaviour.summarise(sum(([dict(row, seed=seed) for row in _seeded_rows(
             method, clips, session, seed)] for seed in SEEDS), []))["wave"]
@@ -78,21 +79,21 @@ def markdown(results, command):
     lines = ["# Issue 10's agent choices against their alternatives", "",
              "One-behaviour agents (preset `default` or the named ablation preset, seed 0, 50 epochs), measured with "
              "`core.behaviour_metrics` (docs/METRICS.md) on the sample library's held-out requests at each clip's "
-             "own length, deterministic rollouts of the numpy runtime; seeded = variation seeds "
+             "own length, deterministic rollouts of the numpy runtime; T: the run's updates per epoch; seeded = variation seeds "
              f"{', '.join(map(str, SEEDS))}. Regenerate: `{command}`.", "", "## Wave (4 held-out requests)", ""]
     rows = []
     for name, result in results.items():
         if ABLATIONS[name][0] != "wave":
             continue
         held, seeded = result["held_out"], result["seeded"]
-        rows.append([ABLATIONS[name][3], f"{held['accepted_share'] * 4:.0f} / 4",
+        rows.append([ABLATIONS[name][3], result["update_steps"], f"{held['accepted_share'] * 4:.0f} / 4",
                      f"{seeded['accepted_share'] * 4 * len(SEEDS):.0f} / {4 * len(SEEDS)}",
                      f"{held['swing_ratio_min']:.2f} / {held['swing_ratio_median']:.2f} / {held['swing_ratio_max']:.2f}",
                      f"{held['frequency_ratio_median']:.2f}", f"{held['cycles_min']:.0f} / {held['cycles_median']:.1f}",
                      "yes" if all(s["swing_rising"] for s in result["sweep"].values()) else "no",
                      f"{100 * result['variation']:.1f}", f"{held['elevation_first_error_max']:.1f}",
                      f"{held['elevation_last_error_max']:.1f}", f"{held['score']:.2f}", f"{held['smoothness']:.2f}"])
-    lines += markdown_table(["method", "accepted", "accepted, seeded", "swing ratio min / median / max",
+    lines += markdown_table(["method", "T", "accepted", "accepted, seeded", "swing ratio min / median / max",
                              "frequency ratio", "cycles min / median", "swing rises with exaggeration",
                              "seed variation (cm)", "first-frame elevation error (deg, max)",
                              "last-frame error (deg, max)", "score", "smoothness"], rows)
@@ -102,11 +103,12 @@ def markdown(results, command):
         if ABLATIONS[name][0] != "point":
             continue
         held, random = result["held_out"], result["random_targets"]
-        rows.append([ABLATIONS[name][3], f"{held['pointing_angle_median']:.2f} / {held['pointing_angle_max']:.2f}",
+        rows.append([ABLATIONS[name][3], result["update_steps"],
+                     f"{held['pointing_angle_median']:.2f} / {held['pointing_angle_max']:.2f}",
                      f"{random['left']['median_angle']:.2f} / {random['left']['max_angle']:.2f}",
                      f"{random['right']['median_angle']:.2f} / {random['right']['max_angle']:.2f}",
                      f"{held['elevation_first_error_max']:.1f}", f"{held['score']:.2f}", f"{held['smoothness']:.2f}"])
-    lines += markdown_table(["method", "raw angle held out (deg, median / max)", "random left", "random right",
+    lines += markdown_table(["method", "T", "raw angle held out (deg, median / max)", "random left", "random right",
                              "first-frame elevation error (deg, max)", "score", "smoothness"], rows)
     return "\n".join(lines) + "\n"
 
