@@ -95,7 +95,8 @@ class Trainer:
         #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
         self.rhythm_model = None
         if waves and train_config.wave_rhythm:
-            swinging = [(c.attributes, r) for c, r in ((c, wave_rhythm.clip_rhythm(c)) for c in waves) if r is not None]
+            read = [(clip.attributes, wave_rhythm.clip_rhythm(clip)) for clip in waves]
+            swinging = [(exaggeration, read_rhythm) for exaggeration, read_rhythm in read if read_rhythm is not None]
             self.rhythm_model = rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])
         self.references = references or ClipReferences(env)
         self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from trainer.blender_io.rig_session import import_bpy, load_rig, new_empty_scene
+from trainer.blender_io.rig_session import blender_output, import_bpy, load_rig, new_empty_scene
 from trainer.paths import SAMPLE_RIG_BLEND
 
 ADDON = "rlanimate_addon"
@@ -113,7 +113,8 @@ def render_requests(requests, out_dir, agent_path=None, rig_path=SAMPLE_RIG_BLEN
             scene.frame_set(frame)
             path = out_dir / f"request{k:02d}_frame{frame:05d}.png"
             scene.render.filepath = str(path)
-            bpy.ops.render.render(write_still=True)
+            with blender_output():  # Cycles' progress and 'Saved: ...' lines
+                bpy.ops.render.render(write_still=True)
             request.frames.append((frame - start, path))
         if target is not None:
             target.hide_render = True  # only this request's target shows in its own frames
