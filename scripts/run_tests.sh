@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # The project's test command: the whole suite on Blender 5.0 (bpy 5.0.1), then the Blender-facing
 # extension tests again on Blender 4.2 LTS from the second environment made by scripts/setup.sh.
+# Test files run in parallel, one per core (pytest-xdist; a file's module fixtures are built once);
+# PYTEST_WORKERS=0 runs them in this one process.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-python -m pytest -q "$@"
+PARALLEL=(-n "${PYTEST_WORKERS:-auto}" --dist loadfile)
+python -m pytest -q "${PARALLEL[@]}" "$@"
 if [ -x .venv-bpy42/bin/python ]; then
     echo "== Blender 4.2 LTS: extension tests =="
-    .venv-bpy42/bin/python -m pytest -q tests/addon -p no:cacheprovider
+    .venv-bpy42/bin/python -m pytest -q "${PARALLEL[@]}" tests/addon -p no:cacheprovider
 else
     echo "scripts/run_tests.sh: .venv-bpy42 is missing; run scripts/setup.sh to test Blender 4.2 too" >&2
     exit 1
