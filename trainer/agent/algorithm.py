@@ -157,10 +157,13 @@ class Trainer:
 
     def _random_direction(self, arm):
         """A unit pointing direction for `arm`, uniform in azimuth and elevation over the range of the
-        arm's training clips."""
-        angles = np.array([pointing.azimuth_elevation(arm, clip.attributes) for group in self.clip_groups
-                           for clip in group if clip.behaviour.upper() == "POINT" and clip.arm.upper() == arm])
-        azimuth, elevation = self.rng.uniform(angles.min(axis=0), angles.max(axis=0))
+        arm's training clips widened by the config's margin (elevation kept within 80 degrees)."""
+        angles = np.degrees([pointing.azimuth_elevation(arm, clip.attributes) for group in self.clip_groups
+                             for clip in group if clip.behaviour.upper() == "POINT" and clip.arm.upper() == arm])
+        margin = self.train_config.random_target_margin_deg
+        low = np.maximum(angles.min(axis=0) - margin, (-180.0, -80.0))
+        high = np.minimum(angles.max(axis=0) + margin, (180.0, 80.0))
+        azimuth, elevation = np.radians(self.rng.uniform(low, high))
         return pointing.direction_from_angles(arm, azimuth, elevation)
 
     def request_objective(self, clip, frame_count=None):

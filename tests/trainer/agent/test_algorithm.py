@@ -1,10 +1,13 @@
 """Algorithm 1: the episode buffer's chunks, one iteration's collection, and a debug run whose loss falls."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
 
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
+from trainer.agent import pointing
 from trainer.agent.algorithm import ClipReferences, Trainer, clip_objective, clips_for_behaviour
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
@@ -128,3 +131,17 @@ def test_clips_are_drawn_in_passes_without_replacement(env, library):
     drawn = [id(trainer.draw(0)) for _ in range(2 * len(waves))]
     assert sorted(drawn[:len(waves)]) == sorted(id(clip) for clip in waves)  # each clip once per pass
     assert sorted(drawn[len(waves):]) == sorted(drawn[:len(waves)]) and drawn[len(waves):] != drawn[:len(waves)]
+
+
+@pytest.mark.parametrize("margin", [0.0, 10.0])
+def test_random_targets_cover_the_clips_range_widened_by_the_margin(env, library, margin):
+    agent_config, train_config = load_preset("debug")
+    train_config = replace(train_config, random_target_margin_deg=margin)
+    trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "point", seed=2)
+    clips = [np.degrees(pointing.azimuth_elevation("LEFT", c.attributes)) for c in trainer.clip_groups[0]
+             if c.arm.upper() == "LEFT"]
+    drawn = np.degrees([pointing.azimuth_elevation("LEFT", trainer._random_direction("LEFT")) for _ in range(400)])
+    low, high = np.min(clips, axis=0) - margin, np.max(clips, axis=0) + margin
+    assert np.all(drawn >= low - 1e-9) and np.all(drawn <= high + 1e-9)
+    reach = margin / 2 if margin else -0.1 * (high - low)  # the draws use the margin, or fill the range
+    assert np.all(drawn.min(axis=0) < low + margin - reach) and np.all(drawn.max(axis=0) > high - margin + reach)
