@@ -200,16 +200,18 @@ def rest_swings(roles, rest_heads, to_character):
     and wave where the canonical skeleton's do, not 45 degrees lower, and a rig whose fingers rest
     curled points with a straight index finger.
     """
+    names = [n for n in skeleton.BONE_NAMES if n in roles]  # parents first
+    directed = [n for n in names if _DIRECTION_TO.get(n) in rest_heads]
+    rig = np.array([np.subtract(rest_heads[_DIRECTION_TO[n]], rest_heads[n]) for n in directed]).reshape(-1, 3)
+    rig = rig @ np.asarray(to_character).T
+    canonical = np.array([np.subtract(skeleton.BONE_BY_NAME[_DIRECTION_TO[n]].head, skeleton.BONE_BY_NAME[n].head)
+                          for n in directed]).reshape(-1, 3)
+    turns = dict(zip(directed, aim.rotation_between(rig / np.linalg.norm(rig, axis=1, keepdims=True),
+                                                     canonical / np.linalg.norm(canonical, axis=1, keepdims=True))))
     swings = {}
-    for name in [n for n in skeleton.BONE_NAMES if n in roles]:  # parents first
+    for name in names:
         parent = _parent_role(name, roles)
-        swings[name] = np.eye(3) if parent is None else swings[parent]
-        child = _DIRECTION_TO.get(name)
-        if child in rest_heads:
-            rig = to_character @ (np.asarray(rest_heads[child]) - np.asarray(rest_heads[name]))
-            canonical = np.subtract(skeleton.BONE_BY_NAME[child].head, skeleton.BONE_BY_NAME[name].head)
-            rig, canonical = rig / np.linalg.norm(rig), canonical / np.linalg.norm(canonical)
-            swings[name] = aim.rotation_between(rig[None], canonical[None])[0]
+        swings[name] = turns.get(name, np.eye(3) if parent is None else swings[parent])
     return swings
 
 
