@@ -119,11 +119,14 @@ def main(argv=None):
     parser.add_argument("--runs", default=str(REPO_ROOT / "runs" / "agent_ablation"))
     parser.add_argument("--results", default=str(RESULTS_DIR))
     parser.add_argument("--targets", type=int, default=100, help="random pointing targets per arm")
-    parser.add_argument("--only", nargs="*", choices=sorted(ABLATIONS), help="train and measure only these")
+    parser.add_argument("--only", nargs="*", choices=sorted(ABLATIONS),
+                        help="train and measure only these; the other rows stay as agent_ablation.json has them")
     options = parser.parse_args(script_args(argv))
     torch.set_num_threads(1)
     session = LibrarySession(DEFAULT_MANIFEST)
-    results = {}
+    results_dir = Path(options.results)
+    kept = results_dir / "agent_ablation.json"
+    results = json.loads(kept.read_text()) if options.only and kept.is_file() else {}
     for name in options.only or ABLATIONS:
         behaviour_name, preset, variant, _ = ABLATIONS[name]
         output = Path(options.runs) / name
@@ -132,10 +135,10 @@ def main(argv=None):
                               progress=False), session)
         results[name] = measure(output / "agent.npz", behaviour_name, session, options.targets)
         print(name, json.dumps(results[name]["held_out"]), flush=True)
+    results = {name: results[name] for name in ABLATIONS if name in results}
     command = f"nice -n 10 python -m trainer.scripts.agent_ablation --runs {shown(options.runs)}"
-    results_dir = Path(options.results)
     results_dir.mkdir(parents=True, exist_ok=True)
-    (results_dir / "agent_ablation.json").write_text(json.dumps(results, indent=1) + "\n")
+    kept.write_text(json.dumps(results, indent=1) + "\n")
     (results_dir / "agent_ablation.md").write_text(markdown(results, command))
     print((results_dir / "agent_ablation.md").read_text())
     return 0

@@ -1,0 +1,28 @@
+"""trainer.scripts.agent_ablation --only: trains and measures the named rows, keeps the others as they were."""
+import json
+import shutil
+
+from trainer.paths import RESULTS_DIR
+from trainer.scripts import agent_ablation
+
+
+def test_only_replaces_its_rows_and_keeps_the_others(tmp_path, monkeypatch):
+    results = tmp_path / "results"
+    results.mkdir()
+    shutil.copyfile(RESULTS_DIR / "agent_ablation.json", results / "agent_ablation.json")
+    before = json.loads((results / "agent_ablation.json").read_text())
+    measured = dict(before["point_no_random_targets"], update_steps=7)
+    trained = []
+    monkeypatch.setattr(agent_ablation, "LibrarySession", lambda manifest: None)
+    monkeypatch.setattr(agent_ablation, "train", lambda settings, session: trained.append(settings.preset))
+    monkeypatch.setattr(agent_ablation, "measure", lambda path, behaviour, session, targets: measured)
+    argv = ["agent_ablation", "--only", "point_no_pointing_term", "point_random_targets", "--runs",
+            str(tmp_path / "runs"), "--results", str(results)]
+    assert agent_ablation.main(argv) == 0
+    after = json.loads((results / "agent_ablation.json").read_text())
+    assert trained == ["no_pointing_term", "default"]
+    assert list(after) == [name for name in agent_ablation.ABLATIONS if name in before or name in (
+        "point_no_pointing_term", "point_random_targets")]
+    assert after["point_no_pointing_term"] == after["point_random_targets"] == measured
+    assert all(after[name] == before[name] for name in before if name not in ("point_random_targets",))
+    assert "| neither | 7 |" in (results / "agent_ablation.md").read_text()
