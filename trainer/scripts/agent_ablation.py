@@ -30,7 +30,8 @@ ABLATIONS = {
     "wave_paper_objective": ("wave", "paper_wave_objective", "rlanimate", "the paper's objective"),
     "wave_reference_posterior": ("wave", "reference_posterior", "single_state",
                                  "behaviour state on the clip, prior at play"),
-    "point_random_targets": ("point", "default", "rlanimate", "pointing term and random targets (chosen)"),
+    "point_random_targets": ("point", "default", "rlanimate",
+                             "pointing term and three random targets per iteration, range + 10 degrees (chosen)"),
     "point_no_random_targets": ("point", "no_random_targets", "rlanimate", "pointing term only"),
     "point_no_pointing_term": ("point", "no_pointing_term", "rlanimate", "neither"),
 }
