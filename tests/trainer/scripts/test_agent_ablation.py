@@ -16,13 +16,14 @@ def test_only_replaces_its_rows_and_keeps_the_others(tmp_path, monkeypatch):
     monkeypatch.setattr(agent_ablation, "LibrarySession", lambda manifest: None)
     monkeypatch.setattr(agent_ablation, "train", lambda settings, session: trained.append(settings.preset))
     monkeypatch.setattr(agent_ablation, "measure", lambda path, behaviour, session, targets: measured)
-    argv = ["agent_ablation", "--only", "point_no_pointing_term", "point_random_targets", "--runs",
+    rerun = ["point_no_pointing_term", "point_random_targets"]
+    argv = ["agent_ablation", "--only", *rerun, "--runs",
             str(tmp_path / "runs"), "--results", str(results)]
     assert agent_ablation.main(argv) == 0
     after = json.loads((results / "agent_ablation.json").read_text())
     assert trained == ["no_pointing_term", "default"]
-    assert list(after) == [name for name in agent_ablation.ABLATIONS if name in before or name in (
-        "point_no_pointing_term", "point_random_targets")]
+    assert list(after) == [name for name in agent_ablation.ABLATIONS if name in before or name in rerun]
     assert after["point_no_pointing_term"] == after["point_random_targets"] == measured
-    assert all(after[name] == before[name] for name in before if name not in ("point_random_targets",))
+    kept = [name for name in before if name not in rerun]
+    assert kept and all(after[name] == before[name] for name in kept)
     assert "| neither | 7 |" in (results / "agent_ablation.md").read_text()
