@@ -16,14 +16,17 @@ import numpy as np
 import torch
 
 from rlanimate_addon.core import kinematics
+from trainer.agent.config import load_preset
 from trainer.agent.run import RunSettings, train
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
 from trainer.evaluation.baselines import AgentMethod
+from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, shown
 from trainer.reporting.tables import markdown_table
 from trainer.scripts.cli import run_main, script_args
 
+_CHOSEN = load_preset("default")[1]
 #: name: (behaviour, preset, variant, label)
 ABLATIONS = {
     "wave_rhythm": ("wave", "default", "rlanimate", "rhythm in the objective (chosen)"),
@@ -31,7 +34,8 @@ ABLATIONS = {
     "wave_reference_posterior": ("wave", "reference_posterior", "single_state",
                                  "behaviour state on the clip, prior at play"),
     "point_random_targets": ("point", "default", "rlanimate",
-                             "pointing term and three random targets per iteration, range + 10 degrees (chosen)"),
+                             f"pointing term and {_CHOSEN.random_targets} random targets per iteration, range + "
+                             f"{_CHOSEN.random_target_margin_deg:g} degrees (chosen)"),
     "point_no_random_targets": ("point", "no_random_targets", "rlanimate", "pointing term only"),
     "point_no_pointing_term": ("point", "no_pointing_term", "rlanimate", "neither"),
 }
@@ -126,8 +130,8 @@ def main(argv=None):
     torch.set_num_threads(1)
     session = LibrarySession(DEFAULT_MANIFEST)
     results_dir = Path(options.results)
-    kept = results_dir / "agent_ablation.json"
-    results = json.loads(kept.read_text()) if options.only and kept.is_file() else {}
+    results_json = results_dir / "agent_ablation.json"
+    results = json.loads(results_json.read_text()) if options.only and results_json.is_file() else {}
     for name in options.only or ABLATIONS:
         behaviour_name, preset, variant, _ = ABLATIONS[name]
         output = Path(options.runs) / name
@@ -139,8 +143,8 @@ def main(argv=None):
     results = {name: results[name] for name in ABLATIONS if name in results}
     command = f"nice -n 10 python -m trainer.scripts.agent_ablation --runs {shown(options.runs)}"
     results_dir.mkdir(parents=True, exist_ok=True)
-    kept.write_text(json.dumps(results, indent=1) + "\n")
-    (results_dir / "agent_ablation.md").write_text(markdown(results, command))
+    atomic_write_text(results_json, json.dumps(results, indent=1) + "\n")  # it holds rows not rerun here
+    atomic_write_text(results_dir / "agent_ablation.md", markdown(results, command))
     print((results_dir / "agent_ablation.md").read_text())
     return 0
 
