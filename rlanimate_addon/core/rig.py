@@ -32,8 +32,8 @@ class RigSkeleton:
         self.rest = np.asarray(rest, dtype=np.float64)
         self.lengths = np.asarray(lengths, dtype=np.float64)
         # Rest of each bone relative to its parent's rest (B, 4, 4).
-        self._rest_local = np.array([r if p < 0 else np.linalg.inv(self.rest[p]) @ r
-                                     for r, p in zip(self.rest, self.parents)])
+        self._rest_local = np.where((self.parents < 0)[:, None, None], self.rest,
+                                    inverse(self.rest[self.parents]) @ self.rest)
 
     def rest_frame(self, name):
         """(3, 3) armature-space rest rotation of a bone (columns: its local X, Y, Z axes, unit length)."""
@@ -66,17 +66,19 @@ class RigSkeleton:
         Only the bones named in `only` and their ancestors are updated; the others keep `pose`.
         """
         changed = set(changed)
+        bones = self._evaluation_order(only)
+        slot = {i: k for k, i in enumerate(bones)}
+        pose_inverse, basis_inverse = inverse(pose[:, bones]), inverse(basis[:, bones])  # (N, len(bones), 4, 4)
         out = np.array(pose, dtype=np.float64)
         moved = np.zeros(len(self.names), dtype=bool)
-        for i in sorted({i for name in only for i in self.ancestors(name)},
-                        key=lambda i: len(self.ancestors(self.names[i]))):
+        for i in bones:
             parent = self.parents[i]
             follows = parent >= 0 and moved[parent]
             if i not in changed and not follows:
                 continue
             local = basis[:, i] if i not in changed else new_basis[:, i]
-            placed = pose[:, i] @ inverse(basis[:, i]) @ local
-            out[:, i] = out[:, parent] @ inverse(pose[:, parent]) @ placed if follows else placed
+            placed = pose[:, i] @ basis_inverse[:, slot[i]] @ local
+            out[:, i] = out[:, parent] @ pose_inverse[:, slot[parent]] @ placed if follows else placed
             moved[i] = True
         return out
 
@@ -85,10 +87,13 @@ class RigSkeleton:
 
         Only the bones named in `only` and their ancestors are evaluated; the others are NaN.
         """
-        evaluated = sorted({i for name in only for i in self.ancestors(name)}, key=lambda i: len(self.ancestors(self.names[i])))
         pose = np.full(np.shape(basis), np.nan)
-        for i in evaluated:
+        for i in self._evaluation_order(only):
             local = self._rest_local[i] @ basis[..., i, :, :]
             parent = self.parents[i]
             pose[..., i, :, :] = local if parent < 0 else pose[..., parent, :, :] @ local
         return pose
+
+    def _evaluation_order(self, only):
+        """Indices of the bones named in `only` and their ancestors, parents before children."""
+        return sorted({i for name in only for i in self.ancestors(name)}, key=lambda i: len(self.ancestors(self.names[i])))
