@@ -2,7 +2,7 @@
 import bpy
 import numpy as np
 
-from ..core import channels, gesture, key_reduction, rig_roles
+from ..core import blas_threads, channels, gesture, key_reduction, rig_roles
 from ..core.errors import RLAnimateError
 from . import armature_io, constraints, preferences, properties
 
@@ -89,33 +89,35 @@ def _check(obj, settings, start, end, mute_constraints):
 
 
 def _compute(context, plan, settings, agent, frames):
-    """Fill in the plan's gesture and keys (nothing written)."""
-    obj, scene = plan.obj, context.scene
-    original_frame = scene.frame_current
-    target = settings.target if settings.behaviour == "POINT" else None
-    try:
-        rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
-                                                            settings.target_bone if target else "")
-    finally:
-        if scene.frame_current != original_frame:
-            scene.frame_set(original_frame)
-    request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
-                                     targets=targets if settings.behaviour == "POINT" else None,
-                                     exaggeration=settings.exaggeration, seed=settings.seed or None,
-                                     exact_aim=settings.exact_aim)
-    plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
-    plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
-    plan.keys = {}
-    for column, bone in enumerate(plan.bones):
-        mode = obj.pose.bones[bone].rotation_mode
-        values = channels.rotation_keys(mode, keyed[:, column], below[:, column], below_values[bone],
-                                        plan.blend_type)
-        kept = None
-        if settings.editable_keys:
-            added = below_values[bone] if plan.blend_type == "COMBINE" and mode != "QUATERNION" else None
-            kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
-            plan.worst = max(plan.worst, deviation)
-        plan.keys[bone] = (mode, values, kept)
+    """Fill in the plan's gesture and keys (nothing written), on one BLAS thread: every product here is
+    small, and on a machine with busy cores BLAS threads only wait (core/blas_threads.py)."""
+    with blas_threads.single_blas_thread():
+        obj, scene = plan.obj, context.scene
+        original_frame = scene.frame_current
+        target = settings.target if settings.behaviour == "POINT" else None
+        try:
+            rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
+                                                                settings.target_bone if target else "")
+        finally:
+            if scene.frame_current != original_frame:
+                scene.frame_set(original_frame)
+        request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
+                                         targets=targets if settings.behaviour == "POINT" else None,
+                                         exaggeration=settings.exaggeration, seed=settings.seed or None,
+                                         exact_aim=settings.exact_aim)
+        plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
+        plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
+        plan.keys = {}
+        for column, bone in enumerate(plan.bones):
+            mode = obj.pose.bones[bone].rotation_mode
+            values = channels.rotation_keys(mode, keyed[:, column], below[:, column], below_values[bone],
+                                            plan.blend_type)
+            kept = None
+            if settings.editable_keys:
+                added = below_values[bone] if plan.blend_type == "COMBINE" and mode != "QUATERNION" else None
+                kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
+                plan.worst = max(plan.worst, deviation)
+            plan.keys[bone] = (mode, values, kept)
 
 
 def generate(context, settings, progress=lambda step: None, mute_constraints=False):
