@@ -11,6 +11,7 @@ file the user loads in the panel (JSON: {"family": name, "bones": {role: bone na
 import json
 import re
 from collections import namedtuple
+from functools import lru_cache
 
 from .errors import RLAnimateError
 
@@ -116,8 +117,10 @@ FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, CHARACTER
 _MIXAMO_PREFIX = re.compile(r"^mixamorig\d*_?")
 
 
+@lru_cache(maxsize=4096)
 def name_key(name):
-    """A bone name as matching compares it: namespace and Mixamo prefix dropped, lower case."""
+    """A bone name as matching compares it: namespace and Mixamo prefix dropped, lower case (cached:
+    detection compares every bone with every family's names on each Generate)."""
     return _MIXAMO_PREFIX.sub("", re.split(r"[:|]", name)[-1].lower())
 
 
