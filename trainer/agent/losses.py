@@ -61,9 +61,10 @@ def agent_losses(agent, batch, config, bounds=None):
                           if described is not None and config.portrayal_direct_loss
                           else torch.zeros((), dtype=objective.dtype))
     terms["pointing"] = torch.zeros((), dtype=objective.dtype)
-    if bounds is not None and "hold" in batch and float(batch["hold"].sum()) > 0:
-        errors = pointing.pointing_error(policy.mean, objective, torch.as_tensor(bounds, dtype=objective.dtype))
-        terms["pointing"] = (errors * batch["hold"]).sum() / batch["hold"].sum()
+    hold = batch["hold"] > 0.5 if "hold" in batch else None  # (C, L)
+    if bounds is not None and hold is not None and hold.any():
+        terms["pointing"] = pointing.pointing_error(policy.mean[hold], objective[hold],
+                                                    torch.as_tensor(bounds, dtype=objective.dtype)).mean()
     terms["policy"] = masked_mean(concentration_nll(policy, motion), imitate)
     scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
               "portrayal": config.portrayal_scale, "pointing": config.pointing_scale, "policy": config.policy_scale}

@@ -51,16 +51,17 @@ class FingerKinematics:
     def finger(self, rotvecs, arm):
         """rotvecs (..., 15, 3) -> index base (..., 3) and unit finger direction (..., 3)."""
         local, columns = self._chains[arm]
-        pose = None
+        local = local.to(rotvecs.dtype)
+        rotation, position = None, None  # the world rotation (..., 3, 3) and head (..., 3) down the chain
         heads = []
         for k, column in enumerate(columns):
-            matrix = local[k].to(rotvecs.dtype).expand(rotvecs.shape[:-2] + (4, 4))
-            if column is not None:
-                rotation = _rotvec_to_matrix(rotvecs[..., column, :])
-                matrix = torch.cat([torch.cat([matrix[..., :3, :3] @ rotation, matrix[..., :3, 3:]], -1),
-                                    matrix[..., 3:, :]], -2)
-            pose = matrix if pose is None else pose @ matrix
-            heads.append(pose[..., :3, 3])
+            turn = local[k, :3, :3] if column is None else local[k, :3, :3] @ _rotvec_to_matrix(rotvecs[..., column, :])
+            if rotation is None:
+                rotation, position = turn.expand(rotvecs.shape[:-2] + (3, 3)), local[k, :3, 3].expand(rotvecs.shape[:-2] + (3,))
+            else:
+                position = position + (rotation @ local[k, :3, 3:])[..., 0]
+                rotation = rotation @ turn
+            heads.append(position)
         base, tip = heads[-4], heads[-1]  # HandIndex1 and HandIndex4 heads
         direction = tip - base
         return base, direction / direction.norm(dim=-1, keepdim=True)
@@ -78,17 +79,21 @@ def _rotvec_to_matrix(rotvec):
 
 
 def pointing_error(actions, objectives, bounds):
-    """(...) per-frame pointing term of actions (..., 45) in [0, 1] against POINT objectives (..., 7)."""
+    """(N,) pointing term of actions (N, 45) in [0, 1] against POINT objectives (N, 7): pass only the
+    frames that count (the hold), since forward kinematics is most of a training step's cost."""
     low, high = bounds[:, 0], bounds[:, 1]
     rotvecs = (low + actions * (high - low)).reshape(actions.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
     ray = objectives[..., spaces.OBJECTIVE_ATTRIBUTES]
-    error = torch.zeros(actions.shape[:-1], dtype=actions.dtype)
+    error = actions.new_zeros(actions.shape[:-1])
     for k, arm in enumerate(skeleton.ARMS):
-        base, finger = FINGERS.finger(rotvecs, arm)
+        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5  # the frames this arm points on
+        if not mine.any():
+            continue
+        base, finger = FINGERS.finger(rotvecs[mine], arm)
         offset = base - torch.as_tensor(skeleton.shoulder_rest_position(arm), dtype=actions.dtype)
-        across = offset - (offset * ray).sum(-1, keepdim=True) * ray
-        term = (finger - ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
-        error = error + objectives[..., spaces.OBJECTIVE_ARM][..., k] * term
+        across = offset - (offset * ray[mine]).sum(-1, keepdim=True) * ray[mine]
+        term = (finger - ray[mine]).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
+        error = error.index_put((mine,), term)
     return error
 
 
