@@ -189,7 +189,8 @@ class Trainer:
         self.agent.train()
         totals = {}
         for _ in range(config.update_steps):
-            batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng)
+            batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng,
+                                              config.random_target_weight)
             losses = self.agent.losses(batch, config, self.bounds)
             self.optimizer.zero_grad(set_to_none=True)
             losses["total"].backward()

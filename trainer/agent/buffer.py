@@ -6,8 +6,8 @@ An episode is a mapping of per-frame arrays that share their first (time) axis:
     hold (F,) (1 where the clip holds its point on its objective's ray: trainer/agent/pointing.py),
     imitate (F,) (1 where the episode imitates its clip; 0 for a pointing request at a random target,
     which only borrows a clip's length and hold timing).
-`sample_chunks` draws C chunks of L consecutive frames, each from an episode chosen uniformly at
-random, starting at its first frame with probability FIRST_FRAME_SHARE and otherwise at a uniformly
+`sample_chunks` draws C chunks of L consecutive frames, each from an episode chosen at random (a
+random-target episode with `unimitated_weight` times a clip episode's chance), starting at its first frame with probability FIRST_FRAME_SHARE and otherwise at a uniformly
 random frame, and stacks them batch-major: (C, L, ...). Uniform starts alone would show the agent a
 gesture's first frame, where the unroll starts from a_0 in the middle of every channel, in about one
 chunk in 85, and its rollouts started some 20 degrees off the neutral arm.
@@ -39,16 +39,19 @@ class EpisodeBuffer:
             raise ValueError(f"Episode arrays disagree on their frame count: {lengths}")
         self.episodes.append({key: np.asarray(episode[key], dtype=np.float32) for key in EPISODE_KEYS})
 
-    def sample_chunks(self, count, length, rng):
+    def sample_chunks(self, count, length, rng, unimitated_weight=1.0):
         """`count` chunks of `length` frames as {key: (C, L, ...) float32 tensor}.
 
-        `length` is capped at the shortest episode, so every chunk is whole. `rng` is a
-        numpy Generator, the only source of randomness, so sampling is reproducible.
+        `length` is capped at the shortest episode, so every chunk is whole. Episodes that imitate no
+        clip are drawn `unimitated_weight` times as often as those that do. `rng` is a numpy
+        Generator, the only source of randomness, so sampling is reproducible.
         """
         if not self.episodes:
             raise ValueError("The episode buffer is empty: collect an episode before sampling.")
         length = min(int(length), min(len(e["objective"]) for e in self.episodes))
-        picks = rng.integers(0, len(self.episodes), size=count)
+        weights = np.array([1.0 if e["imitate"][0] else unimitated_weight for e in self.episodes])
+        uniform = np.all(weights == weights[0])  # then the draws of runs from before the weights, unchanged
+        picks = rng.choice(len(self.episodes), size=count, p=None if uniform else weights / weights.sum())
         chunks = {key: [] for key in EPISODE_KEYS}
         for index in picks:
             episode = self.episodes[index]

@@ -56,6 +56,7 @@ class TrainConfig:
     portrayal_scale: float = 1.0  # ... with this scale (MSE, summed over the 42 numbers)
     random_targets: int = 1  # pointing requests at random targets per iteration (pointing term only)
     random_target_margin_deg: float = 0.0  # random directions reach this far past the clips' azimuth and elevation
+    random_target_weight: float = 1.0  # a random-target episode's chance in the update batch, relative to a clip's
     pointing_scale: float = 100.0  # the finger line against the objective's ray at the hold (squared radians)
     policy_scale: float = 0.01  # Beta concentrations fitted by NLL of the clip's pose (mean detached)
     posterior_on_reference: bool = False  # single_state: condition the posterior on the clip's description
@@ -75,7 +76,7 @@ def _known_fields(cls, values):
 
 
 _DEFAULT_TRAIN = TrainConfig(update_steps=160, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4,
-                             random_targets=3, random_target_margin_deg=10.0)
+                             random_targets=3, random_target_margin_deg=20.0, random_target_weight=1 / 3)
 PRESETS = {
     "debug": (
         AgentConfig(task_size=8, behaviour_size=8, stochastic_size=4, hidden_size=8,

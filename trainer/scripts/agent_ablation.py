@@ -35,7 +35,8 @@ ABLATIONS = {
                                  "behaviour state on the clip, prior at play"),
     "point_random_targets": ("point", "default", "rlanimate",
                              f"pointing term and {_CHOSEN.random_targets} random targets per iteration, range + "
-                             f"{_CHOSEN.random_target_margin_deg:g} degrees (chosen)"),
+                             f"{_CHOSEN.random_target_margin_deg:g} degrees, each drawn into updates at "
+                             f"{_CHOSEN.random_target_weight:.2g}x a clip's chance (chosen)"),
     "point_no_random_targets": ("point", "no_random_targets", "rlanimate", "pointing term only"),
     "point_no_pointing_term": ("point", "no_pointing_term", "rlanimate", "neither"),
 }

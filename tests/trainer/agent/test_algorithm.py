@@ -48,6 +48,17 @@ def test_a_share_of_chunks_starts_at_the_first_frame():
     assert len(np.unique(starts)) > 150  # the others anywhere
 
 
+def test_random_target_episodes_are_drawn_at_their_weight():
+    buffer = EpisodeBuffer()
+    for k in range(6):
+        episode = _episode(20, 1000 * k)
+        episode["imitate"] = np.full(20, float(k < 3))  # three clip episodes, then three random-target ones
+        buffer.add(episode)
+    for weight, share in ((1.0, 0.5), (1 / 3, 0.25)):
+        firsts = buffer.sample_chunks(4000, 5, np.random.default_rng(2), weight)["objective"][:, 0, 0].numpy()
+        assert abs(np.mean(firsts >= 3000) - share) < 0.03
+
+
 def test_chunk_length_is_capped_at_the_shortest_episode():
     buffer = EpisodeBuffer()
     buffer.add(_episode(12, 0))

@@ -92,7 +92,8 @@ def test_resumed_run_equals_the_uninterrupted_run(session, tmp_path):
 def test_a_run_killed_mid_schedule_resumes_exactly(session, tmp_path):
     """Kill after 2 of 4 planned epochs (learning rate mid-decay), rebuild from the file, continue."""
     agent_config, train_config = load_preset("debug")
-    train_config = dataclasses.replace(train_config, learning_rate=3e-3, learning_rate_final=1e-4)
+    train_config = dataclasses.replace(train_config, learning_rate=3e-3, learning_rate_final=1e-4,
+                                       random_targets=2, random_target_weight=0.5)  # weighted chunk draws too
 
     def fresh_trainer():
         torch.manual_seed(0)
