@@ -49,22 +49,32 @@ def matrix_to_quat(matrix):
     m = np.asarray(matrix, dtype=np.float64)
     batch = m.shape[:-2]
     m = m.reshape(-1, 3, 3)
-    diagonal = np.einsum("nii->ni", m)  # (N, 3)
-    trace = diagonal.sum(axis=1)
-    # Derive each quaternion from its numerically largest of 4w^2, 4x^2, 4y^2, 4z^2 (one candidate per row).
-    largest = np.stack([1.0 + trace, 1.0 + 2.0 * diagonal[:, 0] - trace, 1.0 + 2.0 * diagonal[:, 1] - trace,
-                        1.0 + 2.0 * diagonal[:, 2] - trace], axis=1)  # (N, 4)
-    differences = np.stack([m[:, 2, 1] - m[:, 1, 2], m[:, 0, 2] - m[:, 2, 0], m[:, 1, 0] - m[:, 0, 1]], axis=1)
-    sums = np.stack([m[:, 0, 1] + m[:, 1, 0], m[:, 0, 2] + m[:, 2, 0], m[:, 1, 2] + m[:, 2, 1]], axis=1)
-    dx, dy, dz = differences.T
-    sxy, sxz, syz = sums.T
-    candidates = np.stack([  # (N, 4 candidates, 4), each 4 * (that component) * quaternion
-        np.stack([largest[:, 0], dx, dy, dz], axis=1),
-        np.stack([dx, largest[:, 1], sxy, sxz], axis=1),
-        np.stack([dy, sxy, largest[:, 2], syz], axis=1),
-        np.stack([dz, sxz, syz, largest[:, 3]], axis=1)], axis=1)
-    choice = np.argmax(largest, axis=1)
-    q = candidates[np.arange(len(m)), choice]
+    trace = np.trace(m, axis1=1, axis2=2)
+    # Pick the numerically largest of w, x, y, z per matrix and derive the rest from it.
+    candidates = np.stack([trace, m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]], axis=1)
+    choice = np.argmax(candidates, axis=1)
+    q = np.empty((m.shape[0], 4))
+    for k in range(4):
+        sel = choice == k
+        if not np.any(sel):
+            continue
+        s = m[sel]
+        if k == 0:
+            r = np.sqrt(1.0 + trace[sel]) * 2.0
+            q[sel] = np.stack([0.25 * r, (s[:, 2, 1] - s[:, 1, 2]) / r,
+                               (s[:, 0, 2] - s[:, 2, 0]) / r, (s[:, 1, 0] - s[:, 0, 1]) / r], axis=1)
+        elif k == 1:
+            r = np.sqrt(1.0 + s[:, 0, 0] - s[:, 1, 1] - s[:, 2, 2]) * 2.0
+            q[sel] = np.stack([(s[:, 2, 1] - s[:, 1, 2]) / r, 0.25 * r,
+                               (s[:, 0, 1] + s[:, 1, 0]) / r, (s[:, 0, 2] + s[:, 2, 0]) / r], axis=1)
+        elif k == 2:
+            r = np.sqrt(1.0 + s[:, 1, 1] - s[:, 0, 0] - s[:, 2, 2]) * 2.0
+            q[sel] = np.stack([(s[:, 0, 2] - s[:, 2, 0]) / r, (s[:, 0, 1] + s[:, 1, 0]) / r,
+                               0.25 * r, (s[:, 1, 2] + s[:, 2, 1]) / r], axis=1)
+        else:
+            r = np.sqrt(1.0 + s[:, 2, 2] - s[:, 0, 0] - s[:, 1, 1]) * 2.0
+            q[sel] = np.stack([(s[:, 1, 0] - s[:, 0, 1]) / r, (s[:, 0, 2] + s[:, 2, 0]) / r,
+                               (s[:, 1, 2] + s[:, 2, 1]) / r, 0.25 * r], axis=1)
     q = np.where(q[:, :1] < 0.0, -q, q)
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     return q.reshape(batch + (4,))
