@@ -96,4 +96,5 @@ class RigSkeleton:
 
     def _evaluation_order(self, only):
         """Indices of the bones named in `only` and their ancestors, parents before children."""
-        return sorted({i for name in only for i in self.ancestors(name)}, key=lambda i: len(self.ancestors(self.names[i])))
+        return sorted({i for name in only for i in self.ancestors(name)},
+                      key=lambda i: len(self.ancestors(self.names[i])))

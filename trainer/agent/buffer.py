@@ -7,10 +7,11 @@ An episode is a mapping of per-frame arrays that share their first (time) axis:
     imitate (F,) (1 where the episode imitates its clip; 0 for a pointing request at a random target,
     which only borrows a clip's length and hold timing).
 `sample_chunks` draws C chunks of L consecutive frames, each from an episode chosen at random (a
-random-target episode with `unimitated_weight` times a clip episode's chance), starting at its first frame with probability FIRST_FRAME_SHARE and otherwise at a uniformly
-random frame, and stacks them batch-major: (C, L, ...). Uniform starts alone would show the agent a
-gesture's first frame, where the unroll starts from a_0 in the middle of every channel, in about one
-chunk in 85, and its rollouts started some 20 degrees off the neutral arm.
+random-target episode with `unimitated_weight` times a clip episode's chance), starting at its first
+frame with probability FIRST_FRAME_SHARE and otherwise at a uniformly random frame, and stacks them
+batch-major: (C, L, ...). Uniform starts alone would show the agent a gesture's first frame, where
+the unroll starts from a_0 in the middle of every channel, in about one chunk in 85, and its
+rollouts started some 20 degrees off the neutral arm.
 """
 import numpy as np
 import torch

@@ -52,12 +52,13 @@ class FingerKinematics:
         """rotvecs (..., 15, 3) -> index base (..., 3) and unit finger direction (..., 3)."""
         local, columns = self._chains[arm]
         local = local.to(rotvecs.dtype)
+        batch = rotvecs.shape[:-2]
         rotation, position = None, None  # the world rotation (..., 3, 3) and head (..., 3) down the chain
         heads = []
         for k, column in enumerate(columns):
             turn = local[k, :3, :3] if column is None else local[k, :3, :3] @ _rotvec_to_matrix(rotvecs[..., column, :])
             if rotation is None:
-                rotation, position = turn.expand(rotvecs.shape[:-2] + (3, 3)), local[k, :3, 3].expand(rotvecs.shape[:-2] + (3,))
+                rotation, position = turn.expand(batch + (3, 3)), local[k, :3, 3].expand(batch + (3,))
             else:
                 position = position + (rotation @ local[k, :3, 3:])[..., 0]
                 rotation = rotation @ turn
@@ -90,9 +91,10 @@ def pointing_error(actions, objectives, bounds):
         if not mine.any():
             continue
         base, finger = FINGERS.finger(rotvecs[mine], arm)
+        arm_ray = ray[mine]
         offset = base - torch.as_tensor(skeleton.shoulder_rest_position(arm), dtype=actions.dtype)
-        across = offset - (offset * ray[mine]).sum(-1, keepdim=True) * ray[mine]
-        term = (finger - ray[mine]).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
+        across = offset - (offset * arm_ray).sum(-1, keepdim=True) * arm_ray
+        term = (finger - arm_ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
         error = error.index_put((mine,), term)
     return error
 
