@@ -1,8 +1,11 @@
 """The real-mocap results as a page (docs/results/realmocap.md) and a figure of real and generated frames."""
+from collections import defaultdict
+
 import matplotlib
+import numpy as np
 
 from rlanimate_addon.core import skeleton
-from trainer.motion.realmocap_takes import HOLDOUT_STYLES
+from trainer.motion.realmocap_takes import HOLDOUT_STYLES, parse_name
 from trainer.reporting.baselines_report import METHOD_LABELS
 from trainer.reporting.tables import markdown_table
 
@@ -44,12 +47,31 @@ def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
     plt.close(figure)
 
 
+def per_style_rows(set_label, methods):
+    """Rows of the per-style table for one test set: {method: result with per-clip 'clips'} -> per style
+    and method, the mean score and DTW score, the median swing and frequency ratios and the waves accepted."""
+    rows = []
+    for method, result in methods.items():
+        by_style = defaultdict(list)
+        for clip in result["clips"]:
+            by_style[parse_name(clip["name"])["style"]].append(clip)
+        for style, clips in by_style.items():
+            def values(key):
+                return np.array([clip[key] for clip in clips], dtype=np.float64)
+            rows.append((style, method, [set_label, style, METHOD_LABELS[method], len(clips),
+                                         f"{values('score').mean():.1f}", f"{values('aligned_score').mean():.1f}",
+                                         f"{np.median(values('swing_ratio')):.2f}",
+                                         f"{np.median(values('frequency_ratio')):.2f}",
+                                         f"{int(values('wave_accepted').sum())}/{len(clips)}"]))
+    return [row for _, _, row in sorted(rows, key=lambda item: (item[0], list(methods).index(item[1])))]
+
+
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
     label_rows = [[style, f"{row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f}", f"{row['elevation_deg']:.0f}",
                    f"{row['stroke_arm_lengths']:.2f}", f"{row['arm_correct']}/{row['clips']}"]
                   for style, row in results["labels"]["wave"].items()]
-    score_rows = []
+    score_rows, behaviour_rows, style_rows = [], [], []
     for name, label in (("wave", "wave agent, takes 001-008 (112 clips)"),
                         ("holdout", f"wave agent, 5 styles (100 clips; unseen: {', '.join(HOLDOUT_STYLES)})")):
         entry = results[name]
@@ -57,6 +79,13 @@ def realmocap_markdown(results):
             for method, result in entry.get(set_name, {}).items():
                 score_rows.append([label, f"{set_name} ({len(result['clips'])})", METHOD_LABELS[method],
                                    f"{result['score']:.2f}", f"{result['smoothness']:.2f}", f"{result['label_error']:.3f}"])
+                wave = result["by_behaviour"]["wave"]
+                behaviour_rows.append([label, f"{set_name} ({len(result['clips'])})", METHOD_LABELS[method],
+                                       f"{wave['aligned_score']:.2f}", f"{wave['swing_ratio_median']:.2f}",
+                                       f"{wave['frequency_ratio_median']:.2f}", f"{wave['cycles_median']:.0f}",
+                                       f"{round(wave['accepted_share'] * len(result['clips']))}/{len(result['clips'])}"])
+        if "test" in entry:
+            style_rows += per_style_rows("takes 009-010" if name == "wave" else "unseen styles", entry["test"])
         score_rows.append([label, "seen (10 training clips)", "RLAnimate", f"{entry['seen']['score']:.2f}",
                            f"{entry['seen']['smoothness']:.2f}", ""])
     bye = results["labels"]["bye"].items()
@@ -72,6 +101,18 @@ def realmocap_markdown(results):
              "## Score and smoothness", "",
              "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
              *markdown_table(["experiment", "test set", "method", "score", "smoothness", "label error"], score_rows),
+             "", "## Behaviour", "",
+             "Each generated wave against the real take for the same request (docs/METRICS.md): the score after "
+             "time alignment (DTW), the medians of the swing and frequency ratios (issue 10 asks 0.75-1.33x "
+             "and 0.8-1.2x) and of the full cycles while the hand is up, and the waves that "
+             "`core.behaviour_metrics` accepts.", "",
+             *markdown_table(["experiment", "test set", "method", "DTW score", "swing ratio", "frequency ratio",
+                              "cycles", "accepted"], behaviour_rows),
+             "", "### Per style", "",
+             "Mean score and DTW score, median swing and frequency ratios over a style's test takes (takes "
+             "009-010: two takes x two arms; unseen styles: ten takes x two arms).", "",
+             *markdown_table(["test set", "style", "method", "takes", "score", "DTW score", "swing ratio",
+                              "frequency ratio", "accepted"], style_rows),
              "", f"Training: wave agent {results['wave']['episodes']} episodes, "
              f"{results['wave']['train_seconds']:.0f} s; hold-out agent {results['holdout']['episodes']} episodes, "
              f"{results['holdout']['train_seconds']:.0f} s (1 torch thread).", "",
