@@ -36,13 +36,15 @@ SUPPORTED_LENGTH = (0.4, 1.5)
 BLEND_FRACTION = 0.2
 
 #: Bones of the pointing hand shape, with their canonical local rotation vectors (radians): the
-#: thumb tucked and the three other fingers curled towards the palm (negative about the local X
-#: axis curls a finger of either hand towards the palm of the T-pose).
+#: thumb tucked, the three other fingers curled towards the palm (negative about the local X axis
+#: curls a finger of either hand towards the palm of the T-pose) and the index straight beyond its
+#: base (Index1 is the agent's), whatever curl the rig's fingers rest in.
 _CURL = {"1": 1.2, "2": 1.4, "3": 1.0}
 POINTING_HAND = {
     **{f"{finger}{k}": (-angle, 0.0, 0.0)
        for finger in ("HandMiddle", "HandRing", "HandPinky") for k, angle in _CURL.items()},
     "HandThumb1": (-0.35, 0.0, 0.25), "HandThumb2": (-0.5, 0.0, 0.0), "HandThumb3": (-0.4, 0.0, 0.0),
+    "HandIndex2": (0.0, 0.0, 0.0), "HandIndex3": (0.0, 0.0, 0.0),
 }
 
 
@@ -184,26 +186,50 @@ def retarget(canonical_rotvecs, conversions, parent_conversions=None):
 
 #: Role whose rest head a bone's rest direction points to, for the bones whose rest pose differs
 #: between rigs (T- or A-pose arms, relaxed or straight fingers); the spine, neck and head rest upright.
+_FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")
 _DIRECTION_TO = {f"{side}{bone}": f"{side}{child}" for side in ("Left", "Right")
                  for bone, child in (("Shoulder", "Arm"), ("Arm", "ForeArm"), ("ForeArm", "Hand"),
                                      ("Hand", "HandMiddle1"))
-                 + tuple((f"Hand{finger}{k}", f"Hand{finger}{k + 1}")
-                         for finger in ("Thumb", "Index", "Middle", "Ring", "Pinky") for k in (1, 2))}
+                 + tuple((f"Hand{finger}{k}", f"Hand{finger}{k + 1}") for finger in _FINGERS for k in (1, 2, 3))}
+#: Each finger's last posable bone: without the end bone after it, its direction comes from its tail.
+_FINGER_LAST = {f"{side}Hand{finger}3" for side in ("Left", "Right") for finger in _FINGERS}
+#: A finger's last bone follows its own tail (when the rig has no fourth bone) only within this many
+#: degrees of the bone before it: an imported rig's tails need not run along the finger.
+_TAIL_TRUST_DEG = 45.0
 
 
-def rest_swings(roles, rest_heads, to_character):
+def _rest_direction(name, rest_heads, rest_tails):
+    """(3,) the rig's rest direction of role `name` (armature space), or None: towards the head of the
+    role it points to, else, for a finger's last bone, along its own tail while that continues the
+    finger (within _TAIL_TRUST_DEG of the bone before it)."""
+    child = _DIRECTION_TO.get(name)
+    if child is None or name not in rest_heads:
+        return None
+    if child in rest_heads:
+        return np.subtract(rest_heads[child], rest_heads[name])
+    before = skeleton.BONE_BY_NAME[name].parent
+    if name not in _FINGER_LAST or name not in rest_tails or before not in rest_heads:
+        return None
+    own, previous = np.subtract(rest_tails[name], rest_heads[name]), np.subtract(rest_heads[name], rest_heads[before])
+    cos = own @ previous / (np.linalg.norm(own) * np.linalg.norm(previous))
+    return own if cos >= np.cos(np.radians(_TAIL_TRUST_DEG)) else None
+
+
+def rest_swings(roles, rest_heads, rest_tails, to_character):
     """{role: (3, 3)} D per role: the shortest rotation (character frame) taking the rig's rest
     direction of the bone onto the canonical one. Bones without a direction of their own (the spine,
-    the fingers) take their parent's (identity at the root).
+    a finger's last bone whose tail does not follow the finger) take their parent's (identity at the
+    root).
 
-    With it an A-pose rig plays the canonical rotations as a T-pose rig does: the arms hang, raise
-    and wave where the canonical skeleton's do, not 45 degrees lower, and a rig whose fingers rest
-    curled points with a straight index finger.
+    rest_heads, rest_tails: {role: (3,)} in the rig's armature space. With the swings an A-pose rig
+    plays the canonical rotations as a T-pose rig does: the arms hang, raise and wave where the
+    canonical skeleton's do, not 45 degrees lower, and a rig whose fingers rest curled points with a
+    straight index finger.
     """
     names = [n for n in skeleton.BONE_NAMES if n in roles]  # parents first
-    directed = [n for n in names if _DIRECTION_TO.get(n) in rest_heads]
-    rig = np.array([np.subtract(rest_heads[_DIRECTION_TO[n]], rest_heads[n]) for n in directed]).reshape(-1, 3)
-    rig = rig @ np.asarray(to_character).T
+    directions = {n: _rest_direction(n, rest_heads, rest_tails) for n in names}
+    directed = [n for n in names if directions[n] is not None]
+    rig = np.array([directions[n] for n in directed]).reshape(-1, 3) @ np.asarray(to_character).T
     canonical = np.array([np.subtract(skeleton.BONE_BY_NAME[_DIRECTION_TO[n]].head, skeleton.BONE_BY_NAME[n].head)
                           for n in directed]).reshape(-1, 3)
     turns = dict(zip(directed, aim.rotation_between(rig / np.linalg.norm(rig, axis=1, keepdims=True),
@@ -411,7 +437,7 @@ def gesture_rotations(agent, request, rig):
     bones = [rig.roles[n] for n in names]
     columns = [rig.skeleton.index[b] for b in bones]  # the eyes, keyed for Point, come after these
     to_character = character_frame(rest_heads)
-    swings = rest_swings(rig.roles, rest_heads, to_character)
+    swings = rest_swings(rig.roles, rest_heads, rig.rest_tails, to_character)
     frames = [rig.skeleton.rest_frame(b) for b in bones]
     conversions = retarget_matrices(names, frames, to_character, np.array([swings[n] for n in names]))
     parents = [_parent_role(n, rig.roles) for n in names]
@@ -498,6 +524,11 @@ class RigState:
     def rest_heads(self):
         """{role: (3,) rest head in armature space}."""
         return {role: self.skeleton.rest_head(bone) for role, bone in self.roles.items()}
+
+    @property
+    def rest_tails(self):
+        """{role: (3,) rest tail in armature space}."""
+        return {role: self.skeleton.tails(self.skeleton.rest, bone) for role, bone in self.roles.items()}
 
 
 def role_skeleton(roles, rest, lengths):

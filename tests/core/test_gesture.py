@@ -7,7 +7,7 @@ from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import (matrix_to_quat, quat_to_matrix, rotvec_to_matrix,
                                             rotvec_to_quat)
 
-RNG = np.random.default_rng()
+RNG = np.random.default_rng(11)
 
 
 def random_rotations(count):
@@ -232,6 +232,40 @@ def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
         for finger in ("Middle", "Ring", "Pinky"):
             tip = kinematics.bone_index(f"{prefix}Hand{finger}4")
             assert pose[tip, 2] < rest[tip, 2] - 0.02, f"{arm} {finger} must curl down, towards the palm"
+
+
+def test_the_pointing_index_is_straight_beyond_the_agents_base_joint():
+    names, rotvecs = gesture.pointing_hand_rotations("RIGHT", 2)
+    index = [n for n in names if "Index" in n]
+    assert index == ["RightHandIndex2", "RightHandIndex3"]
+    assert np.all(rotvecs[:, [names.index(n) for n in index]] == 0.0)
+
+
+def _curled(rest_heads, rest_tails, role, degrees):
+    """rest_tails with role's tail turned by `degrees` about the character's forward axis (Y) around its
+    head: a bend of a finger that runs sideways along X in the T-pose."""
+    turned = dict(rest_tails)
+    turn = rotvec_to_matrix(np.array([0.0, np.radians(degrees), 0.0]))
+    turned[role] = rest_heads[role] + turn @ np.subtract(rest_tails[role], rest_heads[role])
+    return turned
+
+
+def test_a_finger_whose_last_bone_rests_curled_is_swung_straight_by_its_own_tail():
+    rig = gesture.canonical_rig()
+    heads, tails = rig.rest_heads, rig.rest_tails
+    roles = {r: b for r, b in rig.roles.items() if r != "RightHandIndex4"}
+    heads = {r: h for r, h in heads.items() if r in roles}
+    last, before = "RightHandIndex3", "RightHandIndex2"
+    canonical = np.subtract(skeleton.BONE_BY_NAME["RightHandIndex4"].head, skeleton.BONE_BY_NAME[last].head)
+    curled = _curled(heads, tails, last, 25.0)
+    swings = gesture.rest_swings(roles, heads, curled, np.eye(3))
+    swung = swings[last] @ (curled[last] - heads[last])
+    assert np.allclose(swung / np.linalg.norm(swung), canonical / np.linalg.norm(canonical), atol=1e-9)
+    assert not np.allclose(swings[last], swings[before], atol=0.1)  # its own turn, not the bone before's
+    # a tail that does not follow the finger (an imported rig's bone axis) is not trusted
+    crossing = _curled(heads, tails, last, 90.0)
+    swings = gesture.rest_swings(roles, heads, crossing, np.eye(3))
+    assert np.allclose(swings[last], swings[before])
 
 
 @pytest.mark.parametrize("request_kwargs, message", [
