@@ -10,9 +10,9 @@ Wave, over the *hand-up run*: the longest run of frames whose wrist is at most H
 lengths below the same arm's shoulder joint. The side-to-side coordinate is the wrist's X relative to
 that shoulder; a *stroke* is one leg between turning points of it found with hysteresis
 STROKE_FRACTION x shoulder width (each stroke moves at least that far); a full cycle is two strokes.
-Point: the finger line (index base b, unit direction f) against the target T; the *hold* is the run
-of frames, around the frame where b is farthest from its first position, with b within
-HOLD_FRACTION x shoulder width of that apex position.
+Point: the finger line (index base b, unit direction f) against the target T; the *hold* is the
+longest run of frames in which b moves slower than HOLD_SPEED shoulder widths per second and is at
+least half its largest distance from its first position.
 """
 import numpy as np
 
@@ -188,14 +188,21 @@ def pointing_angles(finger_base, finger_direction, target):
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
-def hold_run(positions, arm, fps=FPS):
-    """(first, last) frame of the pointing hold (see the module docstring), or None for a finger that
-    never slows down past half its travel; a still arm holds throughout."""
-    p, side = _positions(positions), _side(arm)
-    base = p[:, _JOINT[f"{side}_index_base"]]  # (F, 3)
+def hold_frames(base, width, fps=FPS):
+    """(first, last) frame of the pointing hold of index-base positions (F, 3) on a character whose
+    shoulders are `width` apart (any units, the positions'), or None for a finger that never slows down
+    past half its travel; a still arm holds throughout."""
+    base = np.asarray(base, dtype=np.float64)
     travel = np.linalg.norm(base - base[0], axis=1)
-    speed = np.linalg.norm(np.gradient(base, axis=0), axis=1) * fps  # (F,) m/s
-    return longest_run((speed <= HOLD_SPEED * shoulder_width(p)) & (travel >= 0.5 * travel.max()))
+    speed = np.linalg.norm(np.gradient(base, axis=0), axis=1) * fps  # (F,) units per second
+    return longest_run((speed <= HOLD_SPEED * width) & (travel >= 0.5 * travel.max()))
+
+
+def hold_run(positions, arm, fps=FPS):
+    """(first, last) frame of the pointing hold (see the module docstring) of a gesture's description
+    joint positions, or None."""
+    p, side = _positions(positions), _side(arm)
+    return hold_frames(p[:, _JOINT[f"{side}_index_base"]], shoulder_width(p), fps)
 
 
 def point_measures(positions, finger_direction, arm, target, fps=FPS):

@@ -8,7 +8,7 @@ import rig_variants
 from test_generate import random_target
 
 from rlanimate_addon.blender import action_adapter
-from rlanimate_addon.core import gesture, rig_roles
+from rlanimate_addon.core import behaviour_metrics, gesture, rig_roles
 
 RNG = np.random.default_rng(11)
 POINT_STARTS = (20, 220, 420)
@@ -43,6 +43,20 @@ def finger_angle(rig, arm, target, frames):
         angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
         bases.append(base)
     return np.array(angles), np.array(bases)
+
+
+def hold_miss(rig, angles, bases):
+    """Median of a Point gesture's finger angles (F,) over its pointing hold (behaviour_metrics.hold_frames
+    of the finger base's world positions (F, 3), as docs/METRICS.md measures the agent's own aim); the
+    angle at the apex, where the base is farthest from its start, for a gesture without a hold."""
+    roles = _roles(rig)
+    width = np.linalg.norm(np.subtract(*(_world(rig, rig.data.bones[roles[side + "Arm"]].head_local)[:3]
+                                         for side in ("Left", "Right"))))
+    render = bpy.context.scene.render
+    hold = behaviour_metrics.hold_frames(bases, width, render.fps / render.fps_base)
+    if hold is None:
+        return float(angles[int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))])
+    return float(np.median(angles[hold[0]:hold[1] + 1]))
 
 
 def _eye_misses(rig, target, frame):
@@ -208,8 +222,8 @@ def test_waves_keep_their_strokes_and_change_nothing_they_do_not_own(settings, v
 
 
 def _own_aim_misses(rig, settings, count=6):
-    """Apex misses (degrees) of `count` Point gestures with Exact Aim off, at the same character-relative
-    targets on any rig (both arms alternating)."""
+    """Misses at the hold (degrees, `hold_miss`) of `count` Point gestures with Exact Aim off, at the same
+    character-relative targets on any rig (both arms alternating)."""
     rng, misses = np.random.default_rng(5), []
     for k in range(count):
         arm, start = ("RIGHT", "LEFT")[k % 2], 1 + 200 * k
@@ -217,8 +231,7 @@ def _own_aim_misses(rig, settings, count=6):
         target = helpers.add_empty(f"OwnAim{k}", location)
         assert helpers.generate(rig, settings, behaviour="POINT", arm=arm, target=target, start_frame=start,
                                 frame_count=120, exact_aim=False) == {"FINISHED"}
-        angles, bases = finger_angle(rig, arm, location, np.arange(start, start + 120))
-        misses.append(angles[int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))])
+        misses.append(hold_miss(rig, *finger_angle(rig, arm, location, np.arange(start, start + 120))))
     return np.array(misses)
 
 
@@ -235,7 +248,7 @@ def test_a_rig_whose_fingers_rest_curled_points_with_the_agents_own_aim_as_the_s
         settings, variant_files, sample_own_aim, variant):
     """Blender's human metarig rests its index finger curled and Rigify's rig keeps that rest: the pointing
     index is keyed straight and its last bone swung by its own tail, so Exact Aim off misses by what it
-    misses on the sample character asked the same (it missed by 6 degrees more before)."""
+    misses on the sample character asked the same (it missed by 4 to 8 degrees more before)."""
     misses = _own_aim_misses(rig_variants.load(variant_files[variant]), settings)
     print(f"{variant}: own aim {np.round(misses, 1)} deg, sample {np.round(sample_own_aim, 1)} deg")
     assert np.median(misses - sample_own_aim) <= 1.5 and np.median(misses) <= np.median(sample_own_aim) + 1.5

@@ -159,6 +159,15 @@ def test_pointing_angle_and_hold():
     assert missed["angle"] == pytest.approx(5.0, abs=1e-6)
 
 
+def test_the_hold_of_a_finger_path_does_not_depend_on_its_units():
+    clip, _, _ = pointing_clip()
+    base, width = clip[:, JOINT["right_index_base"]], bm.shoulder_width(clip)
+    hold = bm.hold_frames(base, width)
+    assert hold == bm.hold_run(clip, "RIGHT") and hold[1] - hold[0] > 30
+    assert bm.hold_frames(100.0 * base + 7.0, 100.0 * width) == hold  # centimetres, elsewhere
+    assert bm.hold_frames(base, 0.1 * width) != hold  # the speed threshold scales with the width
+
+
 def test_a_point_that_never_holds_is_measured_at_its_apex():
     frames = 20  # rises and falls straight away: the finger never slows down past half its travel
     clip, finger, target = pointing_clip(frames)
