@@ -27,7 +27,7 @@ import numpy as np
 
 from . import aim, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
-from .rig import RigSkeleton
+from .rig import RigSkeleton, inverse
 from .rotations import matrix_to_quat, matrix_to_rotvec, quat_to_matrix, rotvec_to_matrix
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
@@ -411,6 +411,21 @@ def look_at(rig, basis, changed, eye_bones, to_character, targets, weights):
     return np.stack(out, axis=1)
 
 
+def hips_relative_targets(rig, targets, count):
+    """(N, 3) targets (3,) or (N, 3) in the rig's armature space, carried back by the motion of its hips
+    underneath at each of `count` frames: where each target is for a body whose hips rest.
+
+    The gesture keys the bones above the hips; hips that sway or turn in the rig's own animation carry
+    the gesture with them, so the agent is asked for the direction its body sees.
+    """
+    points = np.broadcast_to(np.asarray(targets, dtype=np.float64), (count, 3))
+    if "Hips" not in rig.roles or not rig.animated:
+        return points
+    i = rig.skeleton.index[rig.roles["Hips"]]
+    back = rig.skeleton.rest[i] @ inverse(rig.under_pose_at(count)[:, i])  # (N, 4, 4) pose -> rest
+    return np.einsum("nij,nj->ni", back[:, :3, :3], points) + back[:, :3, 3]
+
+
 def gesture_rotations(agent, request, rig):
     """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
 
@@ -424,7 +439,8 @@ def gesture_rotations(agent, request, rig):
     check_length(request.frame_count)
     rhythm = (agent.wave_rhythm(request.exaggeration, request.frame_count, request.seed)
               if request.behaviour == "WAVE" else None)
-    objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=request.targets,
+    asked = None if request.targets is None else hips_relative_targets(rig, request.targets, request.frame_count)
+    objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=asked,
                                   rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
     phase_base = aim.finger_lines(canonical, request.arm)[1] if request.behaviour == "POINT" else None

@@ -146,7 +146,30 @@ def test_pointing_adds_the_hand_shape_and_the_gesture_blends_from_and_to_the_pos
     for frame in (0, -1):
         assert np.allclose(np.abs(np.sum(quats[frame] * expected[frame], axis=-1)), 1.0)
     objectives, _ = agent.calls[-1]
-    assert np.allclose(objectives[:, spaces.OBJECTIVE_ATTRIBUTES], spaces.pointing_direction("RIGHT", targets[0]))
+    hips = rig.skeleton.index["Hips"]
+    back = rig.skeleton.rest[hips] @ np.linalg.inv(rig.under_pose[:, hips])  # (50, 4, 4): the hips' motion undone
+    carried = np.einsum("nij,nj->ni", back, np.concatenate([targets, np.ones((50, 1))], axis=1))[:, :3]
+    assert np.allclose(objectives[:, spaces.OBJECTIVE_ATTRIBUTES],
+                       [spaces.pointing_direction("RIGHT", t) for t in carried])
+
+
+def test_point_asks_the_agent_for_the_direction_the_body_sees_over_hips_that_turn_underneath():
+    frames, turn = 40, np.radians(30.0)
+    rig = gesture.canonical_rig()
+    under = np.tile(np.eye(4), (frames, len(skeleton.BONES), 1, 1))
+    hips = rig.skeleton.index["Hips"]
+    frame = skeleton.rest_frame(skeleton.BONE_BY_NAME["Hips"])  # local axes of the hips at rest
+    under[:, hips, :3, :3] = frame.T @ rotvec_to_matrix(np.array([0.0, 0.0, turn])) @ frame  # a turn to its left
+    turned = gesture.RigState(rig.name, rig.skeleton, rig.roles, rig.family, under, animated=True)
+    target = np.array([-1.0, -2.5, 1.5])
+    agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(frames, spaces.ACTION_SIZE)))
+    gesture.gesture_rotations(agent, _request("POINT", frames=frames, targets=target), turned)
+    asked = agent.calls[-1][0][:, spaces.OBJECTIVE_ATTRIBUTES]
+    hips_head = np.array(skeleton.BONE_BY_NAME["Hips"].head)
+    seen = hips_head + rotvec_to_matrix(np.array([0.0, 0.0, -turn])) @ (target - hips_head)
+    assert np.allclose(asked, spaces.pointing_direction("RIGHT", seen), atol=1e-9)
+    gesture.gesture_rotations(agent, _request("POINT", frames=frames, targets=target), rig)  # hips at rest
+    assert np.allclose(agent.calls[-1][0][:, spaces.OBJECTIVE_ATTRIBUTES], spaces.pointing_direction("RIGHT", target))
 
 
 def test_a_still_rig_at_rest_starts_and_ends_in_the_standing_pose_not_its_bind_pose():
