@@ -22,6 +22,8 @@ AZIMUTH_DEG = (-60.0, 95.0)
 ELEVATION_DEG = (-40.0, 55.0)
 DISTANCE_M = (1.5, 4.0)
 LOWEST_TARGET_M = 0.05
+#: Seed of the random unseen pointing targets (`random_target_sweeps`).
+RANDOM_TARGET_SEED = 2024
 EXAGGERATIONS = (0.0, 0.25, 0.5, 0.75, 1.0)
 
 
@@ -97,6 +99,14 @@ def random_targets(rng, arm, count):
         if target[2] >= LOWEST_TARGET_M:
             targets.append(target)
     return np.array(targets)
+
+
+def random_target_sweeps(method, frames, describe, count, exact_aim=False):
+    """{'left', 'right': pointing_sweep} over `count` random unseen targets per arm at `frames`: the same
+    targets for every method and call (drawn with RANDOM_TARGET_SEED, left arm first)."""
+    rng = np.random.default_rng(RANDOM_TARGET_SEED)
+    return {arm.lower(): pointing_sweep(method, arm, random_targets(rng, arm, count), frames, describe, exact_aim)
+            for arm in ("LEFT", "RIGHT")}
 
 
 def pointing_sweep(method, arm, targets, frames, describe, exact_aim=False):

@@ -30,6 +30,8 @@ from trainer.reporting.table4 import table4_markdown
 COLUMNS = tuple(plots.COLUMN_LABELS)  # wave, point, both
 #: The paper's training lengths (Figure 3): 50 epochs for one behaviour, 100 for both.
 PAPER_EPOCHS = {"point": 50, "wave": 50, "both": 100}
+#: Random unseen pointing targets per arm at which every pointing agent's own aim is measured.
+RANDOM_TARGETS = 100
 LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
 
 
@@ -128,6 +130,24 @@ def evaluate_runs(options, runs, session):
     return results
 
 
+def random_target_aim(options, runs, session):
+    """{column: {variant: [per seed: {'left', 'right': {'median', 'max'}}]}}: each pointing agent's own aim
+    (no aim correction, degrees at the hold) at RANDOM_TARGETS random unseen targets per arm, at the
+    class-average pointing length."""
+    frames = behaviour.class_lengths(session.train_clips)["POINT"]
+
+    def describe(rotvecs):
+        return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
+
+    results = {}
+    for (seed, variant, column), folder in sorted(runs.items()):
+        if "POINT" in column_behaviours(column):
+            sweeps = behaviour.random_target_sweeps(AgentMethod(folder / "agent.npz"), frames, describe, RANDOM_TARGETS)
+            results.setdefault(column, {}).setdefault(variant, []).append(
+                {arm: {"median": sweep["median_angle"], "max": sweep["max_angle"]} for arm, sweep in sweeps.items()})
+    return results
+
+
 def aggregate(per_seed):
     """[summary per seed] -> {behaviour: {metric: {mean, sd, n}}}; sd 0 for one value, NaN values (a ratio
     to a zero reference) left out."""
@@ -164,7 +184,10 @@ def write_table_and_figures(options, results, session):
                 f"{len(runs)} of {len(options.seeds) * len(options.variants) * len(options.columns)} runs finished. "
                 f"Regenerate: `nice -n 10 python -m trainer.scripts.experiments --preset {options.preset} "
                 f"--epoch-scale {options.epoch_scale:g} --seeds {seeds}`.")
-    report = {"settings": settings, "seeds": list(options.seeds), "table": table, "training": training}
+    aim = {column: {variant: aggregate(per_seed) for variant, per_seed in variants.items()}
+           for column, variants in random_target_aim(options, runs, session).items()}
+    report = {"settings": settings, "seeds": list(options.seeds), "table": table, "random_targets": aim,
+              "training": training}
     atomic_write_text(results / "table4.json", json.dumps(report, indent=1) + "\n")
     atomic_write_text(results / "table4.md", table4_markdown(report))
     for split in ("seen", "unseen"):

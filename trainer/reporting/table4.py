@@ -44,6 +44,18 @@ def table4_markdown(report):
                                          + [cell(entry[key], digits) for key, _, digits in fields]
                                          for m, entry in rows.items()])
                 lines.append("")
+    if report.get("random_targets"):
+        lines += ["## Own aim at 100 random unseen targets per arm", "",
+                  "Each pointing agent, no aim correction, at the class-average length; targets drawn over the "
+                  "library's ranges (trainer/evaluation/behaviour.py, the same targets for every agent). Degrees at "
+                  "the hold, the median and the worst of the 100 per arm; issue 10 asks at most 3 and 8.", ""]
+        for column, variants in report["random_targets"].items():
+            lines += [f"### {COLUMN_LABELS[column]} agents", ""]
+            lines += markdown_table(("method", "n", "left: median", "left: max", "right: median", "right: max"),
+                                    [[LABELS.get(v, v), str(entry["left"]["median"]["n"])]
+                                     + [cell(entry[arm][key], 1) for arm in ("left", "right") for key in ("median", "max")]
+                                     for v, entry in variants.items()])
+            lines.append("")
     lines += ["## Training runs", ""]
     lines += markdown_table(("variant", "column", "seed", "episodes", "wall s", "CPU s", "held-out score", "seen score"),
                             [[LABELS.get(r["variant"], r["variant"]), r["column"], r["seed"], r["episodes"],

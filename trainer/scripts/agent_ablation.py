@@ -40,7 +40,6 @@ ABLATIONS = {
     "point_no_random_targets": ("point", "no_random_targets", "rlanimate", "pointing term only"),
     "point_no_pointing_term": ("point", "no_pointing_term", "rlanimate", "neither"),
 }
-TARGET_SEED = 2024
 SEEDS = (1, 2, 3)
 
 
@@ -64,10 +63,7 @@ def measure(path, behaviour_name, session, target_count):
         result["variation"] = float(np.median([r["variation"] for r in behaviour.seed_variation(
             method, clips, describe, SEEDS)]))
     else:
-        rng = np.random.default_rng(TARGET_SEED)
-        result["random_targets"] = {arm.lower(): behaviour.pointing_sweep(
-            method, arm, behaviour.random_targets(rng, arm, target_count), lengths["POINT"], describe)
-            for arm in ("LEFT", "RIGHT")}
+        result["random_targets"] = behaviour.random_target_sweeps(method, lengths["POINT"], describe, target_count)
     return result
 
 

@@ -21,7 +21,6 @@ from trainer.reporting.behaviour_report import write_behaviour
 from trainer.reporting.plots import wave_hand_paths
 from trainer.scripts.cli import run_main, script_args
 
-TARGET_SEED = 2024
 WAVE_PATHS = "behaviour_wave_paths.png"
 
 
@@ -48,13 +47,9 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir):
         sets["point_exact_aim"][name] = summary_aimed["point"]
         clips[name] = rows
 
-    rng = np.random.default_rng(TARGET_SEED)
-    random_targets = {}
-    for arm in ("LEFT", "RIGHT"):
-        targets = behaviour.random_targets(rng, arm, target_count)
-        random_targets[arm.lower()] = {
-            "own": behaviour.pointing_sweep(agent, arm, targets, lengths["POINT"], describe),
-            "exact": behaviour.pointing_sweep(agent, arm, targets, lengths["POINT"], describe, exact_aim=True)}
+    own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], describe, target_count, exact_aim=aimed)
+                  for aimed in (False, True))
+    random_targets = {arm: {"own": own[arm], "exact": exact[arm]} for arm in own}
     sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], describe) for arm in ("LEFT", "RIGHT")}
     seeded = behaviour.seed_variation(agent, waves + points, describe, seeds)
     distances = [r["variation"] for r in seeded]
