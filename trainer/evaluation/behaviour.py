@@ -101,10 +101,10 @@ def random_targets(rng, arm, count):
     return np.array(targets)
 
 
-def random_target_sweeps(method, frames, describe, count, exact_aim=False):
+def random_target_sweeps(method, frames, describe, count, exact_aim=False, seed=RANDOM_TARGET_SEED):
     """{'left', 'right': pointing_sweep} over `count` random unseen targets per arm at `frames`: the same
-    targets for every method and call (drawn with RANDOM_TARGET_SEED, left arm first)."""
-    rng = np.random.default_rng(RANDOM_TARGET_SEED)
+    targets for every method and call with the same generator seed (left arm first)."""
+    rng = np.random.default_rng(seed)
     return {arm.lower(): pointing_sweep(method, arm, random_targets(rng, arm, count), frames, describe, exact_aim)
             for arm in ("LEFT", "RIGHT")}
 

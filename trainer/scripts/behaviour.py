@@ -24,7 +24,7 @@ from trainer.scripts.cli import run_main, script_args
 WAVE_PATHS = "behaviour_wave_paths.png"
 
 
-def behaviour_report(agent_path, manifest, target_count, seeds, results_dir):
+def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, target_seed=behaviour.RANDOM_TARGET_SEED):
     """The report behaviour.json holds; also draws the hand-path figure into results_dir."""
     session = LibrarySession(manifest)
     train, test = session.train_clips, session.test_clips
@@ -47,8 +47,8 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir):
         sets["point_exact_aim"][name] = summary_aimed["point"]
         clips[name] = rows
 
-    own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], describe, target_count, exact_aim=aimed)
-                  for aimed in (False, True))
+    own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], describe, target_count, exact_aim=aimed,
+                                                 seed=target_seed) for aimed in (False, True))
     random_targets = {arm: {"own": own[arm], "exact": exact[arm]} for arm in own}
     sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], describe) for arm in ("LEFT", "RIGHT")}
     seeded = behaviour.seed_variation(agent, waves + points, describe, seeds)
@@ -77,7 +77,8 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir):
                    f"({lengths['POINT']} frames for point, {lengths['WAVE']} for wave: the time-scaled and the DTW "
                    f"scores). RLAnimate: `{shown(agent_path)}` ({provenance}), deterministic rollouts of the numpy "
                    f"runtime, FK by Blender. Regenerate: `nice -n 10 python -m trainer.scripts.behaviour --agent "
-                   f"{shown(agent_path)} --targets {target_count} --seeds {seed_words}`.")
+                   f"{shown(agent_path)} --targets {target_count} --seeds {seed_words}"
+                   + ("" if target_seed == behaviour.RANDOM_TARGET_SEED else f" --target-seed {target_seed}") + "`.")
     return {"description": description, "class_lengths": lengths, "sets": sets,
             "agent": {"targets_per_arm": target_count, "random_targets": random_targets,
                       "exaggeration_sweep": sweeps,
@@ -96,10 +97,13 @@ def main(argv=None):
     parser.add_argument("--results", default=str(RESULTS_DIR))
     parser.add_argument("--targets", type=int, default=100, help="random unseen pointing targets per arm")
     parser.add_argument("--seeds", type=int, nargs="*", default=[1, 2, 3, 4], help="variation seeds (not 0)")
+    parser.add_argument("--target-seed", type=int, default=behaviour.RANDOM_TARGET_SEED,
+                        help="generator seed of the random targets (another seed: other targets)")
     options = parser.parse_args(script_args(argv))
     torch.set_num_threads(1)
     new_empty_scene()
-    report = behaviour_report(options.agent, options.clips, options.targets, tuple(options.seeds), options.results)
+    report = behaviour_report(options.agent, options.clips, options.targets, tuple(options.seeds), options.results,
+                              options.target_seed)
     write_behaviour(options.results, report)
     print((Path(options.results) / "behaviour.md").read_text())
     return 0
