@@ -32,19 +32,9 @@ FRAMES = 120
 def point_misses(path, targets, exact):
     """Misses at the hold (degrees) of `targets` Point gestures on the variant saved at path."""
     settings = helpers.enable_addon()
-    rig = rig_variants.load(path)
-    misses = []
-    for k in range(targets):
-        arm = ("RIGHT", "LEFT")[k % 2]
-        location = measures._sample_world_target(rig, arm)
-        target = helpers.add_empty(f"Target{k}", location)
-        start = 1 + 200 * k
-        assert helpers.generate(rig, settings, behaviour="POINT", arm=arm, target=target, start_frame=start,
-                                frame_count=FRAMES, exact_aim=exact) == {"FINISHED"}
-        misses.append(measures.hold_miss(rig, *measures.finger_angle(rig, arm, location,
-                                                                     np.arange(start, start + FRAMES))))
+    misses = measures.point_misses(rig_variants.load(path), settings, targets, exact, measures.RNG, FRAMES)
     helpers.disable_addon()
-    return np.array(misses)
+    return misses
 
 
 def wave_swing(path):

@@ -184,9 +184,9 @@ def retarget(canonical_rotvecs, conversions, parent_conversions=None):
     return matrix_to_quat(np.swapaxes(left, -1, -2) @ rotations @ conversions)
 
 
+_FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")
 #: Role whose rest head a bone's rest direction points to, for the bones whose rest pose differs
 #: between rigs (T- or A-pose arms, relaxed or straight fingers); the spine, neck and head rest upright.
-_FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")
 _DIRECTION_TO = {f"{side}{bone}": f"{side}{child}" for side in ("Left", "Right")
                  for bone, child in (("Shoulder", "Arm"), ("Arm", "ForeArm"), ("ForeArm", "Hand"),
                                      ("Hand", "HandMiddle1"))

@@ -221,18 +221,24 @@ def test_waves_keep_their_strokes_and_change_nothing_they_do_not_own(settings, v
     _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=150)
 
 
-def _own_aim_misses(rig, settings, count=6):
-    """Misses at the hold (degrees, `hold_miss`) of `count` Point gestures with Exact Aim off, at the same
-    character-relative targets on any rig (both arms alternating)."""
-    rng, misses = np.random.default_rng(5), []
+def point_misses(rig, settings, count, exact_aim, rng, frames=120):
+    """Misses at the hold (degrees, `hold_miss`) of `count` Point gestures of `frames` frames, 200 frames
+    apart, both arms alternating, at random targets drawn with rng (the same character-relative targets
+    on any rig for the same generator state)."""
+    misses = []
     for k in range(count):
         arm, start = ("RIGHT", "LEFT")[k % 2], 1 + 200 * k
         location = _sample_world_target(rig, arm, rng)
-        target = helpers.add_empty(f"OwnAim{k}", location)
+        target = helpers.add_empty(f"Target{k}", location)
         assert helpers.generate(rig, settings, behaviour="POINT", arm=arm, target=target, start_frame=start,
-                                frame_count=120, exact_aim=False) == {"FINISHED"}
-        misses.append(hold_miss(rig, *finger_angle(rig, arm, location, np.arange(start, start + 120))))
+                                frame_count=frames, exact_aim=exact_aim) == {"FINISHED"}
+        misses.append(hold_miss(rig, *finger_angle(rig, arm, location, np.arange(start, start + frames))))
     return np.array(misses)
+
+
+def _own_aim_misses(rig, settings):
+    """Six own-aim misses (Exact Aim off) at the same targets on any rig."""
+    return point_misses(rig, settings, 6, False, np.random.default_rng(5))
 
 
 @pytest.fixture(scope="module")

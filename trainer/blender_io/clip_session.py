@@ -2,6 +2,8 @@
 environment, loaded once and shared by the runs of an experiment."""
 import sys
 
+import numpy as np
+
 from trainer.agent.algorithm import ClipReferences
 from trainer.blender_io.clip_import import load_clip_set
 from trainer.blender_io.fk_env import FKEnvironment
@@ -35,6 +37,10 @@ class LibrarySession:
     @property
     def test_clips(self):
         return self.clip_set.test
+
+    def describe(self, rotvecs):
+        """(F, 42) self-descriptions of canonical rotations (F, 15, 3), by the session's Blender FK."""
+        return np.asarray(self.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
 
     @property
     def problems(self):

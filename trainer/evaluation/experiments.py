@@ -111,11 +111,9 @@ def evaluate_runs(options, runs, session):
     baselines = {"no_motion": NoMotion(mean_start_pose(train)), "class_mean": ClassMean(train),
                  "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(mean_start_pose(train))}
 
-    def describe(rotvecs):
-        return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
-
     def summary(method, clips):
-        return behaviour.summarise(behaviour.request_rows(method, clips, session.references, describe, lengths))
+        return behaviour.summarise(behaviour.request_rows(method, clips, session.references, session.describe,
+                                                          lengths))
 
     results = {}
     for split, clips in splits.items():
@@ -135,14 +133,11 @@ def random_target_aim(options, runs, session):
     (no aim correction, degrees at the hold) at RANDOM_TARGETS random unseen targets per arm, at the
     class-average pointing length."""
     frames = behaviour.class_lengths(session.train_clips)["POINT"]
-
-    def describe(rotvecs):
-        return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
-
     results = {}
     for (seed, variant, column), folder in sorted(runs.items()):
         if "POINT" in column_behaviours(column):
-            sweeps = behaviour.random_target_sweeps(AgentMethod(folder / "agent.npz"), frames, describe, RANDOM_TARGETS)
+            sweeps = behaviour.random_target_sweeps(AgentMethod(folder / "agent.npz"), frames, session.describe,
+                                                     RANDOM_TARGETS)
             results.setdefault(column, {}).setdefault(variant, []).append(
                 {arm: {"median": sweep["median_angle"], "max": sweep["max_angle"]} for arm, sweep in sweeps.items()})
     return results

@@ -32,36 +32,34 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
     methods = {"rlanimate": agent, "no_motion": NoMotion(mean_start_pose(train)), "class_mean": ClassMean(train),
                "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(mean_start_pose(train))}
 
-    def describe(rotvecs):
-        return np.asarray(session.env.evaluate(np.asarray(rotvecs, dtype=np.float64)).descriptions)
-
     lengths = behaviour.class_lengths(train)
     waves = [c for c in test if c.behaviour.upper() == "WAVE"]
     points = [c for c in test if c.behaviour.upper() == "POINT"]
     sets, clips = {"wave": {}, "point": {}, "point_exact_aim": {}}, {}
     for name, method in methods.items():
-        rows = behaviour.request_rows(method, waves + points, session.references, describe, lengths)
-        aimed = behaviour.request_rows(method, points, session.references, describe, lengths, exact_aim=True)
+        rows = behaviour.request_rows(method, waves + points, session.references, session.describe, lengths)
+        aimed = behaviour.request_rows(method, points, session.references, session.describe, lengths, exact_aim=True)
         summary, summary_aimed = behaviour.summarise(rows), behaviour.summarise(aimed)
         sets["wave"][name], sets["point"][name] = summary["wave"], summary["point"]
         sets["point_exact_aim"][name] = summary_aimed["point"]
         clips[name] = rows
 
-    own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], describe, target_count, exact_aim=aimed,
-                                                 seed=target_seed) for aimed in (False, True))
+    own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], session.describe, target_count,
+                                                 exact_aim=aimed, seed=target_seed) for aimed in (False, True))
     random_targets = {arm: {"own": own[arm], "exact": exact[arm]} for arm in own}
-    sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], describe) for arm in ("LEFT", "RIGHT")}
-    seeded = behaviour.seed_variation(agent, waves + points, describe, seeds)
+    sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], session.describe)
+              for arm in ("LEFT", "RIGHT")}
+    seeded = behaviour.seed_variation(agent, waves + points, session.describe, seeds)
     distances = [r["variation"] for r in seeded]
 
     panels = []
     for clip in waves:
         reference = spaces.description_joint_positions(session.references.get(clip)[0])
-        answers = {label: spaces.description_joint_positions(describe(methods[key].generate(
+        answers = {label: spaces.description_joint_positions(session.describe(methods[key].generate(
             "WAVE", clip.arm.upper(), clip.attributes, len(clip.rotvecs))))
             for key, label in (("rlanimate", "RLAnimate"), ("class_mean", "class mean"))}
         if seeds:
-            answers[f"RLAnimate seed {seeds[0]}"] = spaces.description_joint_positions(describe(agent.generate(
+            answers[f"RLAnimate seed {seeds[0]}"] = spaces.description_joint_positions(session.describe(agent.generate(
                 "WAVE", clip.arm.upper(), clip.attributes, len(clip.rotvecs), seed=seeds[0])))
         panels.append((f"{clip.name} (e = {float(np.ravel(clip.attributes)[0]):.2f})", clip.arm.upper(),
                        {"reference": reference, **answers}))
