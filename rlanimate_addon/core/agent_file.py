@@ -28,7 +28,11 @@ from .errors import RLAnimateError
 
 FORMAT_NAME = "rlanimate-agent"
 #: 2: waves' objectives carry their rhythm (core/rhythm.py) and the file its `wave_rhythm` model.
-FORMAT_VERSION = 2
+#: 3: that model holds the training waves' rhythms, not a line through them.
+FORMAT_VERSION = 3
+#: Older versions, and why this add-on cannot play them.
+_RETIRED_VERSIONS = {1: "from before waves carried their rhythm in the objective",
+                     2: "whose wave rhythm is a line through the training waves, not the waves themselves"}
 METADATA_KEY = "__metadata__"
 VARIANTS = ("rlanimate", "single_state", "single_dynamics", "supervised")
 #: a_0, the previous action of a sequence's first frame (the middle of every channel's range): part
@@ -233,10 +237,11 @@ def _parse_metadata(path, entry):
         raise _damaged(path, error) from error
     if not isinstance(metadata, dict) or metadata.get("format") != FORMAT_NAME:
         raise _not_an_agent(path)
-    if _is_int(metadata.get("format_version")) and metadata["format_version"] == 1:
-        raise RLAnimateError(f"The agent file {path} is format version 1, from before waves carried their rhythm "
-                             f"in the objective; this add-on reads version {FORMAT_VERSION}: retrain the agent "
-                             f"with this version's trainer (python trainer/train.py).")
+    version = metadata.get("format_version")
+    if _is_int(version) and version in _RETIRED_VERSIONS:
+        raise RLAnimateError(f"The agent file {path} is format version {version}, {_RETIRED_VERSIONS[version]}; "
+                             f"this add-on reads version {FORMAT_VERSION}: retrain the agent with this version's "
+                             f"trainer (python trainer/train.py).")
     if not _is_int(metadata.get("format_version")) or metadata["format_version"] != FORMAT_VERSION:
         raise RLAnimateError(f"The agent file {path} is format version {metadata.get('format_version')!r}, but "
                              f"this add-on reads version {FORMAT_VERSION}: update the add-on, or re-export "

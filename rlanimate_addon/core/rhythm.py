@@ -10,9 +10,9 @@ into a still arm. Here the wave's attributes are [exaggeration, A_t sin(phi_t), 
 
 with start and stop in frames (given as fractions of the gesture, so a longer gesture swings for
 proportionally longer). During training the task module reads these from each clip
-(trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` picks them from the training clips'
-distribution: their regression on the exaggeration for `seed=None`, a seeded draw within the
-training range otherwise, so seeds vary the phase, rate and number of swings.
+(trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves of
+nearby exaggeration: their kernel-weighted mean for `seed=None`, one of them (by weight) at any phase
+for a seed, so seeds vary the phase, rate and number of swings within what the training waves do.
 """
 from dataclasses import asdict, dataclass
 
@@ -20,11 +20,12 @@ import numpy as np
 
 from .errors import RLAnimateError
 
-#: The parameters of a rhythm, each regressed on the exaggeration over the training clips.
+#: The parameters of a rhythm that a request takes from the training waves of nearby exaggeration.
 PARAMETERS = ("frequency", "start", "stop")
-#: A seeded draw keeps each parameter's residual within this many standard deviations (and within the
-#: training clips' own range), so a varied wave stays a typical one: rate within about 10%.
-DRAW_SDS = 1.5
+#: Exaggeration: the training waves within about this of a request's weigh in its rhythm (a Gaussian
+#: kernel's sd). Styles of one exaggeration can swing at different rates (docs/REALMOCAP.md), so the
+#: rhythm is a local average, not a line through all the waves.
+BANDWIDTH = 0.05
 
 
 @dataclass(frozen=True)
@@ -57,62 +58,60 @@ def _smoothstep(x):
 class RhythmModel:
     """The training clips' rhythms as an agent file stores them (`to_dict` / `from_dict`).
 
-    For each of PARAMETERS: a line on the exaggeration (intercept, slope) and the residuals' standard
-    deviation and range; the phase's circular mean; the envelope ramp in frames.
+    `examples` (K, 4): each training wave's exaggeration and its PARAMETERS; the phase's circular mean;
+    the envelope ramp in frames; the kernel bandwidth in exaggeration.
     """
 
-    def __init__(self, lines, phase, ramp):
-        self.lines, self.phase, self.ramp = lines, float(phase), float(ramp)
+    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH):
+        self.examples = np.asarray(examples, dtype=np.float64)
+        self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
 
     @classmethod
     def fit(cls, exaggerations, rhythms):
         """From the training clips' exaggerations (K,) and their Rhythms (K)."""
-        e = np.asarray(exaggerations, dtype=np.float64)
-        if len(e) < 2:
+        if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
                                  "side: add such wave clips.")
-        design = np.stack([np.ones_like(e), e], axis=1)
-        lines = {}
-        for name in PARAMETERS:
-            values = np.array([getattr(r, name) for r in rhythms])
-            coefficients = np.linalg.lstsq(design, values, rcond=None)[0]
-            residuals = values - design @ coefficients
-            lines[name] = {"intercept": float(coefficients[0]), "slope": float(coefficients[1]),
-                           "sd": float(residuals.std()), "low": float(residuals.min()),
-                           "high": float(residuals.max())}
+        examples = [[float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms)]
         phase = float(np.angle(np.mean(np.exp(1j * np.array([r.phase for r in rhythms])))))
-        return cls(lines, phase, float(np.mean([r.ramp for r in rhythms])))
+        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])))
 
     def to_dict(self):
-        return {"lines": self.lines, "phase": self.phase, "ramp": self.ramp}
+        return {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
+                "bandwidth": self.bandwidth}
 
     @classmethod
     def from_dict(cls, values):
         try:
-            lines = {name: {key: float(values["lines"][name][key])
-                            for key in ("intercept", "slope", "sd", "low", "high")} for name in PARAMETERS}
-            model = cls(lines, float(values["phase"]), float(values["ramp"]))
+            model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
+                        float(values["ramp"]), float(values["bandwidth"]))
         except (KeyError, TypeError, ValueError) as error:
             raise RLAnimateError(f"The agent's wave_rhythm metadata is invalid ({error!r}): re-export the "
                                  f"agent with trainer/agent/agent_export.py.") from error
-        numbers = [v for line in lines.values() for v in line.values()] + [model.phase, model.ramp]
-        if not np.all(np.isfinite(numbers)) or model.ramp <= 0:
-            raise RLAnimateError("The agent's wave_rhythm metadata holds invalid numbers: re-export the agent.")
+        shape_ok = model.examples.ndim == 2 and model.examples.shape[0] >= 2 \
+            and model.examples.shape[1] == 1 + len(PARAMETERS)
+        numbers = np.append(model.examples.ravel(), [model.phase, model.ramp, model.bandwidth])
+        if not shape_ok or not np.all(np.isfinite(numbers)) or model.ramp <= 0 or model.bandwidth <= 0:
+            raise RLAnimateError(f"The agent's wave_rhythm metadata holds invalid numbers (need at least 2 "
+                                 f"examples of {1 + len(PARAMETERS)} finite numbers and a positive ramp and "
+                                 f"bandwidth): re-export the agent.")
         return model
 
+    def weights(self, exaggeration):
+        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1)."""
+        squared = ((self.examples[:, 0] - float(exaggeration)) / self.bandwidth) ** 2
+        kernel = np.exp(-0.5 * (squared - squared.min()))  # shifted, so that a far request still has weights
+        return kernel / kernel.sum()
+
     def draw(self, exaggeration, seed=None):
-        """The Rhythm for a wave of this exaggeration: the regression's mean for seed None, else a
-        seeded draw (normal residuals, clipped to DRAW_SDS and to the training clips' range; any phase)."""
-        rng = None if seed is None else np.random.default_rng(seed)
-        values = {}
-        for name in PARAMETERS:
-            line = self.lines[name]
-            mean = line["intercept"] + line["slope"] * float(exaggeration)
-            residual = 0.0 if rng is None else float(np.clip(rng.normal(0.0, line["sd"]),
-                                                             max(line["low"], -DRAW_SDS * line["sd"]),
-                                                             min(line["high"], DRAW_SDS * line["sd"])))
-            values[name] = mean + residual
-        phase = self.phase if rng is None else float(rng.uniform(-np.pi, np.pi))
-        start = float(np.clip(values["start"], 0.0, 1.0))
-        stop = float(np.clip(values["stop"], start, 1.0))
-        return Rhythm(max(values["frequency"], 0.0), start, stop, phase, self.ramp)
+        """The Rhythm for a wave of this exaggeration: for seed None the kernel-weighted mean of the
+        training waves' rhythms, else a seeded draw of one training wave's (by weight) at any phase."""
+        weights = self.weights(exaggeration)
+        if seed is None:
+            values, phase = weights @ self.examples[:, 1:], self.phase
+        else:
+            rng = np.random.default_rng(seed)
+            values, phase = self.examples[rng.choice(len(weights), p=weights), 1:], float(rng.uniform(-np.pi, np.pi))
+        frequency, start, stop = (float(v) for v in values)
+        start = float(np.clip(start, 0.0, 1.0))
+        return Rhythm(max(frequency, 0.0), start, float(np.clip(stop, start, 1.0)), phase, self.ramp)

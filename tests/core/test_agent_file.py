@@ -78,10 +78,19 @@ def test_a_version_1_file_from_before_the_wave_rhythm_is_refused_with_the_fix(tm
         load_agent_file(rewrite(tmp_path / "v1.npz", weights, {**old, "format_version": 1}))
 
 
+def test_a_version_2_file_with_a_line_for_its_wave_rhythm_is_refused_with_the_fix(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    lines = {name: {"intercept": 0.08, "slope": 0.0, "sd": 0.0, "low": 0.0, "high": 0.0}
+             for name in ("frequency", "start", "stop")}
+    old = {**metadata, "format_version": 2, "wave_rhythm": {"lines": lines, "phase": 0.0, "ramp": 9.0}}
+    with pytest.raises(RLAnimateError, match="format version 2, whose wave rhythm is a line.*retrain"):
+        load_agent_file(rewrite(tmp_path / "v2.npz", weights, old))
+
+
 def test_a_broken_wave_rhythm_is_refused(tmp_path, exported):
     weights, metadata = load_agent_file(exported)
     with pytest.raises(RLAnimateError, match="wave_rhythm metadata is invalid"):
-        load_agent_file(rewrite(tmp_path / "rhythm.npz", weights, {**metadata, "wave_rhythm": {"lines": {}}}))
+        load_agent_file(rewrite(tmp_path / "rhythm.npz", weights, {**metadata, "wave_rhythm": {"examples": []}}))
 
 
 def test_wrong_array_shape(tmp_path, exported):

@@ -47,9 +47,9 @@ class RunSettings:
     progress: bool = True  # show a progress bar
 
 
-#: Seed 2: of seeds 0-2 of the default preset (Table 4), the one whose agent meets issue 10's bounds;
+#: Seed 3: of seeds 0-4 of the default preset, the one whose agent comes closest to issue 10's bounds;
 #: the shipped agent is that run (docs/AGENT.md, "The shipped agent's seed").
-NEW_RUN_DEFAULTS = {"behaviour": "both", "clips": str(DEFAULT_MANIFEST), "seed": 2, "preset": "default",
+NEW_RUN_DEFAULTS = {"behaviour": "both", "clips": str(DEFAULT_MANIFEST), "seed": 3, "preset": "default",
                     "variant": "rlanimate", "eval_every": 10}
 
 

@@ -91,6 +91,12 @@ def _raised(elevation_t, elevation):
     return elevation_t >= low + RAISED_SHARE * (elevation - low)
 
 
+def raised_frames(rotvecs, arm):
+    """(F,) bool: the frames where `arm` ('LEFT'/'RIGHT') is raised, as the wave label reads them."""
+    elevation_t = _elevation(_arm_vectors(rotvecs)[arm])
+    return _raised(elevation_t, float(np.percentile(elevation_t, ELEVATION_PERCENTILE)))
+
+
 def _moving_average(values, window):
     """Centred moving average along axis 0 of (F, D), with edge padding."""
     half = window // 2

@@ -1,23 +1,34 @@
 """Reads a wave clip's rhythm (core/rhythm.py) from its motion: the hand's side-to-side swing.
 
 The swing signal is the waving wrist's outward offset from its shoulder, in the character frame
-(forward kinematics of the canonical skeleton, core/kinematics.py). Subtracting a cubic Savitzky-Golay fit over half a second removes the raise and the lowering;
-its analytic signal (Hilbert transform) gives the swing's phase and amplitude per frame. The
-envelope's half-amplitude frames and a line through the unwrapped phase give the Rhythm.
+(forward kinematics of the canonical skeleton, core/kinematics.py). Its rate is the peak of the
+signal's spectrum over the frames where the arm is raised (autolabel.raised_frames), between
+WAVE_BAND; a zero-phase Butterworth band-pass around that rate removes the raise, the lowering and
+the stroke's harmonics, and its analytic signal (Hilbert transform) gives the swing's phase and
+amplitude per frame. The raised frames where the amplitude is at least half its peak give when the
+swing starts and stops, and a line through the unwrapped phase over them its rate.
+
+A fixed high-pass would not do: real waves swing at 0.8-3 Hz, and a filter that takes out a
+half-second raise also takes out a 1 Hz swing, leaving its harmonics (docs/REALMOCAP.md).
 """
 import numpy as np
 from scipy import signal
 
 from rlanimate_addon.core import kinematics, rhythm, skeleton
 from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion import autolabel
 
-#: Window (s) of the cubic Savitzky-Golay fit that takes out the raise and the lowering: it follows
-#: a half-second raise but not a 2-3 Hz swing.
-SMOOTHING_SECONDS = 0.5
+#: Hz: the rates a hand wave swings at (real takes 0.8-3 Hz, the sample library 2-2.7 Hz).
+WAVE_BAND = (0.5, 5.0)
+#: The band-pass keeps rates within this factor of the swing's own.
+BAND_WIDTH = 1.4
+BAND_ORDER = 4
 #: Metres: a swing whose amplitude never reaches this is no swing.
 MIN_SWING = 0.01
 #: Seconds over which the swing envelope rises and falls.
 RAMP_SECONDS = 0.3
+#: Seconds: the shortest wave clip whose swing can be read.
+MIN_SECONDS = 1.0
 _OUTWARD = {"LEFT": 1.0, "RIGHT": -1.0}  # +X is the character's left
 
 
@@ -32,24 +43,37 @@ def swing_signal(rotvecs, arm):
     return _OUTWARD[arm] * (heads[:, wrist, 0] - heads[:, shoulder, 0])
 
 
+def swing_rate(x, fps):
+    """Hz: the peak of the periodogram of (F,) `x`, less its trend, within WAVE_BAND."""
+    frequencies, power = signal.periodogram(signal.detrend(x), fs=fps, window="hann", nfft=max(4096, len(x)))
+    inside = (frequencies >= WAVE_BAND[0]) & (frequencies <= WAVE_BAND[1])
+    return float(frequencies[inside][np.argmax(power[inside])])
+
+
 def clip_rhythm(clip):
     """The Rhythm of a wave clip (a MotionClip with rotvecs, arm and fps), or None for a wave whose hand
     does not swing side to side (real takes have them: a raised, still hand)."""
     fps = clip.fps
-    x = swing_signal(np.asarray(clip.rotvecs, dtype=np.float64), clip.arm.upper())
+    rotvecs = np.asarray(clip.rotvecs, dtype=np.float64)
+    arm = clip.arm.upper()
+    x = swing_signal(rotvecs, arm)
     frames = len(x)
-    window = 2 * int(round(SMOOTHING_SECONDS * fps / 2)) + 1
-    if frames <= 2 * window:
-        raise RLAnimateError(f"A wave clip of {frames} frames is too short to read its swing: use longer clips.")
-    analytic = signal.hilbert(x - signal.savgol_filter(x, window, 3))
+    if frames < MIN_SECONDS * fps:
+        raise RLAnimateError(f"A wave clip of {frames} frames is too short to read its swing: use clips of at "
+                             f"least {MIN_SECONDS:g} s.")
+    raised = np.flatnonzero(autolabel.raised_frames(rotvecs, arm))
+    up = np.arange(raised[0], raised[-1] + 1)
+    rate = swing_rate(x[up], fps)
+    band = (rate / BAND_WIDTH, min(rate * BAND_WIDTH, 0.45 * fps))
+    sections = signal.butter(BAND_ORDER, band, btype="band", fs=fps, output="sos")
+    padding = min(frames - 1, 3 * (2 * len(sections) + 1))  # scipy's own, or what a short clip allows
+    analytic = signal.hilbert(signal.sosfiltfilt(sections, x, padlen=padding))
     amplitude = np.abs(analytic)
-    if amplitude.max() < MIN_SWING:
+    peak = amplitude[up].max()
+    if peak < MIN_SWING:
         return None
-    above = amplitude >= 0.5 * amplitude.max()
-    peak = int(np.argmax(amplitude))  # the swing: the run of frames above half amplitude around the peak
-    first = peak - np.argmin(above[peak::-1]) + 1 if not above[:peak + 1].all() else 0
-    last = peak + np.argmin(above[peak:]) - 1 if not above[peak:].all() else frames - 1
-    active = np.arange(first, last + 1)
+    swinging = up[amplitude[up] >= 0.5 * peak]
+    active = np.arange(swinging[0], swinging[-1] + 1)
     if len(active) < 4:
         return None
     ramp = RAMP_SECONDS * fps
