@@ -242,8 +242,8 @@ def _parse_metadata(path, entry):
         raise RLAnimateError(f"The agent file {path} is format version {version}, {_RETIRED_VERSIONS[version]}; "
                              f"this add-on reads version {FORMAT_VERSION}: retrain the agent with this version's "
                              f"trainer (python trainer/train.py).")
-    if not _is_int(metadata.get("format_version")) or metadata["format_version"] != FORMAT_VERSION:
-        raise RLAnimateError(f"The agent file {path} is format version {metadata.get('format_version')!r}, but "
+    if not _is_int(version) or version != FORMAT_VERSION:
+        raise RLAnimateError(f"The agent file {path} is format version {version!r}, but "
                              f"this add-on reads version {FORMAT_VERSION}: update the add-on, or re-export "
                              f"the agent with this version's trainer.")
     missing = [key for key in REQUIRED_METADATA if key not in metadata]

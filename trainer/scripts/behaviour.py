@@ -45,7 +45,7 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
         clips[name] = rows
 
     own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], session.describe, target_count,
-                                                 exact_aim=aimed, seed=target_seed) for aimed in (False, True))
+                                                 exact_aim=exact_aim, seed=target_seed) for exact_aim in (False, True))
     random_targets = {arm: {"own": own[arm], "exact": exact[arm]} for arm in own}
     sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], session.describe)
               for arm in ("LEFT", "RIGHT")}
