@@ -85,7 +85,8 @@ def squared_error(prediction, target):
 def balanced_kl(posterior, prior, balance, free_nats):
     """KL(q || p) per frame, balanced between training the prior and the posterior, with free nats."""
     def detached(dist):
-        return Independent(type(dist.base_dist)(dist.base_dist.loc.detach(), dist.base_dist.scale.detach()), 1)
+        base = type(dist.base_dist)(dist.base_dist.loc.detach(), dist.base_dist.scale.detach(), validate_args=False)
+        return Independent(base, 1, validate_args=False)
 
     train_prior = kl_divergence(detached(posterior), prior).mean().clamp(min=free_nats)
     train_posterior = kl_divergence(posterior, detached(prior)).mean().clamp(min=free_nats)
@@ -97,5 +98,5 @@ def concentration_nll(policy, motion):
     alpha, beta = policy.base_dist.concentration1, policy.base_dist.concentration0
     concentration = alpha + beta
     mean = (alpha / concentration).detach()
-    fixed_mean = Beta(mean * concentration, (1.0 - mean) * concentration)
+    fixed_mean = Beta(mean * concentration, (1.0 - mean) * concentration, validate_args=False)
     return -fixed_mean.log_prob(motion.clamp(POSE_MARGIN, 1.0 - POSE_MARGIN)).sum(-1)

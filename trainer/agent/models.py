@@ -40,6 +40,12 @@ from trainer.agent import losses as loss_terms
 VARIANTS = agent_file.VARIANTS
 
 
+def gaussian(mean, std):
+    """Diagonal Gaussian over the last axis. Its arguments are not validated: the per-frame checks
+    cost about 5% of an update step, and softplus + min_std keeps the sd positive."""
+    return Independent(Normal(mean, std, validate_args=False), 1, validate_args=False)
+
+
 class MLP(nn.Module):
     """`layers` hidden Linear + tanh layers of width `hidden`, then a Linear output (tanh: smooth, and one
     cheap call in the numpy runtime)."""
@@ -103,6 +109,10 @@ class RLAnimateAgent(nn.Module):
         """q(z_t | e_t, d_t): diagonal Gaussian over (..., Z)."""
         return self._gaussian(self.posterior(torch.cat([e, description], -1)))
 
+    def posterior_parameters(self, e, description):
+        """(mean, sd), each (..., Z), of q(z_t | e_t, d_t), without building the distribution."""
+        return self._gaussian_parameters(self.posterior(torch.cat([e, description], -1)))
+
     def features(self, task, e, z):
         """What the animation model and the decoder see: (h_t, e_t, z_t), or (e_t, z_t) without a task state."""
         return torch.cat([task, e, z], -1) if self.uses_task_state else torch.cat([e, z], -1)
@@ -112,15 +122,18 @@ class RLAnimateAgent(nn.Module):
         concentrations = self.config.concentration_floor + \
             self.config.concentration_scale * F.softplus(self.animation(features))  # (..., 90)
         alpha, beta = concentrations.chunk(2, -1)
-        return Independent(Beta(alpha, beta), 1)
+        return Independent(Beta(alpha, beta, validate_args=False), 1, validate_args=False)
 
     def decode(self, features):
         """Description decoder: features (..., F) -> predicted real description (..., 42)."""
         return self.decoder(features)
 
     def _gaussian(self, out):
+        return gaussian(*self._gaussian_parameters(out))
+
+    def _gaussian_parameters(self, out):
         mean, raw_std = out.chunk(2, -1)
-        return Independent(Normal(mean, F.softplus(raw_std) + self.config.min_std), 1)
+        return mean, F.softplus(raw_std) + self.config.min_std
 
     # --- unrolling -------------------------------------------------------------------------------
 
@@ -169,18 +182,19 @@ class RLAnimateAgent(nn.Module):
         task = self.task_features(objectives)  # (B, T, K)
         e, z, _ = self.initial_state(objectives.shape[0], objectives)
         es, zs, means, stds = [], [], [], []
-        for t in range(objectives.shape[1]):
-            e = self.transition(e, z, previous_actions[:, t], task[:, t])
-            posterior = self.posterior_belief(e, conditions[:, t])
-            z = posterior.rsample()
+        # unbind, not [:, t]: the gradient of T slices is one stack, not T zero-filled (B, T, .) tensors
+        for task_t, a_prev, condition in zip(task.unbind(1), previous_actions.unbind(1), conditions.unbind(1)):
+            e = self.transition(e, z, a_prev, task_t)
+            mean, std = self.posterior_parameters(e, condition)
+            z = mean + torch.empty_like(mean).normal_() * std  # Normal(mean, std).rsample(), draw for draw
             es.append(e)
             zs.append(z)
-            means.append(posterior.base_dist.loc)
-            stds.append(posterior.base_dist.scale)
+            means.append(mean)
+            stds.append(std)
         e, z = torch.stack(es, 1), torch.stack(zs, 1)  # (B, T, E), (B, T, Z)
         return {"features": self.features(task, e, z),
                 "prior": self.prior_belief(e),
-                "posterior": Independent(Normal(torch.stack(means, 1), torch.stack(stds, 1)), 1)}
+                "posterior": gaussian(torch.stack(means, 1), torch.stack(stds, 1))}
 
     def losses(self, batch, train_config, bounds=None):
         """Per-term scalar losses and their weighted "total" on a batch of chunks (trainer/agent/losses.py);
