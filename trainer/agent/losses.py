@@ -12,6 +12,8 @@ On a batch of C chunks of L frames (batch-major, from trainer/agent/buffer.py):
                  the posterior is conditioned on the portrayal's self-description, as at inference;
     portrayal    optional direct MSE of the self-description toward the clip's description (summed
                  over the 42 numbers), when `portrayal_direct_loss`;
+    velocity     optional (`velocity_scale` > 0): Huber of the Beta mean's change from frame to frame to
+                 the clip's, summed over the 45 channels, where both frames imitate a clip;
     pointing     the agent's own finger line against the objective's ray at the frames where the clip
                  holds its point (trainer/agent/pointing.py), through differentiable forward kinematics
                  of the Beta's mean pose; on when the action bounds are given;
@@ -35,8 +37,9 @@ POSE_MARGIN = 1e-3
 
 
 def agent_losses(agent, batch, config, bounds=None):
-    """{"description", "kl", "pose", "portrayal", "pointing", "policy", "total"}: scalar tensors for
-    `agent` on `batch`; the pointing term is zero without the action `bounds` (45, 2) or the batch's "hold"."""
+    """{"description", "kl", "pose", "portrayal", "pointing", "policy", "total"}, and "velocity" when its
+    scale is not 0: scalar tensors for `agent` on `batch`; the pointing term is zero without the action
+    `bounds` (45, 2) or the batch's "hold"."""
     objective, motion = batch["objective"], batch["motion"]  # (C, L, 7), (C, L, 45)
     supervised = agent.variant == "supervised"
     played = motion if supervised else batch["action"]  # (C, L, 45)
@@ -57,6 +60,8 @@ def agent_losses(agent, batch, config, bounds=None):
     policy = agent.policy(features)
     pose_error = F.huber_loss(policy.mean, motion, reduction="none", delta=config.huber_delta)  # (C, L, 45)
     terms["pose"] = masked_mean(pose_error.sum(-1), imitate)  # L3
+    if config.velocity_scale:  # only then: runs without it log the terms they always had
+        terms["velocity"] = velocity_error(policy.mean, motion, imitate, config.huber_delta)
     terms["portrayal"] = (masked_mean((described - batch["motion_description"]).pow(2).sum(-1), imitate)
                           if described is not None and config.portrayal_direct_loss
                           else torch.zeros((), dtype=objective.dtype))
@@ -67,9 +72,17 @@ def agent_losses(agent, batch, config, bounds=None):
                                                     torch.as_tensor(bounds, dtype=objective.dtype)).mean()
     terms["policy"] = masked_mean(concentration_nll(policy, motion), imitate)
     scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
+              "velocity": config.velocity_scale,
               "portrayal": config.portrayal_scale, "pointing": config.pointing_scale, "policy": config.policy_scale}
     terms["total"] = sum(scales[name] * value for name, value in terms.items())
     return terms
+
+
+def velocity_error(poses, motion, imitate, delta):
+    """Huber of the poses' (C, L, 45) change from frame to frame against the clip's, summed over the
+    channels, averaged over the frame pairs that both imitate the clip (imitate (C, L))."""
+    error = F.huber_loss(poses.diff(dim=1), motion.diff(dim=1), reduction="none", delta=delta)  # (C, L - 1, 45)
+    return masked_mean(error.sum(-1), imitate[:, 1:] * imitate[:, :-1])
 
 
 def masked_mean(values, mask):

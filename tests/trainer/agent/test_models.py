@@ -132,7 +132,7 @@ def test_supervised_variant_clones_the_clip_without_kl():
 
 def test_presets_and_config_round_trip():
     assert set(PRESETS) == {"debug", "default", "paper", "paper_wave_objective", "reference_posterior",
-                            "no_random_targets", "no_pointing_term"}
+                            "no_random_targets", "no_pointing_term", "velocity_term"}
     for name in PRESETS:
         agent_config, train_config = load_preset(name)
         assert AgentConfig.from_dict(agent_config.to_dict()) == agent_config
@@ -171,12 +171,38 @@ def test_the_reference_posterior_sees_the_clips_description_and_not_the_rollouts
     assert kl(train, moved) == kl(train, batch)  # single_state's own posterior: the rollout's d'_t
 
 
-def test_the_ablation_presets_undo_one_choice_each():
+def test_the_ablation_presets_change_one_choice_each():
     default = PRESETS["default"][1]
     changed = {name: {f.name for f in dataclasses.fields(TrainConfig)
                       if getattr(PRESETS[name][1], f.name) != getattr(default, f.name)}
-               for name in ("paper_wave_objective", "reference_posterior", "no_random_targets", "no_pointing_term")}
+               for name in ("paper_wave_objective", "reference_posterior", "no_random_targets", "no_pointing_term",
+                            "velocity_term")}
     assert changed == {"paper_wave_objective": {"wave_rhythm"},
                        "reference_posterior": {"wave_rhythm", "posterior_on_reference"},
                        "no_random_targets": {"random_targets"},
-                       "no_pointing_term": {"random_targets", "pointing_scale"}}
+                       "no_pointing_term": {"random_targets", "pointing_scale"},
+                       "velocity_term": {"velocity_scale"}}
+
+
+def test_the_velocity_term_sees_a_still_arm_on_a_wave_and_not_an_offset_pose():
+    from trainer.agent.losses import velocity_error
+    t = torch.arange(40, dtype=torch.float32)
+    wave = (0.5 + 0.1 * torch.sin(2 * torch.pi * t / 12))[None, :, None].expand(2, 40, 45)  # (C, L, 45)
+    imitate = torch.ones(2, 40)
+    still = torch.full_like(wave, 0.5)
+    assert float(velocity_error(wave + 0.05, wave, imitate, 0.05)) == pytest.approx(0.0, abs=1e-6)
+    assert float(velocity_error(still, wave, imitate, 0.05)) > 0.01
+    assert float(velocity_error(still, wave, torch.zeros(2, 40), 0.05)) == 0.0  # random-target requests
+
+
+def test_the_velocity_term_is_logged_and_counted_only_when_on():
+    config, train = load_preset("debug")
+    agent = RLAnimateAgent(config)
+    batch = synthetic_batch(4, 8)
+    assert "velocity" not in agent.losses(batch, train)
+    torch.manual_seed(0)
+    off = agent.losses(batch, train)
+    torch.manual_seed(0)
+    on = agent.losses(batch, dataclasses.replace(train, velocity_scale=10.0))
+    assert torch.isfinite(on["velocity"]) and float(on["velocity"].detach()) > 0.0
+    assert torch.allclose(on["total"], off["total"] + 10.0 * on["velocity"])
