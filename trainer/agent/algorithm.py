@@ -10,13 +10,17 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
        (o, a, d', m, FK of m) is appended to the buffer;
     3. run T update steps, each on C random chunks of L frames, with Adam on the description, KL and pose terms (the paper's L1 + L2 + L3).
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
-that they explore and stay reproducible; evaluation rolls out deterministically.
+that they explore and stay reproducible; evaluation rolls out deterministically. With
+`average_last_epochs` N, the agent that is evaluated and exported (`played_agent`) is the mean of the
+weights after each of the run's last N epochs (stochastic weight averaging, torch.optim.swa_utils);
+rollouts keep using the weights being trained.
 """
 import math
 import time
 
 import numpy as np
 import torch
+from torch.optim.swa_utils import AveragedModel
 
 from rlanimate_addon.core import rhythm, spaces
 from rlanimate_addon.core.errors import RLAnimateError
@@ -104,7 +108,8 @@ class Trainer:
         self.rng = np.random.default_rng(seed)
         self.decks = [[] for _ in self.clip_groups]  # per group: clip indices still to draw this pass
         self.rollout_generator = torch.Generator().manual_seed(seed)
-        self.epochs = epochs  # the planned length of the run, for the learning-rate schedule
+        self.epochs = epochs  # the planned length of the run, for the learning-rate schedule and averaging
+        self.averaged = None  # AveragedModel over the last epochs, once averaging has started
         self.epoch = 0
         self.history = []  # one metrics dict per epoch
 
@@ -208,12 +213,26 @@ class Trainer:
         collected = time.perf_counter()
         losses = self.update()
         self.epoch += 1
+        self._average()
         metrics = {"epoch": self.epoch, "episodes": len(self.buffer), "frames": self.buffer.frames,
                    "learning_rate": self.optimizer.param_groups[0]["lr"], "collect_seconds": collected - start,
                    "update_seconds": time.perf_counter() - collected, "cpu_seconds": time.process_time() - cpu_start,
                    **{f"loss/{name}": value for name, value in losses.items()}}
         self.history.append(metrics)
         return metrics
+
+    def _average(self):
+        """Add this epoch's weights to the average when the epoch is one of the run's last N."""
+        last = self.train_config.average_last_epochs
+        if last and self.epochs and self.epoch > self.epochs - last:
+            if self.averaged is None:
+                self.averaged = AveragedModel(self.agent, use_buffers=False)
+            self.averaged.update_parameters(self.agent)
+
+    @property
+    def played_agent(self):
+        """The agent to evaluate and export: the averaged weights when there are any, else the trained ones."""
+        return self.agent if self.averaged is None else self.averaged.module
 
     def state_dict(self):
         return {
@@ -224,6 +243,7 @@ class Trainer:
             "history": self.history,
             "decks": [list(deck) for deck in self.decks],
             "rng": checkpoint.capture_rng_states(self.rng, self.rollout_generator),
+            "averaged": None if self.averaged is None else self.averaged.state_dict(),
         }
 
     def load_state_dict(self, state):
@@ -235,3 +255,7 @@ class Trainer:
         # A checkpoint from before the draws were in passes starts a fresh pass.
         self.decks = [list(deck) for deck in state.get("decks", [[] for _ in self.clip_groups])]
         checkpoint.restore_rng_states(state["rng"], self.rng, self.rollout_generator)
+        self.averaged = None
+        if state.get("averaged") is not None:
+            self.averaged = AveragedModel(self.agent, use_buffers=False)
+            self.averaged.load_state_dict(state["averaged"])

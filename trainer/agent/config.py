@@ -9,8 +9,9 @@
     paper_wave_objective, reference_posterior, no_random_targets, no_pointing_term
              the default with one of issue 10's choices undone (docs/AGENT.md); reference_posterior
              is meant for the single_state variant (the stochastic behaviour state carries the wave);
-    velocity_term
-             the default plus a pose-velocity term, tried for the biggest waves' shortfall (docs/AGENT.md).
+    velocity_term, weight_average
+             the default plus a pose-velocity term, or with the weights averaged over the last 20
+             epochs: tried for the biggest waves' shortfall and for pointing (docs/AGENT.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -64,6 +65,7 @@ class TrainConfig:
     policy_scale: float = 0.01  # Beta concentrations fitted by NLL of the clip's pose (mean detached)
     posterior_on_reference: bool = False  # single_state: condition the posterior on the clip's description
     wave_rhythm: bool = True  # waves' objectives carry their rhythm (core/rhythm.py); False: the paper's
+    average_last_epochs: int = 0  # play and export the mean of the weights after each of the last N epochs (0: off)
 
     def to_dict(self):
         return asdict(self)
@@ -93,6 +95,7 @@ PRESETS = {
     "no_random_targets": (AgentConfig(), replace(_DEFAULT_TRAIN, random_targets=0)),
     "no_pointing_term": (AgentConfig(), replace(_DEFAULT_TRAIN, random_targets=0, pointing_scale=0.0)),
     "velocity_term": (AgentConfig(), replace(_DEFAULT_TRAIN, velocity_scale=500.0)),
+    "weight_average": (AgentConfig(), replace(_DEFAULT_TRAIN, average_last_epochs=20)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

@@ -179,7 +179,7 @@ def train(settings, session):
         final = evaluate_seen_unseen(trainer, session)
     log.close()
     report = _report(settings, trainer, final, epochs, session.problems)
-    export_agent(agent, output / "agent.npz", _agent_metadata(report, trainer))
+    export_agent(trainer.played_agent, output / "agent.npz", _agent_metadata(report, trainer))
     write_run_report(report, output)
     plots.training_curves(trainer.history, output / "training_curves.png",
                           title=f"{settings.variant}, {settings.behaviour}")

@@ -118,7 +118,7 @@ class TrainedAgentMethod:
     that trainer.evaluation.scoring scores, decoded to rotations with the trainer's bounds."""
 
     def __init__(self, trainer, path):
-        self.agent, self.bounds, self.path = trainer.agent, trainer.bounds, Path(path)
+        self.agent, self.bounds, self.path = trainer.played_agent, trainer.bounds, Path(path)
         self.rhythm_model = trainer.rhythm_model
 
     def generate(self, behaviour, arm, attributes, frame_count, seed=None):

@@ -92,7 +92,7 @@ def evaluate_seen_unseen(trainer, session):
     """Held-out (unseen) and SEEN_CLIP_COUNT training (seen) clips of the trainer's behaviour(s)."""
     unseen = select_clips(session.test_clips, trainer.behaviour)
     seen = select_clips(session.train_clips, trainer.behaviour, SEEN_CLIP_COUNT)
-    return {split: evaluate_clips(trainer.agent, session.env, clips, session.references, trainer.bounds,
+    return {split: evaluate_clips(trainer.played_agent, session.env, clips, session.references, trainer.bounds,
                                   trainer.request_objective)
             for split, clips in (("unseen", unseen), ("seen", seen))}
 

@@ -7,7 +7,7 @@ import torch
 
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
-from trainer.agent import pointing
+from trainer.agent import checkpoint, pointing
 from trainer.agent.algorithm import ClipReferences, Trainer, clip_objective, clips_for_behaviour
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
@@ -156,3 +156,31 @@ def test_random_targets_cover_the_clips_range_widened_by_the_margin(env, library
     assert np.all(drawn >= low - 1e-9) and np.all(drawn <= high + 1e-9)
     reach = margin / 2 if margin else -0.1 * (high - low)  # the draws use the margin, or fill the range
     assert np.all(drawn.min(axis=0) < low + margin - reach) and np.all(drawn.max(axis=0) > high - margin + reach)
+
+
+def test_averaging_plays_the_mean_of_the_last_epochs_weights_and_resumes_exactly(env, library, tmp_path):
+    agent_config, train_config = load_preset("debug")
+    train_config = replace(train_config, average_last_epochs=2)
+
+    def trainer():
+        torch.manual_seed(0)
+        return Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "both", seed=0,
+                       epochs=4)
+
+    run = trainer()
+    snapshots = []
+    for _ in range(4):
+        run.run_epoch()
+        snapshots.append({name: value.clone() for name, value in run.agent.state_dict().items()})
+        assert (run.played_agent is run.agent) == (run.epoch <= 2)
+    for name, value in run.played_agent.state_dict().items():
+        torch.testing.assert_close(value, (snapshots[2][name] + snapshots[3][name]) / 2)
+    resumed = trainer()
+    first = trainer()
+    for _ in range(3):
+        first.run_epoch()
+    checkpoint.save(tmp_path / "checkpoint.pt", first.state_dict(), {})  # loads with weights_only
+    resumed.load_state_dict(checkpoint.load(tmp_path / "checkpoint.pt")["trainer"])
+    resumed.run_epoch()
+    for name, value in run.played_agent.state_dict().items():
+        assert torch.equal(resumed.played_agent.state_dict()[name], value), name
