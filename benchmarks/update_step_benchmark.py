@@ -25,6 +25,7 @@ import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
 from rlanimate_addon.core import spaces  # noqa: E402
+from trainer.agent.algorithm import gradient_step  # noqa: E402
 from trainer.agent.buffer import EpisodeBuffer  # noqa: E402
 from trainer.agent.config import load_preset  # noqa: E402
 from trainer.agent.models import RLAnimateAgent  # noqa: E402
@@ -74,11 +75,7 @@ def measure():
 
     def step():  # Trainer.update's loop body
         batch = buffer.sample_chunks(config.chunk_count, config.chunk_length, rng, config.random_target_weight)
-        losses = agent.losses(batch, config, bounds)
-        optimizer.zero_grad(set_to_none=True)
-        losses["total"].backward()
-        torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip)
-        optimizer.step()
+        gradient_step(agent, optimizer, batch, config, bounds)
 
     for _ in range(STEPS):  # warm-up
         step()

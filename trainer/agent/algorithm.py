@@ -67,6 +67,17 @@ def rollout_actions(agent, objectives, deterministic=True, generator=None):
     return actions[0].double().numpy()
 
 
+def gradient_step(agent, optimizer, batch, config, bounds):
+    """One update on a batch of chunks: the losses, backward, the gradient clip, an Adam step; returns the losses."""
+    losses = agent.losses(batch, config, bounds)
+    optimizer.zero_grad(set_to_none=True)
+    losses["total"].backward()
+    if getattr(config, "grad_clip", None):
+        torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip)
+    optimizer.step()
+    return losses
+
+
 class ClipReferences:
     """FK of each clip's own motion (descriptions (F, 42), joint positions (F, 10, 3)), computed once."""
 
@@ -196,12 +207,7 @@ class Trainer:
         for _ in range(config.update_steps):
             batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng,
                                               config.random_target_weight)
-            losses = self.agent.losses(batch, config, self.bounds)
-            self.optimizer.zero_grad(set_to_none=True)
-            losses["total"].backward()
-            if getattr(config, "grad_clip", None):
-                torch.nn.utils.clip_grad_norm_(self.agent.parameters(), config.grad_clip)
-            self.optimizer.step()
+            losses = gradient_step(self.agent, self.optimizer, batch, config, self.bounds)
             for name, value in losses.items():
                 totals[name] = totals.get(name, 0.0) + float(value.detach())
         return {name: value / config.update_steps for name, value in totals.items()}

@@ -103,11 +103,11 @@ class RLAnimateAgent(nn.Module):
 
     def prior_belief(self, e):
         """p(z_t | e_t): diagonal Gaussian over (..., Z)."""
-        return self._gaussian(self.prior(e))
+        return gaussian(*self._gaussian_parameters(self.prior(e)))
 
     def posterior_belief(self, e, description):
         """q(z_t | e_t, d_t): diagonal Gaussian over (..., Z)."""
-        return self._gaussian(self.posterior(torch.cat([e, description], -1)))
+        return gaussian(*self.posterior_parameters(e, description))
 
     def posterior_parameters(self, e, description):
         """(mean, sd), each (..., Z), of q(z_t | e_t, d_t), without building the distribution."""
@@ -127,9 +127,6 @@ class RLAnimateAgent(nn.Module):
     def decode(self, features):
         """Description decoder: features (..., F) -> predicted real description (..., 42)."""
         return self.decoder(features)
-
-    def _gaussian(self, out):
-        return gaussian(*self._gaussian_parameters(out))
 
     def _gaussian_parameters(self, out):
         mean, raw_std = out.chunk(2, -1)
