@@ -227,10 +227,15 @@ class Trainer:
         self.history.append(metrics)
         return metrics
 
+    def _averaging_window(self):
+        """The first epoch whose weights join the average (the run's last N), or None without averaging."""
+        last = self.train_config.average_last_epochs
+        return self.epochs - last + 1 if last and self.epochs else None
+
     def _average(self):
         """Add this epoch's weights to the average when the epoch is one of the run's last N."""
-        last = self.train_config.average_last_epochs
-        if last and self.epochs and self.epoch > self.epochs - last:
+        first = self._averaging_window()
+        if first is not None and self.epoch >= first:
             if self.averaged is None:
                 self.averaged = AveragedModel(self.agent, use_buffers=False)
             self.averaged.update_parameters(self.agent)
@@ -263,5 +268,10 @@ class Trainer:
         checkpoint.restore_rng_states(state["rng"], self.rng, self.rollout_generator)
         self.averaged = None
         if state.get("averaged") is not None:
-            self.averaged = AveragedModel(self.agent, use_buffers=False)
-            self.averaged.load_state_dict(state["averaged"])
+            averaged = AveragedModel(self.agent, use_buffers=False)
+            averaged.load_state_dict(state["averaged"])
+            # A run extended to more epochs has a later window: an average of the old one is dropped,
+            # and the new window's epochs still to come are averaged.
+            first = self._averaging_window()
+            if first is not None and int(averaged.n_averaged) == self.epoch - first + 1:
+                self.averaged = averaged

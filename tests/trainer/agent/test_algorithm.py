@@ -184,3 +184,28 @@ def test_averaging_plays_the_mean_of_the_last_epochs_weights_and_resumes_exactly
     resumed.run_epoch()
     for name, value in run.played_agent.state_dict().items():
         assert torch.equal(resumed.played_agent.state_dict()[name], value), name
+
+
+def test_an_extended_run_averages_its_new_last_epochs_only(env, library, tmp_path):
+    agent_config, train_config = load_preset("debug")
+    train_config = replace(train_config, average_last_epochs=2)
+
+    def trainer(epochs):
+        torch.manual_seed(0)
+        return Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "both", seed=0,
+                       epochs=epochs)
+
+    planned = trainer(3)
+    for _ in range(3):
+        planned.run_epoch()
+    assert planned.played_agent is not planned.agent  # epochs 2 and 3 averaged
+    checkpoint.save(tmp_path / "checkpoint.pt", planned.state_dict(), {})
+    extended = trainer(5)
+    extended.load_state_dict(checkpoint.load(tmp_path / "checkpoint.pt")["trainer"])
+    assert extended.played_agent is extended.agent  # the old window's average is dropped
+    snapshots = []
+    for _ in range(2):
+        extended.run_epoch()
+        snapshots.append({name: value.clone() for name, value in extended.agent.state_dict().items()})
+    for name, value in extended.played_agent.state_dict().items():
+        torch.testing.assert_close(value, (snapshots[0][name] + snapshots[1][name]) / 2)
