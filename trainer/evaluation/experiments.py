@@ -182,7 +182,7 @@ def write_table_and_figures(options, results, session):
     aim = {column: {variant: aggregate(per_seed) for variant, per_seed in variants.items()}
            for column, variants in random_target_aim(options, runs, session).items()}
     report = {"settings": settings, "seeds": list(options.seeds), "table": table, "random_targets": aim,
-              "training": training}
+              "random_target_count": RANDOM_TARGETS, "training": training}
     atomic_write_text(results / "table4.json", json.dumps(report, indent=1) + "\n")
     atomic_write_text(results / "table4.md", table4_markdown(report))
     for split in ("seen", "unseen"):

@@ -45,10 +45,11 @@ def table4_markdown(report):
                                          for m, entry in rows.items()])
                 lines.append("")
     if report.get("random_targets"):
-        lines += ["## Own aim at 100 random unseen targets per arm", "",
+        count = report["random_target_count"]
+        lines += [f"## Own aim at {count} random unseen targets per arm", "",
                   "Each pointing agent, no aim correction, at the class-average length; targets drawn over the "
                   "library's ranges (trainer/evaluation/behaviour.py, the same targets for every agent). Degrees at "
-                  "the hold, the median and the worst of the 100 per arm; issue 10 asks at most 3 and 8.", ""]
+                  f"the hold, the median and the worst of the {count} per arm; issue 10 asks at most 3 and 8.", ""]
         for column, variants in report["random_targets"].items():
             lines += [f"### {COLUMN_LABELS[column]} agents", ""]
             lines += markdown_table(("method", "n", "left: median", "left: max", "right: median", "right: max"),

@@ -99,7 +99,9 @@ def markdown(results, command):
                              "frequency ratio", "cycles min / median", "swing rises with exaggeration",
                              "seed variation (cm)", "first-frame elevation error (deg, max)",
                              "last-frame error (deg, max)", "score", "smoothness"], rows)
-    lines += ["", "## Point (6 held-out requests; 100 random targets 1.5-4 m per arm)", ""]
+    counts = {len(r["random_targets"]["left"]["angles"]) for r in results.values() if "random_targets" in r}
+    lines += ["", f"## Point (6 held-out requests; {' or '.join(map(str, sorted(counts)))} random targets "
+              "1.5-4 m per arm)", ""]
     rows = []
     for name, result in results.items():
         if ABLATIONS[name][0] != "point":

@@ -31,9 +31,9 @@ def test_markdown_shows_mean_and_sd_only_over_several_seeds():
 def test_table4_shows_each_pointing_agents_random_target_aim_per_arm_over_seeds():
     per_seed = [{"left": {"median": 1.0, "max": 8.0}, "right": {"median": 2.0, "max": 5.0}},
                 {"left": {"median": 3.0, "max": 9.0}, "right": {"median": 2.0, "max": 7.0}}]
-    report = {"settings": "Settings.", "table": {}, "training": {},
+    report = {"settings": "Settings.", "table": {}, "training": {}, "random_target_count": 40,
               "random_targets": {"both": {"rlanimate": aggregate(per_seed), "single_state": aggregate(per_seed[:1])}}}
     markdown = table4_markdown(report)
-    assert "## Own aim at 100 random unseen targets per arm" in markdown
+    assert "## Own aim at 40 random unseen targets per arm" in markdown and "the worst of the 40 per arm" in markdown
     assert "| RLAnimate | 2 | 2.0 ± 1.4 | 8.5 ± 0.7 | 2.0 ± 0.0 | 6.0 ± 1.4 |" in markdown
     assert "| single state | 1 | 1.0 | 8.0 | 2.0 | 5.0 |" in markdown
