@@ -5,6 +5,8 @@ Blender 4.2 keeps F-curves on the action (`action.fcurves`). Blender 4.4+ (and 5
 F-curves live in a channelbag of a keyframe strip of a layer, one channelbag per slot. Callers get
 an `ActionTarget` (the action and, where slots exist, the slot) and never touch either layout.
 """
+import math
+
 import bpy
 import numpy as np
 
@@ -130,16 +132,26 @@ def assign(obj, target):
         data.action_slot = target.slot
 
 
-def push_down(obj):
-    """Move the object's active action onto a new NLA track, as Blender's Push Down does; keys untouched."""
+def push_down(obj, frames):
+    """Move the object's active action onto a new NLA track, as Blender's Push Down does; keys untouched.
+
+    The strip maps each frame to itself over the action's keys and the `frames` (first, last) given
+    (the scene's range and the gesture's), so there the action plays as it did: keys on sub-frames,
+    F-curve modifiers (a Cycles loop) and extrapolation included, and a manual frame range ignored, as
+    it is for an active action. Beyond that span the strip holds its end values.
+    """
     data = obj.animation_data
     target = active_target(obj)
     if target is None:
         return
-    start = int(target.action.frame_range[0])
+    first, last = target.action.curve_frame_range
+    start = math.floor(min(first, frames[0]))
+    end = max(last, frames[1], start + 1.0)
     track = data.nla_tracks.new()
     track.name = target.action.name
     strip = _new_strip(track, target, start)
+    strip.action_frame_start, strip.action_frame_end = start, end
+    strip.frame_end = strip.frame_start + (end - start)
     strip.blend_type = data.action_blend_type
     strip.extrapolation = "HOLD"
     data.action = None

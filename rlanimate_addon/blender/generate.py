@@ -13,10 +13,17 @@ def _check_target(settings):
         return
     if settings.target is None and not settings.use_cursor:
         raise RLAnimateError("Point needs a target: pick a target object, or tick 'Use 3D Cursor'.")
-    target, bone = settings.target, settings.target_bone
-    if target is not None and bone and (target.type != "ARMATURE" or bone not in target.pose.bones):
+    target, bone = settings.target, target_bone(settings)
+    if bone and bone not in target.pose.bones:
         raise RLAnimateError(f"The target {target.name!r} has no bone {bone!r}: pick one of its bones, "
                              "or clear Target Bone to point at the object itself.")
+
+
+def target_bone(settings):
+    """The bone of the target armature to point at, or "": Target Bone is kept, unused and hidden in the
+    panel, while the target is not an armature."""
+    target = settings.target
+    return settings.target_bone if target is not None and target.type == "ARMATURE" else ""
 
 
 #: Blender's frame range: keys outside it cannot be played or reached.
@@ -97,7 +104,7 @@ def _compute(context, plan, settings, agent, frames):
         target = settings.target if settings.behaviour == "POINT" else None
         try:
             rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
-                                                                settings.target_bone if target else "")
+                                                                target_bone(settings) if target else "")
         finally:
             if scene.frame_current != original_frame:
                 scene.frame_set(original_frame)
@@ -146,12 +153,12 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
         start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
         _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
-    lines = [_write(plan, agent) for plan in plans]
+    lines = [_write(plan, agent, context.scene) for plan in plans]
     progress(4)
     return "\n".join(lines)
 
 
-def _write(plan, agent):
+def _write(plan, agent, scene):
     """Write one armature's planned gesture; returns its summary line."""
     settings = plan.settings
     start, count = int(settings.start_frame), int(settings.frame_count)
@@ -163,7 +170,8 @@ def _write(plan, agent):
         note += f" (time-scaled: the agent's range is {shortest}-{longest} frames)"
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
-    action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type)
+    action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
+                                       (scene.frame_start, scene.frame_end))
     constraints.mute(plan.obj, plan.overriding, start, end)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""

@@ -44,7 +44,8 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
         name="Start Frame", default=1, description="First frame of the gesture")
     target_bone: bpy.props.StringProperty(
         name="Target Bone", default="",
-        description="When the target is an armature, point at this bone's head (another character's head)")
+        description="When the target is an armature, point at this bone's head (another character's head); "
+        "unused for other targets")
     exact_aim: bpy.props.BoolProperty(
         name="Exact Aim", default=True,
         description="Turn the arm so the index finger passes exactly through the target; "

@@ -182,6 +182,28 @@ def test_existing_animation_other_frames_and_other_actions_are_preserved(setting
     assert _keys(gesture[0]) == first_keys and _keys(existing) == existing_keys
 
 
+@pytest.mark.parametrize("kind", ["sub-frame keys", "cycles loop", "manual frame range"])
+def test_pushed_down_animation_plays_as_before_over_the_scene(settings, kind):
+    rig = helpers.load_sample_rig()
+    arm = rig.pose.bones[helpers.rig_bone(rig, "RightArm")]
+    shift = 0.5 if kind == "sub-frame keys" else 0.0
+    for frame, angle in ((1, 0.0), (60, 0.6), (120, -0.3)):
+        arm.rotation_quaternion = (math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0)
+        arm.keyframe_insert("rotation_quaternion", frame=frame + shift)
+    existing = rig.animation_data.action
+    if kind == "cycles loop":
+        for fcurve in _fcurves(existing):
+            fcurve.modifiers.new("CYCLES")
+    if kind == "manual frame range":
+        existing.use_frame_range, existing.frame_start, existing.frame_end = True, 30, 90
+    scene = bpy.context.scene
+    outside = np.r_[scene.frame_start:140, 181:scene.frame_end + 1]
+    _, before = _pose_snapshot(rig, outside)
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=140, frame_count=41) == {"FINISHED"}
+    _, after = _pose_snapshot(rig, outside)
+    assert np.abs(after - before).max() < 1e-5, f"{kind}: the pushed-down action plays differently"
+
+
 def _state(rig):
     """What a failed Generate must leave as it was."""
     data = rig.animation_data
@@ -246,7 +268,10 @@ def test_every_bad_input_is_refused_with_its_message_and_changes_nothing(setting
     _assert_refused(partial, r"roles Neck, Head \(closest bone naming: Mixamo\)")
     helpers.activate(rig)
     settings.target_bone = "NoSuchBone"
-    _assert_refused(rig, "has no bone 'NoSuchBone'")
+    settings.target = partial
+    _assert_refused(rig, "The target 'Partial' has no bone 'NoSuchBone'")
+    settings.target = target  # an object target: the Target Bone left from an armature target is unused
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}, "the panel hides Target Bone for an object"
     settings.target_bone = ""
 
     helpers.activate(rig)
