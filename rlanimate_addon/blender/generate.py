@@ -43,6 +43,21 @@ def check_keepable(obj):
                              "Editable) and generate again.")
 
 
+def check_nla(obj):
+    """RLAnimateError when the armature's NLA would not play a new gesture track: a strip in tweak mode,
+    or a soloed track (only it plays)."""
+    data = obj.animation_data
+    if data is None:
+        return
+    if data.use_tweak_mode:
+        raise RLAnimateError(f"{obj.name!r} is in NLA tweak mode (editing a strip's action), where no new strip "
+                             "can be added: leave tweak mode (NLA editor: Tab) and generate again.")
+    soloed = [track.name for track in data.nla_tracks if track.is_solo]
+    if soloed:
+        raise RLAnimateError(f"The NLA track {soloed[0]!r} of {obj.name!r} is soloed, so only it plays and the "
+                             "gesture's track would not: un-solo it (the star in the NLA editor) and generate again.")
+
+
 def check_frames(start, frame_count):
     """RLAnimateError when the gesture's frames leave Blender's frame range."""
     low, high = _FRAMES.hard_min, _FRAMES.hard_max
@@ -87,6 +102,7 @@ def _check(obj, settings, start, end, mute_constraints):
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
     check_fk_arm(obj, family, settings.arm)
     check_keepable(obj)
+    check_nla(obj)
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}

@@ -267,6 +267,15 @@ def test_every_bad_input_is_refused_with_its_message_and_changes_nothing(setting
     helpers.activate(partial)
     _assert_refused(partial, r"roles Neck, Head \(closest bone naming: Mixamo\)")
     helpers.activate(rig)
+    data = rig.animation_data  # the animation is on the NLA now, under the gestures baked above
+    track = data.nla_tracks[0]
+    track.is_solo = True
+    _assert_refused(rig, f"The NLA track {track.name!r} of 'RLAnimate_Character' is soloed")
+    track.is_solo = False
+    track.strips[0].select = True
+    data.use_tweak_mode = True  # Tab on the strip in the NLA editor
+    _assert_refused(rig, "'RLAnimate_Character' is in NLA tweak mode")
+    data.use_tweak_mode = False
     settings.target_bone = "NoSuchBone"
     settings.target = partial
     _assert_refused(rig, "The target 'Partial' has no bone 'NoSuchBone'")
