@@ -36,6 +36,9 @@ def rig_roles_of(obj, bone_map_path=""):
         except OSError as error:
             raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({error.strerror}): pick an "
                                  "existing file, or clear the Bone Map field to detect the bones.") from None
+        except UnicodeDecodeError:
+            raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file "
+                                 "saved from the panel, or clear the Bone Map field.") from None
         return rig_roles.read_bone_map(text, names)
     family, roles = rig_roles.detect(names)
     return family.name, roles

@@ -189,8 +189,14 @@ def read_bone_map(text, bone_names):
     except (ValueError, KeyError, TypeError, AttributeError):
         raise RLAnimateError('The bone-map file is not valid: it must be JSON like {"family": "...", '
                              '"bones": {"Spine": "my_spine", ...}}; save one from the panel to start.') from None
-    if not isinstance(bones, dict):
-        raise RLAnimateError('The bone-map file\'s "bones" must map role names to bone names.')
+    if not isinstance(bones, dict) or not all(isinstance(b, str) and b for b in bones.values()):
+        raise RLAnimateError('The bone-map file\'s "bones" must map role names to bone names, one name (a '
+                             'string) per role: correct the file, or save a new one from the panel.')
+    shared = sorted({b for b in bones.values() if list(bones.values()).count(b) > 1})
+    if shared:
+        roles = [role for role, b in bones.items() if b == shared[0]]
+        raise RLAnimateError(f"The bone-map file gives the bone {shared[0]!r} to the roles {', '.join(roles)}: "
+                             "each role needs a bone of its own; correct the file.")
     unknown = sorted(set(bones) - set(ROLES))
     if unknown:
         raise RLAnimateError(f"The bone-map file names unknown roles {', '.join(unknown)}: use roles among "

@@ -96,8 +96,11 @@ def test_a_bone_map_file_is_saved_edited_and_loaded_for_a_rig_with_unknown_names
     assert bpy.ops.rlanimate.save_bone_map(filepath=str(path)) == {"FINISHED"}
     data = json.loads(path.read_text())
     data["bones"] = {role: "bn_" + role[::-1] for role in rig_roles.ROLES}
-    path.write_text(json.dumps(data))
+    path.write_bytes(b"\xff\xfe not text")
     settings.bone_map_file = str(path)
+    with pytest.raises(RuntimeError, match="is not UTF-8 text"):
+        bpy.ops.rlanimate.generate_gesture()
+    path.write_text(json.dumps(data))
     assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT") == {"FINISHED"}
     assert rig.animation_data.action is not None
 

@@ -64,3 +64,8 @@ def test_a_bone_map_file_round_trips_and_bad_files_are_refused():
         rig_roles.read_bone_map(json.dumps({"bones": {"Elbow": "a"}}), bones)
     with pytest.raises(RLAnimateError, match="lacks: z"):
         rig_roles.read_bone_map(json.dumps({"bones": {"Neck": "z"}}), bones)
+    for value in (["a"], None, "", 3):
+        with pytest.raises(RLAnimateError, match="one name \\(a string\\) per role"):
+            rig_roles.read_bone_map(json.dumps({"bones": {"Neck": value}}), bones)
+    with pytest.raises(RLAnimateError, match="gives the bone 'a' to the roles Neck, Head"):
+        rig_roles.read_bone_map(json.dumps({"bones": {"Spine": "b", "Neck": "a", "Head": "a"}}), bones)
