@@ -9,9 +9,10 @@
     paper_wave_objective, reference_posterior, no_random_targets, no_pointing_term
              the default with one of issue 10's choices undone (docs/AGENT.md); reference_posterior
              is meant for the single_state variant (the stochastic behaviour state carries the wave);
-    velocity_term, weight_average
-             the default plus a pose-velocity term, or with the weights averaged over the last 20
-             epochs: tried for the biggest waves' shortfall and for pointing (docs/AGENT.md).
+    velocity_term, weight_average, wrist_term
+             the default plus a pose-velocity term, with the weights averaged over the last 20
+             epochs, or plus a waving-wrist term: tried for the biggest waves' shortfall and for
+             pointing (docs/AGENT.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -56,6 +57,7 @@ class TrainConfig:
     kl_scale: float = 0.1  # the paper's L2: KL(q || p)
     pose_scale: float = 100.0  # the paper's L3: Huber to the clip's pose, summed over the 45 channels
     velocity_scale: float = 0.0  # Huber of the pose's frame-to-frame change to the clip's (0: off)
+    wrist_scale: float = 0.0  # squared distance (m^2) of the waving wrist to the clip's (0: off)
     portrayal_direct_loss: bool = True  # also fit the self-description to the clip's description
     portrayal_scale: float = 1.0  # ... with this scale (MSE, summed over the 42 numbers)
     random_targets: int = 1  # pointing requests at random targets per iteration (pointing term only)
@@ -96,6 +98,7 @@ PRESETS = {
     "no_pointing_term": (AgentConfig(), replace(_DEFAULT_TRAIN, random_targets=0, pointing_scale=0.0)),
     "velocity_term": (AgentConfig(), replace(_DEFAULT_TRAIN, velocity_scale=500.0)),
     "weight_average": (AgentConfig(), replace(_DEFAULT_TRAIN, average_last_epochs=20)),
+    "wrist_term": (AgentConfig(), replace(_DEFAULT_TRAIN, wrist_scale=300.0)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

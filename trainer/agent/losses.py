@@ -14,6 +14,9 @@ On a batch of C chunks of L frames (batch-major, from trainer/agent/buffer.py):
                  over the 42 numbers), when `portrayal_direct_loss`;
     velocity     optional (`velocity_scale` > 0): Huber of the Beta mean's change from frame to frame to
                  the clip's, summed over the 45 channels, where both frames imitate a clip;
+    wrist        optional (`wrist_scale` > 0): squared distance (m^2) between the waving wrist of the
+                 Beta mean's pose and the clip's, through differentiable forward kinematics, on the
+                 wave frames that imitate a clip: the hand path the swing is measured on;
     pointing     the agent's own finger line against the objective's ray at the frames where the clip
                  holds its point (trainer/agent/pointing.py), through differentiable forward kinematics
                  of the Beta's mean pose; on when the action bounds are given;
@@ -29,6 +32,7 @@ import torch
 import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
+from rlanimate_addon.core import spaces
 from rlanimate_addon.core.agent_file import INITIAL_ACTION
 from trainer.agent import pointing
 
@@ -70,9 +74,14 @@ def agent_losses(agent, batch, config, bounds=None):
     if bounds is not None and hold is not None and hold.any():
         terms["pointing"] = pointing.pointing_error(policy.mean[hold], objective[hold],
                                                     torch.as_tensor(bounds, dtype=objective.dtype)).mean()
+    if config.wrist_scale and bounds is not None:  # only then: runs without it log the terms they always had
+        waving = (objective[..., spaces.OBJECTIVE_TYPE] == spaces.BEHAVIOUR_TYPE["WAVE"]) & (imitate > 0.5)  # (C, L)
+        terms["wrist"] = (pointing.wrist_error(policy.mean[waving], motion[waving], objective[waving],
+                                               torch.as_tensor(bounds, dtype=objective.dtype)).mean()
+                          if waving.any() else torch.zeros((), dtype=objective.dtype))
     terms["policy"] = masked_mean(concentration_nll(policy, motion), imitate)
     scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
-              "velocity": config.velocity_scale,
+              "velocity": config.velocity_scale, "wrist": config.wrist_scale,
               "portrayal": config.portrayal_scale, "pointing": config.pointing_scale, "policy": config.policy_scale}
     terms["total"] = sum(scales[name] * value for name, value in terms.items())
     return terms

@@ -50,6 +50,17 @@ class FingerKinematics:
 
     def finger(self, rotvecs, arm):
         """rotvecs (..., 15, 3) -> index base (..., 3) and unit finger direction (..., 3)."""
+        heads = self.heads(rotvecs, arm)  # (..., K, 3)
+        base, tip = heads[..., -4, :], heads[..., -1, :]  # HandIndex1 and HandIndex4 heads
+        direction = tip - base
+        return base, direction / direction.norm(dim=-1, keepdim=True)
+
+    def wrist(self, rotvecs, arm):
+        """rotvecs (..., 15, 3) -> the arm's wrist (its Hand bone's head) (..., 3)."""
+        return self.heads(rotvecs, arm)[..., -5, :]
+
+    def heads(self, rotvecs, arm):
+        """rotvecs (..., 15, 3) -> the heads (..., K, 3) of the K bones from the root to the index tip."""
         local, columns = self._chains[arm]
         local = local.to(rotvecs.dtype)
         batch = rotvecs.shape[:-2]
@@ -63,9 +74,7 @@ class FingerKinematics:
                 position = position + (rotation @ local[k, :3, 3:])[..., 0]
                 rotation = rotation @ turn
             heads.append(position)
-        base, tip = heads[-4], heads[-1]  # HandIndex1 and HandIndex4 heads
-        direction = tip - base
-        return base, direction / direction.norm(dim=-1, keepdim=True)
+        return torch.stack(heads, -2)
 
 
 def _rotvec_to_matrix(rotvec):
@@ -79,11 +88,16 @@ def _rotvec_to_matrix(rotvec):
     return eye + torch.sin(angle) / angle * cross + (1 - torch.cos(angle)) / (angle2 + 1e-12) * (cross @ cross)
 
 
+def action_rotvecs(actions, bounds):
+    """Actions (..., 45) in [0, 1] -> rotation vectors (..., 15, 3) within the action bounds (45, 2)."""
+    low, high = bounds[:, 0], bounds[:, 1]
+    return (low + actions * (high - low)).reshape(actions.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
+
+
 def pointing_error(actions, objectives, bounds):
     """(N,) pointing term of actions (N, 45) in [0, 1] against POINT objectives (N, 7): pass only the
     frames that count (the hold), since forward kinematics is most of a training step's cost."""
-    low, high = bounds[:, 0], bounds[:, 1]
-    rotvecs = (low + actions * (high - low)).reshape(actions.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
+    rotvecs = action_rotvecs(actions, bounds)
     ray = objectives[..., spaces.OBJECTIVE_ATTRIBUTES]
     error = actions.new_zeros(actions.shape[:-1])
     for k, arm in enumerate(skeleton.ARMS):
@@ -96,6 +110,19 @@ def pointing_error(actions, objectives, bounds):
         across = offset - (offset * arm_ray).sum(-1, keepdim=True) * arm_ray
         term = (finger - arm_ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
         error = error.index_put((mine,), term)
+    return error
+
+
+def wrist_error(actions, motion, objectives, bounds):
+    """(N,) squared distance (m^2) between the wrist of actions (N, 45) and of the clip's poses motion
+    (N, 45), each frame on its objective's (N, 7) arm: the hand path a wave's swing is measured on."""
+    played, reference = action_rotvecs(actions, bounds), action_rotvecs(motion, bounds)
+    error = actions.new_zeros(actions.shape[:-1])
+    for k, arm in enumerate(skeleton.ARMS):
+        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5
+        if mine.any():
+            offset = FINGERS.wrist(played[mine], arm) - FINGERS.wrist(reference[mine], arm)
+            error = error.index_put((mine,), offset.pow(2).sum(-1))
     return error
 
 

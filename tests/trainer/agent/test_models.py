@@ -2,6 +2,7 @@
 the portrayal model through the pose term (the paper's L3)."""
 import dataclasses
 
+import numpy as np
 import pytest
 import torch
 
@@ -132,7 +133,7 @@ def test_supervised_variant_clones_the_clip_without_kl():
 
 def test_presets_and_config_round_trip():
     assert set(PRESETS) == {"debug", "default", "paper", "paper_wave_objective", "reference_posterior",
-                            "no_random_targets", "no_pointing_term", "velocity_term", "weight_average"}
+                            "no_random_targets", "no_pointing_term", "velocity_term", "weight_average", "wrist_term"}
     for name in PRESETS:
         agent_config, train_config = load_preset(name)
         assert AgentConfig.from_dict(agent_config.to_dict()) == agent_config
@@ -176,13 +177,14 @@ def test_the_ablation_presets_change_one_choice_each():
     changed = {name: {f.name for f in dataclasses.fields(TrainConfig)
                       if getattr(PRESETS[name][1], f.name) != getattr(default, f.name)}
                for name in ("paper_wave_objective", "reference_posterior", "no_random_targets", "no_pointing_term",
-                            "velocity_term", "weight_average")}
+                            "velocity_term", "weight_average", "wrist_term")}
     assert changed == {"paper_wave_objective": {"wave_rhythm"},
                        "reference_posterior": {"wave_rhythm", "posterior_on_reference"},
                        "no_random_targets": {"random_targets"},
                        "no_pointing_term": {"random_targets", "pointing_scale"},
                        "velocity_term": {"velocity_scale"},
-                       "weight_average": {"average_last_epochs"}}
+                       "weight_average": {"average_last_epochs"},
+                       "wrist_term": {"wrist_scale"}}
 
 
 def test_the_velocity_term_sees_a_still_arm_on_a_wave_and_not_an_offset_pose():
@@ -207,3 +209,17 @@ def test_the_velocity_term_is_logged_and_counted_only_when_on():
     on = agent.losses(batch, dataclasses.replace(train, velocity_scale=10.0))
     assert torch.isfinite(on["velocity"]) and float(on["velocity"].detach()) > 0.0
     assert torch.allclose(on["total"], off["total"] + 10.0 * on["velocity"])
+
+
+def test_the_wrist_term_is_logged_and_counted_only_when_on_and_given_the_bounds():
+    config, train = load_preset("debug")
+    agent = RLAnimateAgent(config)
+    batch = synthetic_batch(6, 8)
+    bounds = np.asarray(spaces.DEFAULT_ACTION_BOUNDS)
+    assert "wrist" not in agent.losses(batch, train, bounds)
+    torch.manual_seed(0)
+    off = agent.losses(batch, train, bounds)
+    torch.manual_seed(0)
+    on = agent.losses(batch, dataclasses.replace(train, wrist_scale=10.0), bounds)
+    assert float(on["wrist"].detach()) > 0.0
+    assert torch.allclose(on["total"], off["total"] + 10.0 * on["wrist"])
