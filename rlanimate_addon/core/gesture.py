@@ -86,6 +86,12 @@ def character_frame(rest_heads):
     return u @ np.diag([1.0, 1.0, sign]) @ vt
 
 
+#: A target nearer the rest shoulder than this times the arm's reach is refused: the collar bone's turn
+#: carries the finger base past the rest reach (the sample rig's arm points away from a target 1.04
+#: times the reach in front of its shoulder, and hits one at 1.09).
+REACH_MARGIN = 1.1
+
+
 def pointing_directions(arm, targets, rest_heads):
     """(N, 3) unit vectors in the character frame from the rig's rest shoulder to each target.
 
@@ -102,7 +108,26 @@ def pointing_directions(arm, targets, rest_heads):
                              "and parents, and the armature's transform.")
     if np.any(norms < 1e-3 * scale):
         raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
+    reach = arm_reach(arm, rest_heads)
+    if np.any(norms < REACH_MARGIN * reach):
+        raise RLAnimateError(f"The target comes within the {arm.lower()} arm's reach (at its closest "
+                             f"{norms.min() / reach:.0%} of the way from the shoulder to the outstretched index "
+                             "finger), so the pointing arm would reach through it and point away from it: move the "
+                             f"target at least {REACH_MARGIN:.1f} times that far from the shoulder.")
     return (offsets / norms[:, None]) @ character_frame(rest_heads).T
+
+
+def arm_reach(arm, rest_heads):
+    """The outstretched arm's reach: from the rest shoulder to the index finger's base, in the rig's
+    units (rest_heads: {role: (3,)}); from the wrist, scaled as on the canonical skeleton, for a rig
+    without index bones."""
+    prefix = skeleton.ARM_PREFIX[arm]
+    shoulder = np.asarray(rest_heads[prefix + "Arm"], dtype=np.float64)
+    if prefix + "HandIndex1" in rest_heads:
+        return float(np.linalg.norm(np.subtract(rest_heads[prefix + "HandIndex1"], shoulder)))
+    canonical = {name: np.asarray(skeleton.BONE_BY_NAME[prefix + name].head) for name in ("Arm", "Hand", "HandIndex1")}
+    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(canonical["Hand"] - canonical["Arm"])
+    return float(ratio * np.linalg.norm(np.subtract(rest_heads[prefix + "Hand"], shoulder)))
 
 
 def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5, rhythm=None):

@@ -52,6 +52,20 @@ def test_pointing_directions_match_the_spaces_definition_whatever_the_rig_scale_
         gesture.pointing_directions("RIGHT", [heads["RightArm"]], heads)
 
 
+def test_a_target_within_the_arms_reach_is_refused_on_rigs_with_and_without_index_bones():
+    heads = {name: 100.0 * head for name, head in gesture.canonical_rig().rest_heads.items()}  # centimetres
+    fingerless = {name: head for name, head in heads.items() if "Index" not in name}
+    shoulder = heads["RightArm"]
+    reach = np.linalg.norm(heads["RightHandIndex1"] - shoulder)
+    assert gesture.arm_reach("RIGHT", fingerless) == pytest.approx(gesture.arm_reach("RIGHT", heads)) == \
+        pytest.approx(reach)
+    ahead = np.array([0.0, -1.0, 0.0])  # the character faces -Y
+    for rig in (heads, fingerless):
+        with pytest.raises(RLAnimateError, match="within the right arm's reach \\(at its closest 90% of the way"):
+            gesture.pointing_directions("RIGHT", [shoulder + 2.0 * reach * ahead, shoulder + 0.9 * reach * ahead], rig)
+        assert np.allclose(gesture.pointing_directions("RIGHT", [shoulder + 1.2 * reach * ahead], rig), [ahead])
+
+
 def test_retarget_gives_every_bone_the_canonical_armature_space_rotation():
     names = skeleton.ACTION_JOINTS
     to_character = random_rotations(1)[0]
