@@ -43,6 +43,17 @@ def check_keepable(obj):
                              "Editable) and generate again.")
 
 
+def check_inherited_rotation(obj, roles):
+    """RLAnimateError when a bone playing a role does not inherit its parent's rotation: the gesture's
+    retargeting and aim turn each bone relative to its parent."""
+    loose = [bone for bone in roles.values() if not obj.data.bones[bone].use_inherit_rotation]
+    if loose:
+        raise RLAnimateError(f"Bone {loose[0]!r} of {obj.name!r} does not inherit its parent's rotation (Bone "
+                             "Properties > Relations > Inherit Rotation is off), and the gesture turns each bone "
+                             "relative to its parent: turn Inherit Rotation on for it, or map another bone to its "
+                             "role with a bone-map file.")
+
+
 def check_nla(obj):
     """RLAnimateError when the armature's NLA would not play a new gesture track: a strip in tweak mode,
     or a soloed track (only it plays)."""
@@ -103,6 +114,7 @@ def _check(obj, settings, start, end, mute_constraints):
     check_fk_arm(obj, family, settings.arm)
     check_keepable(obj)
     check_nla(obj)
+    check_inherited_rotation(obj, roles)
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}

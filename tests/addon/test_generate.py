@@ -276,6 +276,10 @@ def test_every_bad_input_is_refused_with_its_message_and_changes_nothing(setting
     data.use_tweak_mode = True  # Tab on the strip in the NLA editor
     _assert_refused(rig, "'RLAnimate_Character' is in NLA tweak mode")
     data.use_tweak_mode = False
+    hand = rig.data.bones[helpers.rig_bone(rig, "RightHand")]
+    hand.use_inherit_rotation = False
+    _assert_refused(rig, f"Bone {hand.name!r} of 'RLAnimate_Character' does not inherit its parent's rotation")
+    hand.use_inherit_rotation = True
     settings.target_bone = "NoSuchBone"
     settings.target = partial
     _assert_refused(rig, "The target 'Partial' has no bone 'NoSuchBone'")
