@@ -2,8 +2,9 @@
 
 A role is a canonical bone name ('Spine1', 'LeftArm', 'RightHandIndex1'). A rig family names its bones
 for the roles with left-side templates in which `{s}` stands for the family's side token; the right
-side swaps the token. Names are compared case-insensitively, after dropping any namespace
-('mixamorig1:', 'Armature|') and a Mixamo prefix, glued ('mixamorigLeftArm') or joined by '_'.
+side swaps the token. Names are compared case-insensitively and without spaces, after dropping any
+namespace ('mixamorig1:', 'Armature|'), a Mixamo prefix, glued ('mixamorigLeftArm') or joined by
+'_', and a 3ds Max Biped prefix ('Bip01 ').
 
 A bone map ({role: bone name}) comes from the family that matches the most roles, or from a bone-map
 file the user loads in the panel (JSON: {"family": name, "bones": {role: bone name}}).
@@ -111,17 +112,36 @@ CHARACTER_CREATOR = _family(
      "LeftArm": ("CC_Base_{s}_Upperarm",), "LeftForeArm": ("CC_Base_{s}_Forearm",), "LeftHand": ("CC_Base_{s}_Hand",)},
     _fingers("CC_Base_{{s}}_{finger}{k}", {f: "Mid" if f == "Middle" else f for f in _FINGERS}))
 
-#: Every family, in the order that wins a tie.
-FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, CHARACTER_CREATOR, METARIG)
+#: Rigify's deform bones alone, as a game export keeps them: the metarig's names behind "DEF-". A
+#: whole Rigify rig has them too, driven by its controls, so this family is only tried on a rig
+#: without Rigify's controls (`detect`).
+RIGIFY_DEFORM = Family("Rigify deform", METARIG.sides,
+                       {role: tuple("DEF-" + name for name in names) for role, names in METARIG.templates.items()})
 
-_MIXAMO_PREFIX = re.compile(r"^mixamorig\d*_?")
+_BIPED_FINGERS = {f: n for n, f in enumerate(_FINGERS)}
+BIPED = _family(
+    "3ds Max Biped", ("L", "R"),
+    {"Hips": ("Pelvis",), "Spine": ("Spine",), "Spine1": ("Spine1",), "Spine2": ("Spine2",), "Neck": ("Neck",),
+     "Head": ("Head",)},
+    {"LeftShoulder": ("{s}Clavicle",), "LeftArm": ("{s}UpperArm",), "LeftForeArm": ("{s}Forearm",),
+     "LeftHand": ("{s}Hand",)},
+    {f"LeftHand{f}{k}": (f"{{s}}Finger{n}{'' if k == 1 else k - 1}",) for f, n in _BIPED_FINGERS.items()
+     for k in (1, 2, 3)})
+
+#: Every family, in the order that wins a tie.
+FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, CHARACTER_CREATOR, METARIG, RIGIFY_DEFORM,
+            BIPED)
+
+#: Prefixes dropped before matching: Mixamo's ('mixamorig', 'mixamorig1_') and 3ds Max Biped's
+#: ('Bip01 ', 'Bip001 ').
+_PREFIX = re.compile(r"^(mixamorig\d*_?|bip0*1)")
 
 
 @lru_cache(maxsize=4096)
 def name_key(name):
-    """A bone name as matching compares it: namespace and Mixamo prefix dropped, lower case (cached:
-    detection compares every bone with every family's names on each Generate)."""
-    return _MIXAMO_PREFIX.sub("", re.split(r"[:|]", name)[-1].lower())
+    """A bone name as matching compares it: namespace, spaces and a Mixamo or Biped prefix dropped, lower
+    case (cached: detection compares every bone with every family's names on each Generate)."""
+    return _PREFIX.sub("", re.split(r"[:|]", name)[-1].lower().replace(" ", ""))
 
 
 def _side_templates(family, role):
@@ -151,7 +171,9 @@ def family_roles(bone_names, family):
 
 def detect(bone_names):
     """(family, {role: bone name}) of the family that recognises the most roles (ties: FAMILIES order)."""
-    scored = [(len(family_roles(bone_names, f)), -i, f) for i, f in enumerate(FAMILIES)]
+    controlled = bool(family_roles(bone_names, RIGIFY))
+    scored = [(len(family_roles(bone_names, f)), -i, f) for i, f in enumerate(FAMILIES)
+              if not (f is RIGIFY_DEFORM and controlled)]
     _, _, family = max(scored, key=lambda s: s[:2])
     return family, family_roles(bone_names, family)
 

@@ -59,6 +59,23 @@ def unreal_named(rig, tmp):
     return _rename(rig, _family_renamer(rig_roles.UNREAL))
 
 
+def rigify_deform_named(rig, tmp):
+    """Rigify's deform bones alone, as a game export of a Rigify rig has them (DEF-upper_arm.L, ...)."""
+    return _rename(rig, _family_renamer(rig_roles.RIGIFY_DEFORM))
+
+
+def biped_named(rig, tmp):
+    """3ds Max Biped names with their spaces: 'Bip01 R UpperArm', 'Bip01 Spine1'."""
+    family_name = _family_renamer(rig_roles.BIPED)
+
+    def rename(name):
+        new = family_name(name)
+        if new == name:
+            return name
+        return f"Bip01 {new[0]} {new[1:]}" if name.startswith(("Left", "Right")) else "Bip01 " + new
+    return _rename(rig, rename)
+
+
 def _select_only(objects):
     for obj in bpy.context.view_layer.objects:
         obj.select_set(obj in objects)
@@ -192,7 +209,8 @@ def rigify_generated(rig, tmp):
 BUILDERS = {f.__name__: f for f in (
     no_eyes_no_index4, numbered_prefix, glued_prefix, centimetre_fbx_automatic_orientation,
     centimetre_fbx_plain_orientation, gltf_blender_bones, gltf_temperance_bones, gltf_fortune_bones, euler_bones,
-    rigify_named, unreal_named, rotated_and_parented, idle_animation, blender_human_metarig, rigify_generated)}
+    rigify_named, unreal_named, rigify_deform_named, biped_named, rotated_and_parented, idle_animation,
+    blender_human_metarig, rigify_generated)}
 
 
 def build(name, folder):

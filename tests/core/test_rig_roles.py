@@ -33,7 +33,30 @@ def test_each_family_is_detected_from_its_own_names_with_every_gesture_role(fami
     assert detected is family
     for arm in skeleton.ARMS:
         rig_roles.check_roles("Rig", roles, arm, family.name)
-    assert not any(bone.startswith(("DEF-", "ORG-", "MCH-")) for bone in roles.values())
+    if family is not rig_roles.RIGIFY_DEFORM:
+        assert not any(bone.startswith(("DEF-", "ORG-", "MCH-")) for bone in roles.values())
+
+
+def test_a_rigify_game_export_keys_its_deform_bones_and_a_whole_rigify_rig_its_controls():
+    deform = _family_names(rig_roles.RIGIFY_DEFORM) + ["DEF-upper_arm.L.001", "DEF-forearm.R.001", "root"]
+    family, roles = rig_roles.detect(deform)
+    assert family is rig_roles.RIGIFY_DEFORM and roles["LeftArm"] == "DEF-upper_arm.L" and roles["Head"] == "DEF-spine.006"
+    family, roles = rig_roles.detect(deform + _family_names(rig_roles.RIGIFY))
+    assert family is rig_roles.RIGIFY and roles["LeftArm"] == "upper_arm_fk.L"
+
+
+@pytest.mark.parametrize("prefix", ["Bip01 ", "Bip001 "])
+def test_biped_and_spaced_mixamo_names_are_detected(prefix):
+    names = [prefix + n for n in ("Pelvis", "Spine", "Spine1", "Spine2", "Neck", "Head")] + [
+        f"{prefix}{s} {part}" for s in "LR" for part in ("Clavicle", "UpperArm", "Forearm", "Hand", "Finger0",
+                                                        "Finger1", "Finger11", "Finger12")]
+    family, roles = rig_roles.detect(names)
+    assert family is rig_roles.BIPED
+    assert (roles["RightArm"], roles["LeftHandIndex3"], roles["LeftHandThumb1"]) == (
+        f"{prefix}R UpperArm", f"{prefix}L Finger12", f"{prefix}L Finger0")
+    spaced = ["mixamorig:" + n.replace("Left", "Left ").replace("Right", "Right ") for n in MIXAMO]
+    family, roles = rig_roles.detect(spaced)
+    assert family is rig_roles.MIXAMO and roles["RightForeArm"] == "mixamorig:Right ForeArm"
 
 
 def test_rigify_keys_the_fk_controls():
