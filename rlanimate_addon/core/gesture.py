@@ -451,6 +451,15 @@ def hips_relative_targets(rig, targets, count):
     return np.einsum("nij,nj->ni", back[:, :3, :3], points) + back[:, :3, 3]
 
 
+def played_finger_base(canonical, arm):
+    """(N, 3) index-base path of canonical rotations (N, 15, 3) blended from their first frame as the keys
+    blend from the pose underneath (`blend_weights`): it comes back to its start even where the agent's
+    own hand does not (a target behind the character), so the aim's pointing phase stays whole."""
+    quats = matrix_to_quat(rotvec_to_matrix(canonical))  # (N, 15, 4)
+    blended = blend_from_pose(quats[0], quats, blend_weights(len(canonical)))
+    return aim.finger_lines(matrix_to_rotvec(quat_to_matrix(blended)), arm)[1]
+
+
 def gesture_rotations(agent, request, rig):
     """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
 
@@ -468,7 +477,7 @@ def gesture_rotations(agent, request, rig):
     objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=asked,
                                   rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
-    phase_base = aim.finger_lines(canonical, request.arm)[1] if request.behaviour == "POINT" else None
+    phase_base = played_finger_base(canonical, request.arm) if request.behaviour == "POINT" else None
     names, canonical = fold_spine(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
     if request.behaviour == "POINT":
         hand_names, hand = pointing_hand_rotations(request.arm, request.frame_count)

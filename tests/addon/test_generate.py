@@ -64,6 +64,21 @@ def test_point_aims_the_index_finger_at_unseen_targets_and_returns(settings, arm
         assert np.linalg.norm(bases[-1] - bases[0]) < 0.02, "the gesture must end where it started"
 
 
+def test_exact_aim_holds_on_a_target_behind_the_character(settings):
+    """The agent never learned to point behind itself and its hand does not come back from there; the
+    aim still holds the finger on the target through the middle of the gesture."""
+    rig = helpers.load_sample_rig()
+    helpers.stand_neutral(rig)
+    location = skeleton.shoulder_rest_position("RIGHT") + (0.0, 2.0, 0.0)  # the character faces -Y
+    target = helpers.add_empty("Behind", location)
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, start_frame=1) == {"FINISHED"}
+    count = settings.frame_count
+    angles, bases = finger_angles(rig, "RIGHT", location, np.arange(1, count + 1))
+    middle = angles[int(0.4 * count):int(0.6 * count)]
+    print(f"behind: middle of the gesture misses by {middle.max():.2f} deg at worst")
+    assert middle.max() < 0.5 and np.linalg.norm(bases[-1] - bases[0]) < 0.02
+
+
 @pytest.mark.parametrize("arm", ["LEFT", "RIGHT"])
 def test_a_bigger_exaggeration_gives_a_wider_and_higher_wave(settings, arm):
     rig = helpers.load_sample_rig()
