@@ -218,7 +218,7 @@ def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underne
     finger, to_target = rig.skeleton.tails(pose, end) - base, target - base
     cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(finger, axis=1) / np.linalg.norm(to_target, axis=1)
     angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
-    phase = aim.pointing_phase(aim.finger_lines(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm)[1])
+    phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm))
     assert angles[phase == 1.0].max() < 0.01, "at full weight the finger line must pass through the target"
 
 
@@ -233,7 +233,7 @@ def test_the_eyes_look_at_the_target_while_pointing(animated):
     basis = rig.under_at(frames).copy()
     basis[:, [rig.skeleton.index[n] for n in names], :3, :3] = quat_to_matrix(quats)
     pose = rig.skeleton.pose_matrices(basis, only=("LeftEye", "RightEye"))
-    phase = aim.pointing_phase(aim.finger_lines(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT")[1])
+    phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT"))
     for eye in ("LeftEye", "RightEye"):
         i = rig.skeleton.index[eye]
         looking = pose[:, i, :3, :3] @ (skeleton.rest_frame(skeleton.BONE_BY_NAME[eye]).T @ [0.0, -1.0, 0.0])
