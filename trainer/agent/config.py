@@ -6,13 +6,12 @@
     paper    the paper gives no sizes; it follows PlaNet (Hafner et al. 2019), so this preset uses
              PlaNet's (200 deterministic / 30 stochastic units, 50 chunks of 50 frames, free nats 3,
              Adam 1e-3, gradient clip 1000). It is slow on a CPU.
-    paper_wave_objective, reference_posterior, no_random_targets, no_pointing_term
+    paper_wave_objective, reference_posterior, no_random_targets, no_pointing_term, no_wrist_term
              the default with one of issue 10's choices undone (docs/AGENT.md); reference_posterior
              is meant for the single_state variant (the stochastic behaviour state carries the wave);
-    velocity_term, weight_average, wrist_term
-             the default plus a pose-velocity term, with the weights averaged over the last 20
-             epochs, or plus a waving-wrist term: tried for the biggest waves' shortfall and for
-             pointing (docs/AGENT.md).
+    velocity_term, weight_average
+             the default plus a pose-velocity term, or with the weights averaged over the last 20
+             epochs: tried for the biggest waves' shortfall and for pointing (docs/AGENT.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -57,7 +56,7 @@ class TrainConfig:
     kl_scale: float = 0.1  # the paper's L2: KL(q || p)
     pose_scale: float = 100.0  # the paper's L3: Huber to the clip's pose, summed over the 45 channels
     velocity_scale: float = 0.0  # Huber of the pose's frame-to-frame change to the clip's (0: off)
-    wrist_scale: float = 0.0  # squared distance (m^2) of the waving wrist to the clip's (0: off)
+    wrist_scale: float = 0.0  # squared distance (m^2) of the waving wrist to the clip's (0: off; default preset 1000)
     portrayal_direct_loss: bool = True  # also fit the self-description to the clip's description
     portrayal_scale: float = 1.0  # ... with this scale (MSE, summed over the 42 numbers)
     random_targets: int = 1  # pointing requests at random targets per iteration (pointing term only)
@@ -83,7 +82,8 @@ def _known_fields(cls, values):
 
 
 _DEFAULT_TRAIN = TrainConfig(update_steps=160, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4,
-                             random_targets=3, random_target_margin_deg=20.0, random_target_weight=1 / 3)
+                             random_targets=3, random_target_margin_deg=20.0, random_target_weight=1 / 3,
+                             wrist_scale=1000.0)
 PRESETS = {
     "debug": (
         AgentConfig(task_size=8, behaviour_size=8, stochastic_size=4, hidden_size=8,
@@ -98,7 +98,7 @@ PRESETS = {
     "no_pointing_term": (AgentConfig(), replace(_DEFAULT_TRAIN, random_targets=0, pointing_scale=0.0)),
     "velocity_term": (AgentConfig(), replace(_DEFAULT_TRAIN, velocity_scale=500.0)),
     "weight_average": (AgentConfig(), replace(_DEFAULT_TRAIN, average_last_epochs=20)),
-    "wrist_term": (AgentConfig(), replace(_DEFAULT_TRAIN, wrist_scale=300.0)),
+    "no_wrist_term": (AgentConfig(), replace(_DEFAULT_TRAIN, wrist_scale=0.0)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

@@ -121,7 +121,9 @@ def wrist_error(actions, motion, objectives, bounds):
     for k, arm in enumerate(skeleton.ARMS):
         mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5
         if mine.any():
-            offset = FINGERS.wrist(played[mine], arm) - FINGERS.wrist(reference[mine], arm)
+            with torch.no_grad():  # the clip's wrist is a target
+                target = FINGERS.wrist(reference[mine], arm)
+            offset = FINGERS.wrist(played[mine], arm) - target
             error = error.index_put((mine,), offset.pow(2).sum(-1))
     return error
 

@@ -133,7 +133,7 @@ def test_supervised_variant_clones_the_clip_without_kl():
 
 def test_presets_and_config_round_trip():
     assert set(PRESETS) == {"debug", "default", "paper", "paper_wave_objective", "reference_posterior",
-                            "no_random_targets", "no_pointing_term", "velocity_term", "weight_average", "wrist_term"}
+                            "no_random_targets", "no_pointing_term", "velocity_term", "weight_average", "no_wrist_term"}
     for name in PRESETS:
         agent_config, train_config = load_preset(name)
         assert AgentConfig.from_dict(agent_config.to_dict()) == agent_config
@@ -177,14 +177,14 @@ def test_the_ablation_presets_change_one_choice_each():
     changed = {name: {f.name for f in dataclasses.fields(TrainConfig)
                       if getattr(PRESETS[name][1], f.name) != getattr(default, f.name)}
                for name in ("paper_wave_objective", "reference_posterior", "no_random_targets", "no_pointing_term",
-                            "velocity_term", "weight_average", "wrist_term")}
+                            "velocity_term", "weight_average", "no_wrist_term")}
     assert changed == {"paper_wave_objective": {"wave_rhythm"},
                        "reference_posterior": {"wave_rhythm", "posterior_on_reference"},
                        "no_random_targets": {"random_targets"},
                        "no_pointing_term": {"random_targets", "pointing_scale"},
                        "velocity_term": {"velocity_scale"},
                        "weight_average": {"average_last_epochs"},
-                       "wrist_term": {"wrist_scale"}}
+                       "no_wrist_term": {"wrist_scale"}}
 
 
 def test_the_velocity_term_sees_a_still_arm_on_a_wave_and_not_an_offset_pose():
