@@ -3,9 +3,9 @@ with each, their behaviour measures on the held-out requests -> docs/results/age
 
     nice -n 10 python -m trainer.scripts.agent_ablation [--runs runs/agent_ablation] [--results docs/results]
 
-Waves: the rhythm in the objective (the default), the paper's objective (exaggeration only), and the
-stochastic behaviour state carrying the wave (single_state, its posterior on the clip's description
-during updates, its prior at play). Points: the pointing term with random targets (the default),
+Waves: the rhythm in the objective with the waving-wrist term (the default), without the wrist term,
+the paper's objective (exaggeration only), and the stochastic behaviour state carrying the wave
+(single_state, its posterior on the clip's description during updates, its prior at play). Points: the pointing term with random targets (the default),
 without the random targets, and with neither. Runs that already finished are not trained again.
 """
 import argparse
@@ -29,7 +29,8 @@ from trainer.scripts.cli import run_main, script_args
 _CHOSEN = load_preset("default")[1]
 #: name: (behaviour, preset, variant, label)
 ABLATIONS = {
-    "wave_rhythm": ("wave", "default", "rlanimate", "rhythm in the objective (chosen)"),
+    "wave_rhythm": ("wave", "default", "rlanimate", "rhythm in the objective and the wrist term (chosen)"),
+    "wave_no_wrist_term": ("wave", "no_wrist_term", "rlanimate", "rhythm in the objective, no wrist term"),
     "wave_paper_objective": ("wave", "paper_wave_objective", "rlanimate", "the paper's objective"),
     "wave_reference_posterior": ("wave", "reference_posterior", "single_state",
                                  "behaviour state on the clip, prior at play"),
