@@ -42,17 +42,21 @@ LOAD_AT_START = os.getloadavg()[0]
 
 
 def synthetic_buffer(rng):
-    """EPISODES episodes of random frames with the buffer's fields; every third a random-target request."""
+    """EPISODES episodes of random frames with the buffer's fields: a random-target pointing request, a
+    pointing clip and a wave clip in turn (the default run's buffer holds about as many wave frames as
+    pointing-clip frames, and the wrist term works on the waves)."""
     buffer = EpisodeBuffer()
     for k in range(EPISODES):
         frames = int(rng.integers(*EPISODE_FRAMES))
+        wave = k % 3 == 2
         objective = np.zeros((frames, spaces.OBJECTIVE_SIZE))
-        objective[:, 0] = 1.0  # POINT
+        objective[:, 0] = spaces.BEHAVIOUR_TYPE["WAVE" if wave else "POINT"]
         objective[:, 2] = 1.0  # RIGHT
         objective[:, 3:6] = rng.normal(size=3) / np.sqrt(3.0)
         objective[:, 6] = np.linspace(0.0, 1.0, frames)
         hold = np.zeros(frames)
-        hold[frames // 3: frames // 2] = 1.0
+        if not wave:
+            hold[frames // 3: frames // 2] = 1.0
         buffer.add({"objective": objective, "action": rng.random((frames, spaces.ACTION_SIZE)),
                     "description": rng.normal(size=(frames, spaces.DESCRIPTION_SIZE)),
                     "motion": rng.random((frames, spaces.ACTION_SIZE)),
