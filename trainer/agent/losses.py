@@ -32,9 +32,10 @@ import torch
 import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
-from rlanimate_addon.core import spaces
+from rlanimate_addon.core import skeleton, spaces
 from rlanimate_addon.core.agent_file import INITIAL_ACTION
 from trainer.agent import pointing
+from trainer.agent.arm_kinematics import ARMS, action_rotvecs
 
 #: Clip poses are kept this far inside (0, 1) for the Beta's log-likelihood.
 POSE_MARGIN = 1e-3
@@ -76,8 +77,8 @@ def agent_losses(agent, batch, config, bounds=None):
                                                     torch.as_tensor(bounds, dtype=objective.dtype)).mean()
     if config.wrist_scale and bounds is not None:  # only then: runs without it log the terms they always had
         waving = (objective[..., spaces.OBJECTIVE_TYPE] == spaces.BEHAVIOUR_TYPE["WAVE"]) & (imitate > 0.5)  # (C, L)
-        terms["wrist"] = (pointing.wrist_error(policy.mean[waving], motion[waving], objective[waving],
-                                               torch.as_tensor(bounds, dtype=objective.dtype)).mean()
+        terms["wrist"] = (wrist_error(policy.mean[waving], motion[waving], objective[waving],
+                                      torch.as_tensor(bounds, dtype=objective.dtype)).mean()
                           if waving.any() else torch.zeros((), dtype=objective.dtype))
     terms["policy"] = masked_mean(concentration_nll(policy, motion), imitate)
     scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
@@ -92,6 +93,21 @@ def velocity_error(poses, motion, imitate, delta):
     channels, averaged over the frame pairs that both imitate the clip (imitate (C, L))."""
     error = F.huber_loss(poses.diff(dim=1), motion.diff(dim=1), reduction="none", delta=delta)  # (C, L - 1, 45)
     return masked_mean(error.sum(-1), imitate[:, 1:] * imitate[:, :-1])
+
+
+def wrist_error(actions, motion, objectives, bounds):
+    """(N,) squared distance (m^2) between the wrist of actions (N, 45) and of the clip's poses motion
+    (N, 45), each frame on its objective's (N, 7) arm: the hand path a wave's swing is measured on."""
+    played, reference = action_rotvecs(actions, bounds), action_rotvecs(motion, bounds)
+    error = actions.new_zeros(actions.shape[:-1])
+    for k, arm in enumerate(skeleton.ARMS):
+        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5
+        if mine.any():
+            with torch.no_grad():  # the clip's wrist is a target
+                target = ARMS.wrist(reference[mine], arm)
+            offset = ARMS.wrist(played[mine], arm) - target
+            error = error.index_put((mine,), offset.pow(2).sum(-1))
+    return error
 
 
 def masked_mean(values, mask):

@@ -3,13 +3,15 @@ import torch
 
 from rlanimate_addon.core import aim, kinematics, skeleton, spaces
 from trainer.agent import pointing
+from trainer.agent.arm_kinematics import ARMS
+from trainer.agent.losses import wrist_error
 from trainer.motion import synthesis as gs
 
 
 def test_the_torch_finger_matches_the_numpy_forward_kinematics():
     rotvecs = np.random.default_rng(0).normal(0.0, 0.5, (6, 15, 3))
     for arm in skeleton.ARMS:
-        base, finger = pointing.FINGERS.finger(torch.tensor(rotvecs), arm)
+        base, finger = ARMS.finger(torch.tensor(rotvecs), arm)
         _, expected_base, expected_finger, _ = aim.finger_lines(rotvecs, arm)
         assert np.allclose(base.numpy(), expected_base, atol=1e-9)
         assert np.allclose(finger.numpy(), expected_finger, atol=1e-9)
@@ -52,10 +54,10 @@ def test_the_wrist_term_is_the_squared_wrist_distance_on_each_frames_own_arm():
     bounds = torch.tensor(spaces.DEFAULT_ACTION_BOUNDS)
     motion = torch.tensor(spaces.encode_action(rotvecs))
     objective = torch.tensor(np.vstack([spaces.make_objective("WAVE", arm, 0.5, 4) for arm in skeleton.ARMS]))
-    assert pointing.wrist_error(motion, motion, objective, bounds).abs().max() < 1e-12
+    assert wrist_error(motion, motion, objective, bounds).abs().max() < 1e-12
     turned = rotvecs.copy()
     turned[:, skeleton.ACTION_JOINTS.index("LeftForeArm")] += (0.0, 0.0, 0.2)
-    error = pointing.wrist_error(torch.tensor(spaces.encode_action(turned)), motion, objective, bounds).numpy()
+    error = wrist_error(torch.tensor(spaces.encode_action(turned)), motion, objective, bounds).numpy()
     wrists = {arm: kinematics.head_positions(kinematics.pose_matrices(
         dict(zip(skeleton.ACTION_JOINTS, np.moveaxis(r, 1, 0)))))[:, kinematics.bone_index(skeleton.ARM_PREFIX[arm] + "Hand")]
         for arm, r in (("LEFT", turned[:4]), ("RIGHT", turned[4:]))}
