@@ -127,9 +127,9 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
     with kept indices, Bezier keys on those frames only (core.key_reduction), else a linear key on
     every frame. On a rig with no animation the action
     becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
-    Blender's Push Down does, playing as before over its keys, the `played` frames (first, last: the
-    scene's range) and the gesture's, and the gesture goes on a new NLA track above it with the blend
-    type ('REPLACE' or 'COMBINE') and no effect outside its frames.
+    Blender's Push Down does, playing as before over its keys and the `played` frames (first, last:
+    the scene's range and the gesture's), and the gesture goes on a new NLA track above it with the
+    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames.
     """
     target = action_adapter.new_action(name, obj)
     for bone, (mode, values, kept) in keys.items():
@@ -143,8 +143,7 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
             else:
                 action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel])
     if action_adapter.is_animated(obj):
-        last_frame = start_frame + len(next(iter(keys.values()))[1]) - 1
-        action_adapter.push_down(obj, (min(played[0], start_frame), max(played[1], last_frame)))
+        action_adapter.push_down(obj, played)
         strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
         strip.blend_type = blend_type
     else:

@@ -199,7 +199,7 @@ def _write(plan, agent, scene):
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                       (scene.frame_start, scene.frame_end))
+                                       (min(scene.frame_start, start), max(scene.frame_end, end)))
     constraints.mute(plan.obj, plan.overriding, start, end)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""

@@ -11,7 +11,7 @@ file the user loads in the panel (JSON: {"family": name, "bones": {role: bone na
 """
 import json
 import re
-from collections import namedtuple
+from collections import Counter, namedtuple
 from functools import lru_cache
 
 from .errors import RLAnimateError
@@ -214,7 +214,7 @@ def read_bone_map(text, bone_names):
     if not isinstance(bones, dict) or not all(isinstance(b, str) and b for b in bones.values()):
         raise RLAnimateError('The bone-map file\'s "bones" must map role names to bone names, one name (a '
                              'string) per role: correct the file, or save a new one from the panel.')
-    shared = sorted({b for b in bones.values() if list(bones.values()).count(b) > 1})
+    shared = sorted(b for b, uses in Counter(bones.values()).items() if uses > 1)
     if shared:
         roles = [role for role, b in bones.items() if b == shared[0]]
         raise RLAnimateError(f"The bone-map file gives the bone {shared[0]!r} to the roles {', '.join(roles)}: "

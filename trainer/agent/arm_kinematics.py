@@ -6,7 +6,7 @@ pose, and the wrist term (trainer/agent/losses.py) its wrist.
 import numpy as np
 import torch
 
-from rlanimate_addon.core import kinematics, skeleton
+from rlanimate_addon.core import kinematics, skeleton, spaces
 
 _REST = skeleton.rest_matrices()
 
@@ -80,6 +80,17 @@ def action_rotvecs(actions, bounds):
     """Actions (..., 45) in [0, 1] -> rotation vectors (..., 15, 3) within the action bounds (45, 2)."""
     low, high = bounds[:, 0], bounds[:, 1]
     return (low + actions * (high - low)).reshape(actions.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
+
+
+def on_each_arm(objectives, frame_error):
+    """(N,) frame_error(arm, mask) (a (M,) tensor for the M frames of mask) put on the frames whose
+    objective (N, 7) names that arm; 0 elsewhere."""
+    error = objectives.new_zeros(objectives.shape[:-1])
+    for k, arm in enumerate(skeleton.ARMS):
+        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5
+        if mine.any():
+            error = error.index_put((mine,), frame_error(arm, mine))
+    return error
 
 
 #: The canonical skeleton's arm chains, built once.

@@ -32,10 +32,10 @@ import torch
 import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import spaces
 from rlanimate_addon.core.agent_file import INITIAL_ACTION
 from trainer.agent import pointing
-from trainer.agent.arm_kinematics import ARMS, action_rotvecs
+from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
 
 #: Clip poses are kept this far inside (0, 1) for the Beta's log-likelihood.
 POSE_MARGIN = 1e-3
@@ -99,15 +99,13 @@ def wrist_error(actions, motion, objectives, bounds):
     """(N,) squared distance (m^2) between the wrist of actions (N, 45) and of the clip's poses motion
     (N, 45), each frame on its objective's (N, 7) arm: the hand path a wave's swing is measured on."""
     played, reference = action_rotvecs(actions, bounds), action_rotvecs(motion, bounds)
-    error = actions.new_zeros(actions.shape[:-1])
-    for k, arm in enumerate(skeleton.ARMS):
-        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5
-        if mine.any():
-            with torch.no_grad():  # the clip's wrist is a target
-                target = ARMS.wrist(reference[mine], arm)
-            offset = ARMS.wrist(played[mine], arm) - target
-            error = error.index_put((mine,), offset.pow(2).sum(-1))
-    return error
+
+    def arm_error(arm, mine):
+        with torch.no_grad():  # the clip's wrist is a target
+            target = ARMS.wrist(reference[mine], arm)
+        return (ARMS.wrist(played[mine], arm) - target).pow(2).sum(-1)
+
+    return on_each_arm(objectives, arm_error)
 
 
 def masked_mean(values, mask):

@@ -15,7 +15,7 @@ import numpy as np
 import torch
 
 from rlanimate_addon.core import skeleton, spaces
-from trainer.agent.arm_kinematics import ARMS, action_rotvecs
+from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
 
 #: Metres: the nearest target distance the agent is asked to hit (targets are 1.5-4 m away).
 REFERENCE_DISTANCE = 1.5
@@ -27,18 +27,15 @@ def pointing_error(actions, objectives, bounds):
     frames that count (the hold), since forward kinematics is most of a training step's cost."""
     rotvecs = action_rotvecs(actions, bounds)
     ray = objectives[..., spaces.OBJECTIVE_ATTRIBUTES]
-    error = actions.new_zeros(actions.shape[:-1])
-    for k, arm in enumerate(skeleton.ARMS):
-        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5  # the frames this arm points on
-        if not mine.any():
-            continue
+
+    def arm_error(arm, mine):  # mine: the frames this arm points on
         base, finger = ARMS.finger(rotvecs[mine], arm)
         arm_ray = ray[mine]
         offset = base - torch.as_tensor(skeleton.shoulder_rest_position(arm), dtype=actions.dtype)
         across = offset - (offset * arm_ray).sum(-1, keepdim=True) * arm_ray
-        term = (finger - arm_ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
-        error = error.index_put((mine,), term)
-    return error
+        return (finger - arm_ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
+
+    return on_each_arm(objectives, arm_error)
 
 
 _OUTWARD = {"LEFT": 1.0, "RIGHT": -1.0}  # +X is the character's left
@@ -71,4 +68,3 @@ def hold_frames(objective, motion_description):
     across = np.linalg.norm(offset - np.sum(offset * ray, axis=1, keepdims=True) * ray, axis=1)
     angle = np.arccos(np.clip(np.sum(finger * ray, axis=1), -1.0, 1.0))
     return ((angle < HOLD_ANGLE) & (across < HOLD_OFFSET)).astype(np.float64)
-
