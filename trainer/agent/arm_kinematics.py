@@ -9,6 +9,8 @@ import torch
 from rlanimate_addon.core import kinematics, skeleton, spaces
 
 _REST = skeleton.rest_matrices()
+#: The index finger's bones below the hand (HandIndex1-4), the end of each chain.
+_FINGER_BONES = 4
 
 
 def _chain(arm):
@@ -39,18 +41,19 @@ class ArmKinematics:
     def finger(self, rotvecs, arm):
         """rotvecs (..., 15, 3) -> index base (..., 3) and unit finger direction (..., 3)."""
         heads = self.heads(rotvecs, arm)  # (..., K, 3)
-        base, tip = heads[..., -4, :], heads[..., -1, :]  # HandIndex1 and HandIndex4 heads
+        base, tip = heads[..., -_FINGER_BONES, :], heads[..., -1, :]  # HandIndex1 and HandIndex4 heads
         direction = tip - base
         return base, direction / direction.norm(dim=-1, keepdim=True)
 
     def wrist(self, rotvecs, arm):
         """rotvecs (..., 15, 3) -> the arm's wrist (its Hand bone's head) (..., 3)."""
-        return self.heads(rotvecs, arm)[..., -5, :]
+        return self.heads(rotvecs, arm, _FINGER_BONES)[..., -1, :]
 
-    def heads(self, rotvecs, arm):
-        """rotvecs (..., 15, 3) -> the heads (..., K, 3) of the K bones from the root to the index tip."""
+    def heads(self, rotvecs, arm, skip=0):
+        """rotvecs (..., 15, 3) -> the heads (..., K, 3) of the K bones from the root to the index tip, less
+        the last `skip` (a head depends only on the bones above it)."""
         local, columns = self._chains[arm]
-        local = local.to(rotvecs.dtype)
+        local, columns = local[:len(columns) - skip].to(rotvecs.dtype), columns[:len(columns) - skip]
         batch = rotvecs.shape[:-2]
         rotation, position = None, None  # the world rotation (..., 3, 3) and head (..., 3) down the chain
         heads = []
