@@ -81,7 +81,7 @@ def _known_fields(cls, values):
     return {key: value for key, value in dict(values).items() if key in names}
 
 
-_DEFAULT_TRAIN = TrainConfig(update_steps=160, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4,
+_DEFAULT_TRAIN = TrainConfig(update_steps=120, chunk_count=32, learning_rate=3e-3, learning_rate_final=1e-4,
                              random_targets=3, random_target_margin_deg=20.0, random_target_weight=1 / 3,
                              wrist_scale=1000.0)
 PRESETS = {
