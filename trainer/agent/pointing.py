@@ -22,6 +22,7 @@ REFERENCE_DISTANCE = 1.5
 #: A reference frame holds its point when its finger is this close to the ray (radians, metres).
 HOLD_ANGLE, HOLD_OFFSET = np.radians(1.0), 0.01
 
+
 def pointing_error(actions, objectives, bounds):
     """(N,) pointing term of actions (N, 45) in [0, 1] against POINT objectives (N, 7): pass only the
     frames that count (the hold), since forward kinematics is most of a training step's cost."""
