@@ -2,8 +2,8 @@
 
 Run: `nice -n 10 python benchmarks/update_step_benchmark.py`. It pins itself to one core and times
 `Trainer.update`'s inner step (sample C chunks of L frames, the losses, backward, gradient clip, Adam)
-on a default-size agent and a buffer of synthetic episodes shaped like the sample library's (no
-Blender needed: the step's cost does not depend on the numbers). Rounds of STEPS steps are timed in
+on a default-size agent and a buffer of synthetic episodes mixed like the default run's (no Blender
+needed: the step's cost depends on the mix of arms, pointing holds and waves, not on the numbers). Rounds of STEPS steps are timed in
 CPU time; the section gives the median and least step, and what the run's updates cost at that
 rate, against the 15-minute budget for the whole default training. It replaces the "Update step"
 section of docs/BENCHMARKS.md (other sections are kept).
@@ -42,26 +42,29 @@ LOAD_AT_START = os.getloadavg()[0]
 
 
 def synthetic_buffer(rng):
-    """EPISODES episodes of random frames with the buffer's fields: a random-target pointing request, a
-    pointing clip and a wave clip in turn (the default run's buffer holds about as many wave frames as
-    pointing-clip frames, and the wrist term works on the waves)."""
+    """EPISODES episodes of random frames with the buffer's fields, composed as the default run's buffer
+    is at its end (its checkpoint: 300 random-target points, 100 pointing clips, 100 wave clips, each arm
+    half of each): in every five episodes three random-target points and one pointing clip, which hold
+    their point over 28% of their frames, and one wave clip; the arm alternates. The step's forward
+    kinematics runs on each arm's frames of the pointing holds and of the waves, so its cost depends on
+    this mix, not on the numbers."""
     buffer = EpisodeBuffer()
     for k in range(EPISODES):
         frames = int(rng.integers(*EPISODE_FRAMES))
-        wave = k % 3 == 2
+        kind = ("random target", "random target", "random target", "pointing clip", "wave clip")[k % 5]
         objective = np.zeros((frames, spaces.OBJECTIVE_SIZE))
-        objective[:, 0] = spaces.BEHAVIOUR_TYPE["WAVE" if wave else "POINT"]
-        objective[:, 2] = 1.0  # RIGHT
+        objective[:, 0] = spaces.BEHAVIOUR_TYPE["WAVE" if kind == "wave clip" else "POINT"]
+        objective[:, 1 + k % 2] = 1.0  # LEFT, RIGHT in turn
         objective[:, 3:6] = rng.normal(size=3) / np.sqrt(3.0)
         objective[:, 6] = np.linspace(0.0, 1.0, frames)
         hold = np.zeros(frames)
-        if not wave:
-            hold[frames // 3: frames // 2] = 1.0
+        if kind != "wave clip":
+            hold[int(0.45 * frames): int(0.73 * frames)] = 1.0
         buffer.add({"objective": objective, "action": rng.random((frames, spaces.ACTION_SIZE)),
                     "description": rng.normal(size=(frames, spaces.DESCRIPTION_SIZE)),
                     "motion": rng.random((frames, spaces.ACTION_SIZE)),
                     "motion_description": rng.normal(size=(frames, spaces.DESCRIPTION_SIZE)),
-                    "hold": hold, "imitate": np.full(frames, float(k % 3 != 0))})
+                    "hold": hold, "imitate": np.full(frames, float(kind != "random target"))})
     return buffer
 
 
@@ -102,7 +105,7 @@ def section(per_step, config):
         "CPU time of one update step of the default preset (C = "
         f"{config.chunk_count} chunks of L = {config.chunk_length} frames: sampling, losses, backward, "
         "gradient clip, Adam) on a default-size agent and a buffer of "
-        f"{EPISODES} synthetic episodes, pinned to one CPU core; {ROUNDS} rounds of {STEPS} steps after a "
+        f"{EPISODES} synthetic episodes mixed like the default run's (random-target points, pointing and wave clips, both arms), pinned to one CPU core; {ROUNDS} rounds of {STEPS} steps after a "
         "warm-up. The default run makes "
         f"{config.epochs_both} x {config.update_steps} = {steps} of them; collecting an epoch's rollouts "
         "adds about 0.3 s (collect_seconds in a run's metrics.jsonl).", "",
