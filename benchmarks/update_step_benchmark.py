@@ -3,10 +3,10 @@
 Run: `nice -n 10 python benchmarks/update_step_benchmark.py`. It pins itself to one core and times
 `Trainer.update`'s inner step (sample C chunks of L frames, the losses, backward, gradient clip, Adam)
 on a default-size agent and a buffer of synthetic episodes mixed like the default run's (no Blender
-needed: the step's cost depends on the mix of arms, pointing holds and waves, not on the numbers). Rounds of STEPS steps are timed in
-CPU time; the section gives the median and least step, and what the run's updates cost at that
-rate, against the 15-minute budget for the whole default training. It replaces the "Update step"
-section of docs/BENCHMARKS.md (other sections are kept).
+needed: the step's cost depends on the mix of arms, pointing holds and waves, not on the numbers).
+Rounds of STEPS steps are timed in CPU time; the section gives the median and least step, and what
+the run's updates cost at that rate, against the 15-minute budget for the whole default training.
+It replaces the "Update step" section of docs/BENCHMARKS.md (other sections are kept).
 """
 import os
 import platform
@@ -24,7 +24,7 @@ sys.path.insert(0, str(REPO_ROOT))
 import numpy as np  # noqa: E402
 import torch  # noqa: E402
 
-from rlanimate_addon.core import spaces  # noqa: E402
+from rlanimate_addon.core import skeleton, spaces  # noqa: E402
 from trainer.agent.algorithm import gradient_step  # noqa: E402
 from trainer.agent.buffer import EpisodeBuffer  # noqa: E402
 from trainer.agent.config import load_preset  # noqa: E402
@@ -52,11 +52,11 @@ def synthetic_buffer(rng):
     for k in range(EPISODES):
         frames = int(rng.integers(*EPISODE_FRAMES))
         kind = ("random target", "random target", "random target", "pointing clip", "wave clip")[k % 5]
-        objective = np.zeros((frames, spaces.OBJECTIVE_SIZE))
-        objective[:, 0] = spaces.BEHAVIOUR_TYPE["WAVE" if kind == "wave clip" else "POINT"]
-        objective[:, 1 + k % 2] = 1.0  # LEFT, RIGHT in turn
-        objective[:, 3:6] = rng.normal(size=3) / np.sqrt(3.0)
-        objective[:, 6] = np.linspace(0.0, 1.0, frames)
+        arm = skeleton.ARMS[k % 2]
+        if kind == "wave clip":
+            objective = spaces.make_objective("WAVE", arm, rng.random(), frames)
+        else:
+            objective = spaces.make_objective("POINT", arm, rng.normal(size=3), frames)
         hold = np.zeros(frames)
         if kind != "wave clip":
             hold[int(0.45 * frames): int(0.73 * frames)] = 1.0
@@ -105,7 +105,8 @@ def section(per_step, config):
         "CPU time of one update step of the default preset (C = "
         f"{config.chunk_count} chunks of L = {config.chunk_length} frames: sampling, losses, backward, "
         "gradient clip, Adam) on a default-size agent and a buffer of "
-        f"{EPISODES} synthetic episodes mixed like the default run's (random-target points, pointing and wave clips, both arms), pinned to one CPU core; {ROUNDS} rounds of {STEPS} steps after a "
+        f"{EPISODES} synthetic episodes mixed like the default run's (random-target points, pointing and "
+        f"wave clips, both arms), pinned to one CPU core; {ROUNDS} rounds of {STEPS} steps after a "
         "warm-up. The default run makes "
         f"{config.epochs_both} x {config.update_steps} = {steps} of them; collecting an epoch's rollouts "
         "adds about 0.3 s (collect_seconds in a run's metrics.jsonl).", "",
