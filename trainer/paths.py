@@ -15,6 +15,12 @@ REALMOCAP_DIR = REPO_ROOT.parent / "shared" / "realmocap"
 REALMOCAP_RUNS = REPO_ROOT / "runs" / "realmocap"
 
 
+def seed_folder(root, seed):
+    """`root` for seed 0, its sibling <root>_seed<N> for another seed, so that no seed reuses another's runs."""
+    root = Path(root)
+    return root if seed == 0 else root.with_name(f"{root.name}_seed{seed}")
+
+
 def shown(path):
     """`path` relative to the repository when inside it, so docs and reports name no machine paths."""
     path = Path(path).resolve()

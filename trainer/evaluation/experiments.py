@@ -10,7 +10,6 @@ import json
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -23,7 +22,7 @@ from trainer.evaluation import behaviour, scoring
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.evaluation.harder_split import harder_clips
 from trainer.files import atomic_write_text
-from trainer.paths import REPO_ROOT
+from trainer.paths import REPO_ROOT, seed_folder
 from trainer.reporting import plots
 from trainer.reporting.table4 import table4_markdown
 
@@ -36,10 +35,8 @@ LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
 
 
 def run_folder(options, seed, variant, column):
-    """<runs>/<variant>_<column> for seed 0, <runs>_seed<N>/<variant>_<column> for another seed, so that
-    no seed reuses another's runs."""
-    root = Path(options.runs)
-    return (root if seed == 0 else root.with_name(f"{root.name}_seed{seed}")) / f"{variant}_{column}"
+    """<runs>/<variant>_<column> for seed 0, <runs>_seed<N>/<variant>_<column> for another seed."""
+    return seed_folder(options.runs, seed) / f"{variant}_{column}"
 
 
 def planned_epochs(options, column):

@@ -6,14 +6,16 @@ docs/REALMOCAP.md). Each BVH goes through trainer/blender_io/clip_import.py (Ble
 the canonicalisation); the capture has no fingers, so the synthesised clips' relaxed hand (motion/realmocap_takes.py)
 is put on, and labels come from the motion (trainer/motion/autolabel.py).
 
-Experiments, each trained with trainer.agent.run.train on a session of real clips (runs/realmocap/<name>/):
+Experiments, each trained with trainer.agent.run.train on a session of real clips (runs/realmocap/<name>/,
+and runs/realmocap_seed<N>/<name>/ for each further seed):
     wave      wave agent on takes 001-008 of the 7 styles x 2 arms (112 clips), tested on takes
               009-010 (28) and on the 14 goodbye waves of dataset 1 (other actor takes, other styles)
     holdout   the same on all takes of 5 styles (100 clips), tested on the 2 unseen styles (40 clips)
     guide     the right-arm directing gestures as pointing: the pointing agent is given the direction
               in which the actor held the arm, and we report the angle between the generated and the
               real forearm (elbow -> wrist) at each one's hold
-Both baselines (trainer/evaluation/baselines.py) answer the same requests. Writes docs/results/realmocap.json and
+Both baselines (trainer/evaluation/baselines.py) answer the same requests. The first seed's agents give
+the full tables and the figure; every seed's agents are scored on the wave sets ("seeds"). Writes docs/results/realmocap.json and
 .md, the real-data section of docs/results/baselines.json and .md, and
 docs/results/realmocap_frames.png (generated and real frames side by side).
 """
@@ -37,7 +39,7 @@ from trainer.evaluation import baselines, scoring
 from trainer.motion import autolabel
 from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
                                             style_holdout_split, wave_split)
-from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, shown
+from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, seed_folder, shown
 from trainer.reporting.realmocap_report import frames_figure
 
 
@@ -165,6 +167,16 @@ def _summary(result):
             **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result}}
 
 
+def seed_summary(result):
+    """One seed's agent on one wave set: score, smoothness, DTW score, median swing and frequency ratios,
+    and the waves `core.behaviour_metrics` accepts."""
+    wave = result["by_behaviour"]["wave"]
+    return {**_summary(result), "aligned_score": wave["aligned_score"],
+            "swing_ratio_median": wave["swing_ratio_median"],
+            "frequency_ratio_median": wave["frequency_ratio_median"],
+            "accepted": int(round(wave["accepted_share"] * len(result["clips"])))}
+
+
 def run_experiments(options):
     """All experiments; returns the realmocap results dict (also written to options.results)."""
     torch.set_num_threads(1)
@@ -177,19 +189,22 @@ def run_experiments(options):
         waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
         env = FKEnvironment()
     references = ClipReferences(env)
+    seeds = list(dict.fromkeys(options.seeds))
     command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {options.epochs} --preset {options.preset} "
-               f"--seed {options.seed}")
+               f"--seeds {' '.join(str(seed) for seed in seeds)}")
     if options.point_agent:
         command += f" --point-agent {options.point_agent}"
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
                "command": command,
-               "epochs": options.epochs, "preset": options.preset, "seed": options.seed,
+               "epochs": options.epochs, "preset": options.preset, "seeds": seeds,
                "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
 
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
     for name, (train_clips, test_clips) in experiments.items():
         session = RealSession(env, references, train_clips, test_clips)
-        report, agent = train_agent(session, name, "wave", options.epochs, options.preset, options.seed, options.runs)
+        agents = {seed: train_agent(session, name, "wave", options.epochs, options.preset, seed,
+                                    seed_folder(options.runs, seed)) for seed in seeds}
+        report, agent = agents[seeds[0]]
         methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
                    "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
         sets = {"test": test_clips} if name == "holdout" else {"test": test_clips, "bye": byes}
@@ -199,6 +214,10 @@ def run_experiments(options):
             entry["held_out_styles"] = list(HOLDOUT_STYLES)
         for set_name, clips in sets.items():
             entry[set_name] = compare(methods, clips, env, references)
+            entry[f"{set_name}_seeds"] = {str(seeds[0]): seed_summary(entry[set_name]["rlanimate"])}
+            for seed in seeds[1:]:
+                result = compare({"rlanimate": agents[seed][1]}, clips, env, references)["rlanimate"]
+                entry[f"{set_name}_seeds"][str(seed)] = seed_summary(result)
         results[name] = entry
         if name == "wave":
             chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
@@ -208,7 +227,7 @@ def run_experiments(options):
 
     try:
         point_method, point_clips = point_agent_and_library(options.point_agent, options.runs, options.epochs,
-                                                            options.seed)
+                                                            seeds[0])
     except RLAnimateError as error:  # no pointing agent and no sample library to train one on
         results["guide"] = {"skipped": str(error)}
         return results

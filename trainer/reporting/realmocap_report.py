@@ -66,6 +66,34 @@ def per_style_rows(set_label, methods):
     return [row for _, _, row in sorted(rows, key=lambda item: (item[0], list(methods).index(item[1])))]
 
 
+SEED_SETS = (("wave", "test", "takes 009-010"), ("wave", "bye", "goodbye waves"), ("holdout", "test", "unseen styles"))
+SEED_METRICS = (("score", "{:.1f}"), ("aligned_score", "{:.1f}"), ("swing_ratio_median", "{:.2f}"),
+                ("frequency_ratio_median", "{:.2f}"), ("accepted", "{:.1f}"))
+
+
+def seed_rows(results):
+    """Rows of the seeds table: per wave test set, RLAnimate's agent of each seed, their mean ± sd, and
+    nearest-clip retrieval (which has no seed)."""
+    rows = []
+    for name, set_name, label in SEED_SETS:
+        per_seed = results[name][f"{set_name}_seeds"]
+        clips = len(results[name][set_name]["rlanimate"]["clips"])
+        for seed, summary in per_seed.items():
+            rows.append([label, f"RLAnimate, seed {seed}", *(form.format(summary[key]) for key, form in SEED_METRICS)])
+        if len(per_seed) > 1:
+            cells = []
+            for key, form in SEED_METRICS:
+                values = np.array([summary[key] for summary in per_seed.values()], dtype=np.float64)
+                cells.append(f"**{form.format(values.mean())} ± {form.format(values.std(ddof=1))}**")
+            rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}", *cells])
+        retrieval = results[name][set_name]["nearest_clip"]
+        wave = retrieval["by_behaviour"]["wave"]
+        rows.append([label, METHOD_LABELS["nearest_clip"], f"{retrieval['score']:.1f}", f"{wave['aligned_score']:.1f}",
+                     f"{wave['swing_ratio_median']:.2f}", f"{wave['frequency_ratio_median']:.2f}",
+                     f"{wave['accepted_share'] * clips:.0f}"])
+    return rows
+
+
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
     label_rows = [[style, f"{row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f}", f"{row['elevation_deg']:.0f}",
@@ -92,7 +120,9 @@ def realmocap_markdown(results):
     lines = ["# Learning from real motion capture", "",
              f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the "
              f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
-             f"Preset `{results['preset']}`, {results['epochs']} epochs, seed {results['seed']}. "
+             f"Preset `{results['preset']}`, {results['epochs']} epochs, seeds "
+             f"{', '.join(str(seed) for seed in results['seeds'])} (the tables but the last are seed "
+             f"{results['seeds'][0]}'s). "
              f"Regenerate: `{results['command']}`.", "",
              "## Auto-labels per style (one-arm waves, 20 clips each)", "",
              *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
@@ -113,6 +143,11 @@ def realmocap_markdown(results):
              "009-010: two takes x two arms; unseen styles: ten takes x two arms).", "",
              *markdown_table(["test set", "style", "method", "takes", "score", "DTW score", "swing ratio",
                               "frequency ratio", "accepted"], style_rows),
+             "", "### Seeds", "",
+             "RLAnimate trained with each seed, on the same sets: mean score and DTW score, median swing and "
+             "frequency ratios, waves accepted (the mean ± sd row is over the seeds).", "",
+             *markdown_table(["test set", "method", "score", "DTW score", "swing ratio", "frequency ratio",
+                              "accepted"], seed_rows(results)),
              "", f"Training: wave agent {results['wave']['episodes']} episodes, "
              f"{results['wave']['train_seconds']:.0f} s; hold-out agent {results['holdout']['episodes']} episodes, "
              f"{results['holdout']['train_seconds']:.0f} s (1 torch thread).", "",

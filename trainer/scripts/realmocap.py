@@ -1,7 +1,9 @@
 """Train on real motion capture and compare with the baselines: docs/results/realmocap.json and .md, the
 real-data section of docs/results/baselines.json and .md, docs/results/realmocap_frames.png.
 
-    nice -n 15 python -m trainer.scripts.realmocap [--epochs 50] [--point-agent PATH]   (finished runs are reused)
+    nice -n 15 python -m trainer.scripts.realmocap [--epochs 50] [--seeds 0 1 2] [--point-agent PATH]
+
+Finished runs are reused: seed 0's in runs/realmocap/, seed N's in runs/realmocap_seed<N>/.
 """
 import argparse
 import json
@@ -19,7 +21,8 @@ def build_parser():
     parser.add_argument("--realmocap", default=str(REALMOCAP_DIR))
     parser.add_argument("--epochs", type=int, default=50, help="iterations of Algorithm 1 per agent (paper: 50)")
     parser.add_argument("--preset", default="default")
-    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2],
+                        help="training seeds; the first seed's agents give the full tables and the figure")
     parser.add_argument("--point-agent", default=None,
                         help="exported pointing agent (.npz) for the guide clips (default: the installed "
                              "agent when trained, else one trained here on the sample library)")

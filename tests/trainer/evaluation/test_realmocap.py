@@ -54,6 +54,9 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     for result in comparison.values():
         assert np.isfinite(result["score"]) and 0.0 <= result["smoothness"] <= 100.0
         assert 0.0 <= result["label_error"] <= 1.0
+    summary = realmocap.seed_summary(comparison["rlanimate"])
+    assert summary["clips"] == len(test) and 0 <= summary["accepted"] <= len(test)
+    assert summary["aligned_score"] == comparison["rlanimate"]["by_behaviour"]["wave"]["aligned_score"]
     # The nearest clip to the normal wave (e ~ 0.7) is the active one, not the feminine one.
     assert methods["nearest_clip"].nearest("WAVE", "LEFT", test[0].exaggeration).style == "active"
     angles = realmocap.guide_angles(methods["procedural_ik"], [_as_point(test[0])], env)
