@@ -40,7 +40,7 @@ from trainer.motion import autolabel
 from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
                                             style_holdout_split, wave_split)
 from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, seed_folder, shown
-from trainer.reporting.realmocap_report import frames_figure
+from trainer.reporting.realmocap_report import frames_figure, seed_summary
 
 
 def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache"):
@@ -165,16 +165,6 @@ def point_agent_and_library(point_agent, runs, epochs, seed):
 def _summary(result):
     return {"clips": len(result["clips"]),
             **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result}}
-
-
-def seed_summary(result):
-    """One seed's agent on one wave set: score, smoothness, DTW score, median swing and frequency ratios,
-    and the waves `core.behaviour_metrics` accepts."""
-    wave = result["by_behaviour"]["wave"]
-    return {**_summary(result), "aligned_score": wave["aligned_score"],
-            "swing_ratio_median": wave["swing_ratio_median"],
-            "frequency_ratio_median": wave["frequency_ratio_median"],
-            "accepted": int(round(wave["accepted_share"] * len(result["clips"])))}
 
 
 def run_experiments(options):

@@ -67,30 +67,40 @@ def per_style_rows(set_label, methods):
 
 
 SEED_SETS = (("wave", "test", "takes 009-010"), ("wave", "bye", "goodbye waves"), ("holdout", "test", "unseen styles"))
-SEED_METRICS = (("score", "{:.1f}"), ("aligned_score", "{:.1f}"), ("swing_ratio_median", "{:.2f}"),
-                ("frequency_ratio_median", "{:.2f}"), ("accepted", "{:.1f}"))
+#: The seeds table's columns and their decimals (the mean ± sd row keeps at least one).
+SEED_METRICS = (("score", 1), ("aligned_score", 1), ("swing_ratio_median", 2), ("frequency_ratio_median", 2),
+                ("accepted", 0))
+
+
+def seed_summary(result):
+    """One method's (for RLAnimate, one seed's agent's) scoring on one wave set: clips, score, smoothness,
+    label error, DTW score, median swing and frequency ratios, and the waves `core.behaviour_metrics` accepts."""
+    wave = result["by_behaviour"]["wave"]
+    return {"clips": len(result["clips"]),
+            **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result},
+            "aligned_score": wave["aligned_score"], "swing_ratio_median": wave["swing_ratio_median"],
+            "frequency_ratio_median": wave["frequency_ratio_median"],
+            "accepted": int(round(wave["accepted_share"] * len(result["clips"])))}
 
 
 def seed_rows(results):
     """Rows of the seeds table: per wave test set, RLAnimate's agent of each seed, their mean ± sd, and
     nearest-clip retrieval (which has no seed)."""
+    def cells(summary):
+        return [f"{summary[key]:.{digits}f}" for key, digits in SEED_METRICS]
+
     rows = []
     for name, set_name, label in SEED_SETS:
         per_seed = results[name][f"{set_name}_seeds"]
-        clips = len(results[name][set_name]["rlanimate"]["clips"])
-        for seed, summary in per_seed.items():
-            rows.append([label, f"RLAnimate, seed {seed}", *(form.format(summary[key]) for key, form in SEED_METRICS)])
+        rows += [[label, f"RLAnimate, seed {seed}", *cells(summary)] for seed, summary in per_seed.items()]
         if len(per_seed) > 1:
-            cells = []
-            for key, form in SEED_METRICS:
+            spread = []
+            for key, digits in SEED_METRICS:
                 values = np.array([summary[key] for summary in per_seed.values()], dtype=np.float64)
-                cells.append(f"**{form.format(values.mean())} ± {form.format(values.std(ddof=1))}**")
-            rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}", *cells])
-        retrieval = results[name][set_name]["nearest_clip"]
-        wave = retrieval["by_behaviour"]["wave"]
-        rows.append([label, METHOD_LABELS["nearest_clip"], f"{retrieval['score']:.1f}", f"{wave['aligned_score']:.1f}",
-                     f"{wave['swing_ratio_median']:.2f}", f"{wave['frequency_ratio_median']:.2f}",
-                     f"{wave['accepted_share'] * clips:.0f}"])
+                digits = max(digits, 1)
+                spread.append(f"**{values.mean():.{digits}f} ± {values.std(ddof=1):.{digits}f}**")
+            rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}", *spread])
+        rows.append([label, METHOD_LABELS["nearest_clip"], *cells(seed_summary(results[name][set_name]["nearest_clip"]))])
     return rows
 
 

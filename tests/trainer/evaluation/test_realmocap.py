@@ -12,7 +12,7 @@ from trainer.motion import autolabel
 from trainer.motion.realmocap_takes import wave_split
 from trainer.motion.synthesis import neutral_pose
 from trainer.paths import REALMOCAP_DIR
-from trainer.reporting.realmocap_report import frames_figure
+from trainer.reporting.realmocap_report import frames_figure, seed_summary
 
 needs_data = pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
                                 reason=f"real motion capture not found at {REALMOCAP_DIR} "
@@ -54,7 +54,7 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     for result in comparison.values():
         assert np.isfinite(result["score"]) and 0.0 <= result["smoothness"] <= 100.0
         assert 0.0 <= result["label_error"] <= 1.0
-    summary = realmocap.seed_summary(comparison["rlanimate"])
+    summary = seed_summary(comparison["rlanimate"])
     assert summary["clips"] == len(test) and 0 <= summary["accepted"] <= len(test)
     assert summary["aligned_score"] == comparison["rlanimate"]["by_behaviour"]["wave"]["aligned_score"]
     # The nearest clip to the normal wave (e ~ 0.7) is the active one, not the feminine one.

@@ -29,7 +29,7 @@ def _seed(score, aligned, swing, accepted):
 
 def _retrieval(aligned):
     wave = {"aligned_score": aligned, "swing_ratio_median": 1.0, "frequency_ratio_median": 1.0, "accepted_share": 0.5}
-    return {"score": 70.0, "by_behaviour": {"wave": wave}}
+    return {"clips": [{}, {}], "score": 70.0, "smoothness": 99.5, "by_behaviour": {"wave": wave}}
 
 
 def test_seed_rows_give_each_seed_then_their_mean_and_sd_then_retrieval():
