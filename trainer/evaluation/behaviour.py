@@ -49,14 +49,16 @@ def _answer(method, behaviour, arm, attributes, frames, target, exact_aim, seed=
     return rotvecs
 
 
-def request_rows(method, clips, references, describe, lengths, exact_aim=False):
+def request_rows(method, clips, references, describe, lengths, exact_aim=False, seed=None):
     """One row per clip: name, behaviour, arm, score, smoothness, score_class_length, aligned_score and
-    every measure of `behaviour_metrics.compare`. references: .get(clip) -> (descriptions, positions)."""
+    every measure of `behaviour_metrics.compare`. references: .get(clip) -> (descriptions, positions);
+    `seed`: the method's variation seed (None: its deterministic answer)."""
     rows = []
     for clip in clips:
         behaviour, arm, target = clip.behaviour.upper(), clip.arm.upper(), clip_target(clip)
-        own = describe(_answer(method, behaviour, arm, clip.attributes, len(clip.rotvecs), target, exact_aim))
-        at_class = describe(_answer(method, behaviour, arm, clip.attributes, lengths[behaviour], target, exact_aim))
+        own = describe(_answer(method, behaviour, arm, clip.attributes, len(clip.rotvecs), target, exact_aim, seed))
+        at_class = describe(_answer(method, behaviour, arm, clip.attributes, lengths[behaviour], target, exact_aim,
+                                    seed))
         reference, reference_positions = references.get(clip)
         positions = spaces.description_joint_positions(own)
         class_positions = spaces.description_joint_positions(at_class)
@@ -72,7 +74,7 @@ def request_rows(method, clips, references, describe, lengths, exact_aim=False):
 
 def seed_variation(method, clips, describe, seeds):
     """Per clip: the mean distance (m) between the outputs of `seeds` at the clip's length, and whether
-    the deterministic answer (no seed) repeats exactly. -> [{name, variation, deterministic}]"""
+    the deterministic answer (no seed) repeats exactly. -> [{name, behaviour, variation, deterministic}]"""
     rows = []
     for clip in clips:
         behaviour, arm, frames = clip.behaviour.upper(), clip.arm.upper(), len(clip.rotvecs)
@@ -80,7 +82,7 @@ def seed_variation(method, clips, describe, seeds):
                                                                                frames, seed=seed)))
                    for seed in seeds]
         first, again = (method.generate(behaviour, arm, clip.attributes, frames) for _ in range(2))
-        rows.append({"name": clip.name, "variation": bm.variation(outputs),
+        rows.append({"name": clip.name, "behaviour": behaviour.lower(), "variation": bm.variation(outputs),
                      "deterministic": bool(np.array_equal(first, again))})
     return rows
 

@@ -91,11 +91,18 @@ def behaviour_markdown(report):
                              for arm, s in sweeps.items()])
     variation = agent["variation"]
     lines += ["", "### Seeds", "",
-              f"Seeds {', '.join(str(s) for s in variation['seeds'])} on each held-out request at its own length: "
-              f"mean distance between the seeds' joint positions, median {_f(100 * variation['median'], 1)} cm "
-              f"(range {_f(100 * variation['min'], 1)}-{_f(100 * variation['max'], 1)}); the deterministic answer "
-              f"(seed 0 in the panel) repeats exactly on {variation['deterministic']} of {variation['requests']} "
-              f"requests.", ""]
+              "Each variation seed's answers to the held-out requests (the panel's Seed; seed 0 is the "
+              "deterministic answer in the tables above), measured as above:", "",
+              "Waves:", ""]
+    seeded = agent["seeded"]
+    lines += markdown_table(("seed",) + WAVE_COLUMNS, [[seed] + wave_row(e["wave"]) for seed, e in seeded.items()])
+    lines += ["", "Points, own aim:", ""]
+    lines += markdown_table(("seed",) + POINT_COLUMNS, [[seed] + point_row(e["point"]) for seed, e in seeded.items()])
+    spread = {name: f"median {_f(100 * variation[name]['median'], 1)} cm (range {_f(100 * variation[name]['min'], 1)}-"
+                    f"{_f(100 * variation[name]['max'], 1)})" for name in ("wave", "point")}
+    lines += ["", f"Mean distance between the seeds' joint positions (all joints, all frames, each request at its own "
+              f"length): waves {spread['wave']}, points {spread['point']}. The deterministic answer repeats exactly "
+              f"on {variation['deterministic']} of {variation['requests']} requests.", ""]
     if report.get("figures"):
         lines += ["## Figures", ""] + [f"- `{f}`: {text}" for f, text in report["figures"].items()] + [""]
     return "\n".join(lines)

@@ -57,8 +57,8 @@ def measure(path, behaviour_name, session, target_count):
     result = {"held_out": behaviour.summarise(rows)[behaviour_name],
               "update_steps": method.agent.metadata["train_config"]["update_steps"]}
     if behaviour_name == "wave":
-        result["seeded"] = behaviour.summarise(sum(([dict(row, seed=seed) for row in _seeded_rows(
-            method, clips, session, seed)] for seed in SEEDS), []))["wave"]
+        result["seeded"] = behaviour.summarise(sum((behaviour.request_rows(
+            method, clips, session.references, describe, lengths, seed=seed) for seed in SEEDS), []))["wave"]
         result["sweep"] = {arm.lower(): behaviour.exaggeration_sweep(method, arm, lengths["WAVE"], describe)
                            for arm in ("LEFT", "RIGHT")}
         result["variation"] = float(np.median([r["variation"] for r in behaviour.seed_variation(
@@ -66,16 +66,6 @@ def measure(path, behaviour_name, session, target_count):
     else:
         result["random_targets"] = behaviour.random_target_sweeps(method, lengths["POINT"], describe, target_count)
     return result
-
-
-def _seeded_rows(method, clips, session, seed):
-    """request_rows of the method's answers for one variation seed."""
-    class Seeded:
-        def generate(self, behaviour_name, arm, attributes, frame_count):
-            return method.generate(behaviour_name, arm, attributes, frame_count, seed=seed)
-
-    return behaviour.request_rows(Seeded(), clips, session.references, describe,
-                                  behaviour.class_lengths(session.train_clips))
 
 
 def markdown(results, command):

@@ -49,8 +49,10 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
     random_targets = {arm: {"own": own[arm], "exact": exact[arm]} for arm in own}
     sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], session.describe)
               for arm in ("LEFT", "RIGHT")}
-    seeded = behaviour.seed_variation(agent, waves + points, session.describe, seeds)
-    distances = [r["variation"] for r in seeded]
+    seeded = {seed: behaviour.summarise(behaviour.request_rows(agent, waves + points, session.references,
+                                                               session.describe, lengths, seed=seed))
+              for seed in seeds}
+    varied = behaviour.seed_variation(agent, waves + points, session.describe, seeds)
 
     panels = []
     for clip in waves:
@@ -80,12 +82,19 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
     return {"description": description, "class_lengths": lengths, "sets": sets,
             "agent": {"targets_per_arm": target_count, "random_targets": random_targets,
                       "exaggeration_sweep": sweeps,
-                      "variation": {"seeds": list(seeds), "requests": len(seeded), "median": float(np.median(distances)),
-                                    "min": float(np.min(distances)), "max": float(np.max(distances)),
-                                    "deterministic": sum(r["deterministic"] for r in seeded), "clips": seeded}},
+                      "seeded": {str(seed): summary for seed, summary in seeded.items()},
+                      "variation": {"seeds": list(seeds), "requests": len(varied),
+                                    "deterministic": sum(r["deterministic"] for r in varied),
+                                    **{name: _spread([r["variation"] for r in varied if r["behaviour"] == name])
+                                       for name in ("wave", "point")},
+                                    "clips": varied}},
             "figures": {f"docs/results/{WAVE_PATHS}": "the held-out waves' wrist, reference against RLAnimate "
                                                       "(deterministic and one seed) and the class mean"},
             "clips": clips}
+
+
+def _spread(values):
+    return {"median": float(np.median(values)), "min": float(np.min(values)), "max": float(np.max(values))}
 
 
 def main(argv=None):
@@ -98,6 +107,9 @@ def main(argv=None):
     parser.add_argument("--target-seed", type=int, default=behaviour.RANDOM_TARGET_SEED,
                         help="generator seed of the random targets (another seed: other targets)")
     options = parser.parse_args(script_args(argv))
+    if len(set(options.seeds)) < 2 or 0 in options.seeds:
+        parser.error("--seeds needs at least two different seeds, none of them 0 (seed 0 is the deterministic "
+                     "answer, always measured): for example --seeds 1 2 3 4.")
     torch.set_num_threads(1)
     new_empty_scene()
     report = behaviour_report(options.agent, options.clips, options.targets, tuple(options.seeds), options.results,

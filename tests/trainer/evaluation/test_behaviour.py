@@ -99,6 +99,11 @@ def test_sweeps_and_seed_variation_on_a_seeded_method(library):
 
     rows = behaviour.seed_variation(Seeded(), test[:2], kinematics.describe, seeds=(1, 2))
     assert all(r["deterministic"] and r["variation"] > 0.0 for r in rows)
+    assert [r["behaviour"] for r in rows] == [c.behaviour.lower() for c in test[:2]]
+    lengths = behaviour.class_lengths(train)
+    plain, shifted = (behaviour.request_rows(Seeded(), test[:2], NumpyReferences(), kinematics.describe, lengths,
+                                             seed=seed) for seed in (None, 2))
+    assert all(s["score"] < p["score"] for p, s in zip(plain, shifted)), "a seed's answer is the one scored"
     sweep = behaviour.exaggeration_sweep(baselines.NearestClip(train), "RIGHT", 100, kinematics.describe)
     assert sweep["swing_rising"] and len(sweep["swing"]) == len(behaviour.EXAGGERATIONS)
     targets = behaviour.random_targets(np.random.default_rng(1), "RIGHT", 3)

@@ -50,13 +50,17 @@ def test_report_has_a_row_per_method_in_each_table(tmp_path):
                                                                                       kinematics.describe, True)}},
                         "exaggeration_sweep": {"left": behaviour.exaggeration_sweep(nearest, "LEFT", 100,
                                                                                     kinematics.describe)},
-                        "variation": {"seeds": [1, 2], "requests": 2, "median": 0.01, "min": 0.0, "max": 0.02,
-                                      "deterministic": 2}}}
+                        "seeded": {"1": behaviour.summarise(clips["nearest_clip"])},
+                        "variation": {"seeds": [1, 2], "requests": 2, "deterministic": 2,
+                                      "wave": {"median": 0.01, "min": 0.0, "max": 0.02},
+                                      "point": {"median": 0.003, "min": 0.002, "max": 0.004}}}}
     write_behaviour(tmp_path, report)
     markdown = (tmp_path / "behaviour.md").read_text()
     for label in ("No motion", "Nearest clip"):
         assert markdown.count(f"| {label} |") == 3  # waves, points, points with exact aim
     assert "0 of 1" in markdown and "1 of 1" in markdown  # waves accepted: the still arm none, the nearest clip its one
+    assert markdown.count("\n| 1 | ") == 2, "a seed's row in the seeded waves and in the seeded points"
+    assert "waves median 1.0 cm (range 0.0-2.0), points median 0.3 cm" in markdown
     stored = json.loads((tmp_path / "behaviour.json").read_text())
     still_wave = next(r for r in stored["clips"]["no_motion"] if r["behaviour"] == "wave")
     assert still_wave["frequency_ratio"] == 0.0 and still_wave["swing_ratio"] == 0.0
