@@ -2,9 +2,9 @@
 baked pose back from Blender frame by frame, and measure it with core.behaviour_metrics.
 
 Waves: both arms, exaggerations 0.1-0.9, Variation Seeds 0 and 3: hand-up time, strokes, full cycles,
-frequency and swing; whether the swing rises with the exaggeration; how far seeds 0 and 3 lie apart.
+frequency, swing and smoothness; whether the swing rises with the exaggeration; how far seeds 0 and 3 lie apart.
 Points: random targets 1.5-4 m away (the library's ranges), both arms, Exact Aim off (the agent's own aim)
-and on: the pointing angle at the hold. The character starts each gesture standing with its arms hanging.
+and on: the pointing angle at the hold and the lowest smoothness. The character starts each gesture standing with its arms hanging.
 Writes docs/results/generate_behaviour.md.
 
 Run: `nice -n 10 python benchmarks/generate_behaviour.py [--targets 20] [--agent PATH]`
@@ -21,7 +21,7 @@ import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
 import numpy as np  # noqa: E402
 
 from rlanimate_addon.core import behaviour_metrics as bm  # noqa: E402
-from rlanimate_addon.core import skeleton  # noqa: E402
+from rlanimate_addon.core import metrics, skeleton  # noqa: E402
 from rlanimate_addon.core.rotations import matrix_to_quat, rotvec_to_matrix  # noqa: E402
 from trainer.blender_io import rig_session  # noqa: E402
 from trainer.evaluation.behaviour import random_targets  # noqa: E402
@@ -93,7 +93,8 @@ def main(argv=None):
                 m = bm.wave_measures(positions, arm)
                 sweeps.setdefault((arm, seed), []).append((positions, m))
                 wave_rows.append([arm.lower(), seed, f"{exaggeration:.1f}", f"{m['hand_up_s']:.2f}", m["strokes"],
-                                  m["cycles"], f"{m['frequency']:.2f}", f"{100 * m['swing']:.1f}"])
+                                  m["cycles"], f"{m['frequency']:.2f}", f"{100 * m['swing']:.1f}",
+                                  f"{metrics.smoothness(positions):.2f}"])
         for k in range(len(EXAGGERATIONS)):
             seed_gaps.append(bm.variation([sweeps[(arm, s)][k][0] for s in SEEDS]))
     rising = {f"{arm.lower()}, seed {seed}": bool(np.all(np.diff([m["swing"] for _, m in runs]) > 0))
@@ -103,7 +104,7 @@ def main(argv=None):
     point_rows = []
     for arm in skeleton.ARMS:
         targets = random_targets(rng, arm, options.targets)
-        angles = {False: [], True: []}
+        angles, smoothness = {False: [], True: []}, {False: [], True: []}
         for k, location in enumerate(targets):
             target = bpy.data.objects.new(f"Target_{arm}_{k}", None)
             target.location = location
@@ -113,8 +114,10 @@ def main(argv=None):
                                               exact_aim=exact, seed=0)
                 start += SPACING
                 angles[exact].append(bm.point_measures(positions, fingers[arm], arm, location)["angle"])
+                smoothness[exact].append(metrics.smoothness(positions))
         point_rows.append([arm.lower(), len(targets), f"{np.median(angles[False]):.1f}", f"{np.max(angles[False]):.1f}",
-                           f"{np.median(angles[True]):.2f}", f"{np.max(angles[True]):.2f}"])
+                           f"{np.median(angles[True]):.2f}", f"{np.max(angles[True]):.2f}",
+                           f"{min(smoothness[False]):.2f} / {min(smoothness[True]):.2f}"])
 
     agent = shown(options.agent) if options.agent else "the bundled agent (rlanimate_addon/agents/default.npz)"
     lines = ["# Generate Gesture's behaviour, measured from Blender", "",
@@ -125,7 +128,7 @@ def main(argv=None):
              f"{' --agent ' + str(agent) if options.agent else ''} --targets {options.targets}`.", "",
              "## Waves", "",
              *markdown_table(["arm", "seed", "exaggeration", "hand up (s)", "strokes", "full cycles", "frequency (Hz)",
-                              "swing (cm)"], wave_rows), "",
+                              "swing (cm)", "smoothness"], wave_rows), "",
              "Swing strictly rising with the exaggeration: "
              + ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in rising.items()) + ".", "",
              f"Seeds {SEEDS[0]} and {SEEDS[1]} on the same request: mean joint distance median "
@@ -134,7 +137,8 @@ def main(argv=None):
              "## Points at random targets", "",
              "Targets drawn over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, 1.5-4 m).", "",
              *markdown_table(["arm", "targets", "own aim: median (deg)", "own aim: max", "Exact Aim: median",
-                              "Exact Aim: max"], point_rows), ""]
+                              "Exact Aim: max", "smoothness, lowest: own aim / Exact Aim"], point_rows), "",
+             "Smoothness: `core.metrics.smoothness` of the baked description joints (below 98.5 artefacts show).", ""]
     out = RESULTS_DIR / "generate_behaviour.md"
     out.write_text("\n".join(lines))
     print("\n".join(lines))

@@ -9,9 +9,10 @@ the rollout runs on one BLAS thread (core/blas_threads.py).
 `GestureAgent.rollout(objectives, seed=None)`:
     seed None  the deterministic rollout: z_t is the posterior mean (the prior mean for a
                single_state agent) and a_t the Beta mean;
-    seed int   a variation: z_t is sampled from the same Gaussian with numpy's default_rng(seed),
-               while a_t stays the Beta mean. Sampling the behaviour state varies the gesture
-               smoothly through the recurrent state; sampling a_t per frame would only add jitter.
+    seed int   a variation: z_t = mean_t + sd_t * n, a sample of the same Gaussian at every frame,
+               with one standard-normal draw n (Z,) for the whole gesture from numpy's
+               default_rng(seed), while a_t stays the Beta mean. Drawn once, the noise varies the
+               gesture coherently; drawn afresh every frame (z_t or a_t) it only adds jitter.
 """
 import numpy as np
 
@@ -142,9 +143,10 @@ class GestureAgent:
                                  f"only: choose an agent trained for the requested behaviour in the add-on "
                                  f"preferences.")
         with blas_threads.single_blas_thread():
-            return self._rollout(objectives, None if seed is None else np.random.default_rng(seed))
+            noise = None if seed is None else np.random.default_rng(seed).standard_normal(self._sizes[1])  # (Z,)
+            return self._rollout(objectives, noise)
 
-    def _rollout(self, objectives, rng):
+    def _rollout(self, objectives, noise):
         E, Z = self._sizes
         A = spaces.ACTION_SIZE
         count = len(objectives)
@@ -168,8 +170,8 @@ class GestureAgent:
             hidden_gates = from_e[:gates] + self._cell_hidden_bias
             belief = _mlp_tail(self._belief, from_e[gates:belief_end] + belief_inputs[t])
             z = belief[:Z]
-            if rng is not None:
-                z = z + (_softplus(belief[Z:]) + self._min_std) * rng.standard_normal(Z)
+            if noise is not None:
+                z = z + (_softplus(belief[Z:]) + self._min_std) * noise
             from_z = z @ self._from_z
             out = _mlp_tail(self._animation, animation_inputs[t] + from_e[belief_end:] + from_z[gates:])
             concentrations = self._floor + self._concentration_scale * _softplus(out)  # (90,): alpha, beta
