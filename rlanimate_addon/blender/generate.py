@@ -193,9 +193,9 @@ def _write(plan, agent, scene):
     end = start + count - 1
     label = f"{settings.behaviour.title()} {settings.arm.title()}"
     note = ""
-    shortest, longest = gesture.supported_length_range(agent.average_frames[settings.behaviour])
-    if not shortest <= count <= longest:
-        note += f" (time-scaled: the agent's range is {shortest}-{longest} frames)"
+    steps = gesture.rollout_length(count, agent.average_frames[settings.behaviour], settings.behaviour)
+    if steps != count:
+        note += f" (time-scaled from the agent's {steps}-frame gesture)"
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,

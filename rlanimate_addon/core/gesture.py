@@ -155,20 +155,25 @@ def resample(values, count):
     return values[low] * (1.0 - frac) + values[high] * frac
 
 
-def rollout_length(frame_count, average_frames):
-    """Steps the agent runs for a gesture of frame_count frames: clamped into its supported range."""
+def rollout_length(frame_count, average_frames, behaviour):
+    """Steps the agent runs for a gesture of frame_count frames: clamped into its supported range, and
+    for POINT never fewer than the agent's average. A shorter point is the average-length point played
+    faster: the agent's own quick points hold for a few frames and miss by more (docs/EXTENSION.md,
+    "Short points")."""
     shortest, longest = supported_length_range(average_frames)
+    if behaviour == "POINT":
+        shortest = max(shortest, int(round(average_frames)))
     return int(np.clip(frame_count, shortest, longest))
 
 
 def run_agent(agent, behaviour, objectives, seed=None):
     """Canonical local rotation vectors (N, 15, 3) for the objectives (N, 7).
 
-    Lengths outside the supported range are time-scaled: the agent runs at the nearest supported
-    length and its actions are resampled to N frames.
+    The agent runs for `rollout_length` steps; when that is not N, its actions are resampled to N
+    frames (time-scaled).
     """
     count = len(objectives)
-    steps = rollout_length(count, agent.average_frames[behaviour])
+    steps = rollout_length(count, agent.average_frames[behaviour], behaviour)
     agent_objectives = resample(objectives, steps)
     agent_objectives[:, spaces.OBJECTIVE_TIME] = np.linspace(0.0, 1.0, steps)
     if behaviour == "POINT":

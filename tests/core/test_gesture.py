@@ -139,6 +139,15 @@ def test_lengths_outside_the_supported_range_are_time_scaled_from_the_nearest_su
     assert names == skeleton.ACTION_JOINTS
 
 
+def test_a_point_shorter_than_the_agents_average_is_its_average_point_played_faster():
+    agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(80, spaces.ACTION_SIZE)))
+    average = agent.average_frames["POINT"]
+    for frames, steps in ((30, average), (average, average), (70, 70)):
+        gesture.run_agent(agent, "POINT", spaces.make_objective("POINT", "RIGHT", [0.0, -1.0, 0.0], frames))
+        assert len(agent.calls[-1][0]) == steps
+    assert gesture.rollout_length(30, average, "WAVE") == 30, "a quick wave is the agent's own"
+
+
 def _animated(rig, frames, scale=0.3):
     """The rig with a random pose underneath at every frame (as its own animation would play)."""
     under = np.tile(np.eye(4), (frames, len(skeleton.BONES), 1, 1))
