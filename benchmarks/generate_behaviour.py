@@ -2,9 +2,10 @@
 baked pose back from Blender frame by frame, and measure it with core.behaviour_metrics.
 
 Waves: both arms, exaggerations 0.1-0.9, Variation Seeds 0 and 3: hand-up time, strokes, full cycles,
-frequency, swing and smoothness; whether the swing rises with the exaggeration; how far seeds 0 and 3 lie apart.
-Points: random targets 1.5-4 m away (the library's ranges), both arms, Exact Aim off (the agent's own aim)
-and on: the pointing angle at the hold and the lowest smoothness. The character starts each gesture standing with its arms hanging.
+frequency, swing and smoothness; whether the swing rises with the exaggeration; how far seeds 0 and 3
+lie apart. Points: random targets 1.5-4 m away (the library's ranges), both arms, Exact Aim off (the
+agent's own aim) and on: the pointing angle at the hold and the lowest smoothness. The character
+starts each gesture standing with its arms hanging.
 Writes docs/results/generate_behaviour.md.
 
 Run: `nice -n 10 python benchmarks/generate_behaviour.py [--targets 20] [--agent PATH]`
@@ -137,7 +138,8 @@ def main(argv=None):
              "## Points at random targets", "",
              "Targets drawn over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, 1.5-4 m).", "",
              *markdown_table(["arm", "targets", "own aim: median (deg)", "own aim: max", "Exact Aim: median",
-                              "Exact Aim: max", "smoothness, lowest: own aim / Exact Aim"], point_rows), "",
+                              "Exact Aim: max", "smoothness, lowest: own aim / Exact Aim"], point_rows),
+             "",
              "Smoothness: `core.metrics.smoothness` of the baked description joints (below 98.5 artefacts show).", ""]
     out = RESULTS_DIR / "generate_behaviour.md"
     out.write_text("\n".join(lines))
