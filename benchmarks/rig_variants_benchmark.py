@@ -5,7 +5,7 @@ target, median over the pointing hold as docs/METRICS.md defines it) over random
 arms alternating, with Exact Aim on and off (off: the agent's own aim as retargeted to that rig), and a
 wave's side-to-side swing in arm lengths. Writes the "Rig variants" section of docs/BENCHMARKS.md.
 
-Run: `nice -n 10 python benchmarks/rig_variants_benchmark.py [--targets 12] [--seed 5] [--no-write]`
+Run: `nice -n 10 python benchmarks/rig_variants_benchmark.py [--targets 60] [--seed 5] [--no-write]`
 """
 import argparse
 import sys
@@ -49,7 +49,7 @@ def wave_swing(path):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--targets", type=int, default=12)
+    parser.add_argument("--targets", type=int, default=60)
     parser.add_argument("--seed", type=int, default=5)
     parser.add_argument("--no-write", action="store_true")
     args = parser.parse_args()
