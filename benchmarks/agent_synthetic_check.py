@@ -21,11 +21,11 @@ sys.path.insert(0, str(REPO_ROOT / "tests" / "trainer"))
 import torch  # noqa: E402
 
 import synthetic_library  # noqa: E402
-from trainer.agent.algorithm import ClipReferences, Trainer  # noqa: E402
+from trainer.agent.algorithm import Trainer  # noqa: E402
 from trainer.agent.config import load_preset  # noqa: E402
 from trainer.agent.models import VARIANTS, RLAnimateAgent  # noqa: E402
 from trainer.evaluation import scoring  # noqa: E402
-from trainer.motion.fk import NumpyFKEnvironment  # noqa: E402
+from trainer.motion.fk import ClipReferences, NumpyFKEnvironment  # noqa: E402
 
 
 def main():

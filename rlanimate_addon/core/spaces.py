@@ -58,6 +58,16 @@ DEFAULT_ACTION_BOUNDS = np.array(
     [[-_joint_bound(j), _joint_bound(j)] for j in skeleton.ACTION_JOINTS for _ in range(3)])
 
 
+def check_request(behaviour, arm, frame_count):
+    """RLAnimateError naming what no agent or baseline can answer: an unknown behaviour or arm, or under 2 frames."""
+    if behaviour not in BEHAVIOURS:
+        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(BEHAVIOURS)}.")
+    if arm not in skeleton.ARMS:
+        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
+    if int(frame_count) < 2:
+        raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}: set a longer length.")
+
+
 def make_objective(behaviour, arm, attributes, frame_count, rhythm=None):
     """(N, 7) objectives for a gesture of `frame_count` frames.
 
@@ -65,12 +75,7 @@ def make_objective(behaviour, arm, attributes, frame_count, rhythm=None):
     tracked; for WAVE, the exaggeration in [0, 1] (scalar or (N,)). `rhythm` (N, 2), WAVE only: the
     swing signals of core/rhythm.py; None gives the paper's objective (the exaggeration three times).
     """
-    if behaviour not in BEHAVIOURS:
-        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(BEHAVIOURS)}.")
-    if arm not in skeleton.ARMS:
-        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
-    if int(frame_count) < 2:
-        raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}: set a longer length.")
+    check_request(behaviour, arm, frame_count)
     n = int(frame_count)
     attrs = np.asarray(attributes, dtype=np.float64)
     if behaviour == "POINT":

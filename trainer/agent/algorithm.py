@@ -28,6 +28,7 @@ from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint, pointing
 from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
+from trainer.motion.fk import ClipReferences
 
 BEHAVIOUR_CHOICES = ("point", "wave", "both")
 
@@ -76,21 +77,6 @@ def gradient_step(agent, optimizer, batch, config, bounds):
         torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip)
     optimizer.step()
     return losses
-
-
-class ClipReferences:
-    """FK of each clip's own motion (descriptions (F, 42), joint positions (F, 10, 3)), computed once."""
-
-    def __init__(self, env):
-        self.env = env
-        self._cache = {}
-
-    def get(self, clip):
-        key = id(clip)
-        if key not in self._cache:
-            result = self.env.evaluate(np.asarray(clip.rotvecs, dtype=np.float64))
-            self._cache[key] = (clip, np.asarray(result.descriptions), np.asarray(result.joint_positions))
-        return self._cache[key][1:]
 
 
 class Trainer:

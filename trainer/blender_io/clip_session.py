@@ -4,16 +4,16 @@ import sys
 
 import numpy as np
 
-from trainer.agent.algorithm import ClipReferences
 from trainer.blender_io.clip_import import load_clip_set
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.rig_session import blender_output
+from trainer.motion.fk import ClipReferences
 from trainer.motion.manifest import manifest_path
 from trainer.paths import SAMPLE_RIG_BLEND, shown
 
 
 class LibrarySession:
-    """What a run needs besides the trainer (trainer.agent.run.train's `session`): env, references,
+    """What a run needs besides the trainer (trainer.experiments.run.train's `session`): env, references,
     train_clips, test_clips, problems."""
 
     def __init__(self, clips, rig_path=SAMPLE_RIG_BLEND, verbose=False):

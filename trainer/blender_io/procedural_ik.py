@@ -12,11 +12,10 @@ the constraint's influence follows the raise, so the clip starts and ends in the
 """
 import numpy as np
 
-from rlanimate_addon.core import rotations, skeleton
+from rlanimate_addon.core import rotations, skeleton, spaces
 from rlanimate_addon.core.easing import minimum_jerk
 from rlanimate_addon.core.gesture import slerp
 from trainer.blender_io import rig_session
-from trainer.evaluation.baselines import check_request
 from trainer.motion import autolabel
 from trainer.paths import SAMPLE_RIG_BLEND
 
@@ -103,7 +102,7 @@ class ProceduralIK:
         return np.stack(local)
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        check_request(behaviour, arm, frame_count)
+        spaces.check_request(behaviour, arm, frame_count)
         self._set_pose(self.neutral)
         side = skeleton.ARM_PREFIX[arm]
         if behaviour == "POINT":

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import rhythm, rotations, skeleton, spaces
+from rlanimate_addon.core import rhythm, rotations, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 
@@ -42,15 +42,6 @@ def time_warp(rotvecs, frame_count):
     high = np.minimum(low + 1, len(quats) - 1)
     weight = np.broadcast_to((position - low)[:, None], (len(position), quats.shape[1]))
     return rotations.quat_to_rotvec(slerp(quats[low], quats[high], weight))
-
-
-def check_request(behaviour, arm, frame_count):
-    if behaviour not in spaces.BEHAVIOURS:
-        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use POINT or WAVE.")
-    if arm not in skeleton.ARMS:
-        raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
-    if int(frame_count) < 2:
-        raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}.")
 
 
 class NearestClip:
@@ -78,7 +69,7 @@ class NearestClip:
         return abs(float(np.ravel(a)[0]) - float(np.ravel(b)[0]))
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        check_request(behaviour, arm, frame_count)
+        spaces.check_request(behaviour, arm, frame_count)
         return time_warp(self.nearest(behaviour, arm, attributes).rotvecs, frame_count)
 
 
@@ -89,7 +80,7 @@ class NoMotion:
         self.neutral = np.asarray(neutral, dtype=np.float64)  # (15, 3)
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        check_request(behaviour, arm, frame_count)
+        spaces.check_request(behaviour, arm, frame_count)
         return np.repeat(self.neutral[None], int(frame_count), axis=0)
 
 
@@ -102,7 +93,7 @@ class ClassMean:
         self.clips = list(clips)
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        check_request(behaviour, arm, frame_count)
+        spaces.check_request(behaviour, arm, frame_count)
         group = [c for c in self.clips if c.behaviour.upper() == behaviour and c.arm.upper() == arm]
         if not group:
             raise RLAnimateError(f"No {behaviour.lower()} training clip uses the {arm.lower()} arm: "

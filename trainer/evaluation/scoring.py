@@ -81,7 +81,7 @@ def clip_row(clip, generated, reference):
 def score_descriptions(clips, descriptions, references):
     """The one scorer: {'score', 'smoothness', 'by_behaviour': {behaviour: summarise's entry}, 'clips':
     [clip_row]} of generated (F_i, 42) `descriptions` against each clip's own FK (references:
-    algorithm.ClipReferences): means over the clips, per behaviour, per clip."""
+    motion.fk.ClipReferences): means over the clips, per behaviour, per clip."""
     rows = [clip_row(clip, generated, references.get(clip)[0]) for clip, generated in zip(clips, descriptions)]
     return {"score": float(np.mean([r["score"] for r in rows])),
             "smoothness": float(np.mean([r["smoothness"] for r in rows])),

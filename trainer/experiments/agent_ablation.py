@@ -1,15 +1,16 @@
 """Issue 10's choices for the agent, measured against the alternatives: one-behaviour agents trained
 with each, their behaviour measures on the held-out requests -> docs/results/agent_ablation.{json,md}.
 
-    nice -n 10 python -m trainer.scripts.agent_ablation [--runs runs/agent_ablation] [--results docs/results]
+`run_ablation(AblationSettings)`; `python -m trainer.scripts.agent_ablation` builds the settings from its
+command line.
 
 Waves: the rhythm in the objective with the waving-wrist term (the default), without the wrist term,
 the paper's objective (exaggeration only), and the stochastic behaviour state carrying the wave
 (single_state, its posterior on the clip's description during updates, its prior at play). Points: the pointing term with random targets (the default),
 without the random targets, and with neither. Runs that already finished are not trained again.
 """
-import argparse
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -17,14 +18,13 @@ import torch
 
 from rlanimate_addon.core import kinematics
 from trainer.agent.config import load_preset
-from trainer.agent.run import RunSettings, train
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
 from trainer.evaluation.baselines import AgentMethod
+from trainer.experiments.run import RunSettings, train
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, shown
 from trainer.reporting.tables import markdown_table
-from trainer.scripts.cli import run_main, script_args
 
 _CHOSEN = load_preset("default")[1]
 #: name: (behaviour, preset, variant, label)
@@ -42,6 +42,15 @@ ABLATIONS = {
     "point_no_pointing_term": ("point", "no_pointing_term", "rlanimate", "neither"),
 }
 SEEDS = (1, 2, 3)
+
+
+@dataclass(frozen=True)
+class AblationSettings:
+    """Which ablations to train (unless finished) and measure, and where."""
+    runs: str = str(REPO_ROOT / "runs" / "agent_ablation")
+    results: str = str(RESULTS_DIR)
+    targets: int = 100  # random pointing targets per arm
+    only: tuple[str, ...] = ()  # train and measure only these; the other rows stay as agent_ablation.json has them
 
 
 def describe(rotvecs):
@@ -108,36 +117,26 @@ def markdown(results, command):
     return "\n".join(lines) + "\n"
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.agent_ablation",
-                                     description=__doc__.split("\n\n")[0])
-    parser.add_argument("--runs", default=str(REPO_ROOT / "runs" / "agent_ablation"))
-    parser.add_argument("--results", default=str(RESULTS_DIR))
-    parser.add_argument("--targets", type=int, default=100, help="random pointing targets per arm")
-    parser.add_argument("--only", nargs="*", choices=sorted(ABLATIONS),
-                        help="train and measure only these; the other rows stay as agent_ablation.json has them")
-    options = parser.parse_args(script_args(argv))
+def run_ablation(settings):
+    """Train the unfinished ablations of `settings` (all, or `only`), measure them, and write
+    agent_ablation.json and .md into `settings.results`; returns the markdown."""
     torch.set_num_threads(1)
     session = LibrarySession(DEFAULT_MANIFEST)
-    results_dir = Path(options.results)
+    results_dir = Path(settings.results)
     results_json = results_dir / "agent_ablation.json"
-    results = json.loads(results_json.read_text()) if options.only and results_json.is_file() else {}
-    for name in options.only or ABLATIONS:
+    results = json.loads(results_json.read_text()) if settings.only and results_json.is_file() else {}
+    for name in settings.only or ABLATIONS:
         behaviour_name, preset, variant, _ = ABLATIONS[name]
-        output = Path(options.runs) / name
+        output = Path(settings.runs) / name
         if not (output / "report.json").is_file():
             train(RunSettings(str(output), behaviour=behaviour_name, preset=preset, variant=variant, eval_every=0,
                               progress=False), session)
-        results[name] = measure(output / "agent.npz", behaviour_name, session, options.targets)
+        results[name] = measure(output / "agent.npz", behaviour_name, session, settings.targets)
         print(name, json.dumps(results[name]["held_out"]), flush=True)
     results = {name: results[name] for name in ABLATIONS if name in results}
-    command = f"nice -n 10 python -m trainer.scripts.agent_ablation --runs {shown(options.runs)}"
+    command = f"nice -n 10 python -m trainer.scripts.agent_ablation --runs {shown(settings.runs)}"
     results_dir.mkdir(parents=True, exist_ok=True)
     atomic_write_text(results_json, json.dumps(results, indent=1) + "\n")  # it holds rows not rerun here
-    atomic_write_text(results_dir / "agent_ablation.md", markdown(results, command))
-    print((results_dir / "agent_ablation.md").read_text())
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    text = markdown(results, command)
+    atomic_write_text(results_dir / "agent_ablation.md", text)
+    return text

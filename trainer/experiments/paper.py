@@ -1,28 +1,29 @@
 """The paper's Section 4 experiments: one training run per (seed, variant, column), each in its own
 process, then Table 4 (mean ± sd over seeds, with the baselines and the behaviour metrics, on the held-out
-and the harder split), Figure 3 and length flexibility from the finished runs
-(`python -m trainer.scripts.experiments`).
-
-`options` is the experiments' command line (trainer/scripts/experiments.py): preset, epoch_scale,
-variants, columns, clips, runs, results, eval_every, seeds, jobs.
+and the harder split), Figure 3 and length flexibility from the finished runs: `run_paper(PaperSettings)`
+(`python -m trainer.scripts.experiments` builds the settings from its command line).
 """
 import json
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import torch
 
 from rlanimate_addon.core import metrics
 from trainer.agent import checkpoint
 from trainer.agent.config import load_preset
-from trainer.agent.models import RLAnimateAgent
+from trainer.agent.models import VARIANTS, RLAnimateAgent
+from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.evaluation import behaviour, scoring
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.evaluation.harder_split import harder_clips
 from trainer.files import atomic_write_text
-from trainer.paths import REPO_ROOT, seed_folder
+from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, seed_folder
 from trainer.reporting import plots
 from trainer.reporting.table4 import table4_markdown
 
@@ -34,13 +35,29 @@ RANDOM_TARGETS = 100
 LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
 
 
-def run_folder(options, seed, variant, column):
+@dataclass(frozen=True)
+class PaperSettings:
+    """What the Section 4 experiments run: every (seed, variant, column) for the paper's epochs x `epoch_scale`."""
+    preset: str = "default"  # config preset of every run
+    epoch_scale: float = 1.0  # fraction of the paper's 50 / 100 epochs to train (CPU budget)
+    variants: tuple[str, ...] = VARIANTS
+    columns: tuple[str, ...] = COLUMNS
+    clips: str = str(DEFAULT_MANIFEST)
+    runs: str = str(REPO_ROOT / "runs" / "experiments")  # seed 0's runs; seed N's in the sibling <runs>_seed<N>
+    results: str = str(RESULTS_DIR)
+    eval_every: int = 5
+    seeds: tuple[int, ...] = (0, 1, 2)
+    jobs: int = 1  # training runs at a time, one process each
+    skip_training: bool = False  # report the runs that finished, train none
+
+
+def run_folder(settings, seed, variant, column):
     """<runs>/<variant>_<column> for seed 0, <runs>_seed<N>/<variant>_<column> for another seed."""
-    return seed_folder(options.runs, seed) / f"{variant}_{column}"
+    return seed_folder(settings.runs, seed) / f"{variant}_{column}"
 
 
-def planned_epochs(options, column):
-    return max(1, int(round(PAPER_EPOCHS[column] * options.epoch_scale)))
+def planned_epochs(settings, column):
+    return max(1, int(round(PAPER_EPOCHS[column] * settings.epoch_scale)))
 
 
 def is_finished(folder, epochs):
@@ -48,28 +65,28 @@ def is_finished(folder, epochs):
     return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
 
 
-def train_command(options, seed, variant, column):
-    folder = run_folder(options, seed, variant, column)
+def train_command(settings, seed, variant, column):
+    folder = run_folder(settings, seed, variant, column)
     command = [sys.executable, "-m", "trainer.scripts.train", "--behaviour", column,
-               "--variant", variant, "--preset", options.preset, "--clips", options.clips,
-               "--epochs", str(planned_epochs(options, column)), "--seed", str(seed),
-               "--output", str(folder), "--eval-every", str(options.eval_every), "--quiet"]
+               "--variant", variant, "--preset", settings.preset, "--clips", settings.clips,
+               "--epochs", str(planned_epochs(settings, column)), "--seed", str(seed),
+               "--output", str(folder), "--eval-every", str(settings.eval_every), "--quiet"]
     return command + (["--resume"] if (folder / checkpoint.FILENAME).is_file() else [])
 
 
-def train_all(options):
+def train_all(settings):
     """Run every unfinished (seed, variant, column), --jobs processes at a time; raise if one fails."""
-    pending = [(s, v, c) for s in options.seeds for v in options.variants for c in options.columns
-               if not is_finished(run_folder(options, s, v, c), planned_epochs(options, c))]
+    pending = [(s, v, c) for s in settings.seeds for v in settings.variants for c in settings.columns
+               if not is_finished(run_folder(settings, s, v, c), planned_epochs(settings, c))]
     running = []
     while pending or running:
-        while pending and len(running) < options.jobs:
+        while pending and len(running) < settings.jobs:
             seed, variant, column = pending.pop(0)
-            folder = run_folder(options, seed, variant, column)
+            folder = run_folder(settings, seed, variant, column)
             folder.mkdir(parents=True, exist_ok=True)
             log = open(folder / "train.log", "w")
             running.append((seed, variant, column, log, subprocess.Popen(
-                train_command(options, seed, variant, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
+                train_command(settings, seed, variant, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
         time.sleep(1.0)
         for entry in list(running):
             seed, variant, column, log, process = entry
@@ -78,7 +95,7 @@ def train_all(options):
                 running.remove(entry)
                 if process.returncode != 0:
                     raise RuntimeError(f"{variant} {column} seed {seed} failed: see "
-                                       f"{run_folder(options, seed, variant, column)}/train.log")
+                                       f"{run_folder(settings, seed, variant, column)}/train.log")
                 print(f"finished {variant} {column} seed {seed}", flush=True)
 
 
@@ -88,17 +105,17 @@ def load_run(folder):
     return report, history
 
 
-def finished_runs(options):
+def finished_runs(settings):
     """{(seed, variant, column): folder} of the runs that finished their planned epochs."""
-    return {(s, v, c): run_folder(options, s, v, c) for s in options.seeds for v in options.variants
-            for c in options.columns if is_finished(run_folder(options, s, v, c), planned_epochs(options, c))}
+    return {(s, v, c): run_folder(settings, s, v, c) for s in settings.seeds for v in settings.variants
+            for c in settings.columns if is_finished(run_folder(settings, s, v, c), planned_epochs(settings, c))}
 
 
 def column_behaviours(column):
     return ("WAVE", "POINT") if column == "both" else (column.upper(),)
 
 
-def evaluate_runs(options, runs, session):
+def evaluate_runs(settings, runs, session):
     """{split: {column: {method: [behaviour.summarise of each seed]}}}: every finished run's agent (its
     agent.npz, numpy runtime) and each baseline on the held-out clips and the harder split; an agent trained
     on one behaviour is asked for that behaviour only."""
@@ -114,7 +131,7 @@ def evaluate_runs(options, runs, session):
 
     results = {}
     for split, clips in splits.items():
-        for column in options.columns:
+        for column in settings.columns:
             wanted = [c for c in clips if c.behaviour.upper() in column_behaviours(column)]
             entry = results.setdefault(split, {}).setdefault(column, {})
             for (seed, variant, run_column), folder in sorted(runs.items()):
@@ -125,7 +142,7 @@ def evaluate_runs(options, runs, session):
     return results
 
 
-def random_target_aim(options, runs, session):
+def random_target_aim(settings, runs, session):
     """{column: {variant: [per seed: {'left', 'right': {'median', 'max'}}]}}: each pointing agent's own aim
     (no aim correction, degrees at the hold) at RANDOM_TARGETS random unseen targets per arm, at the
     class-average pointing length."""
@@ -154,11 +171,11 @@ def aggregate(per_seed):
     return out
 
 
-def write_table_and_figures(options, results, session):
+def write_table_and_figures(settings, results, session):
     """table4.json/.md over the finished runs, and Figure 3 from the first seed's histories; returns the
     number of finished runs."""
-    runs = finished_runs(options)
-    evaluated = evaluate_runs(options, runs, session)
+    runs = finished_runs(settings)
+    evaluated = evaluate_runs(settings, runs, session)
     table = {split: {column: {method: aggregate(per_seed) for method, per_seed in methods.items()}
                      for column, methods in columns.items()} for split, columns in evaluated.items()}
     training, histories = {}, {}
@@ -168,17 +185,17 @@ def write_table_and_figures(options, results, session):
             "variant": variant, "column": column, "seed": seed, "episodes": report["episodes"],
             "train_seconds": report["train_seconds"], "train_cpu_seconds": report["train_cpu_seconds"],
             "held_out_score": report["held_out"]["score"], "seen_score": report["training"]["score"]}
-        if seed == options.seeds[0]:
+        if seed == settings.seeds[0]:
             histories.setdefault(variant, {})[column] = history
-    seeds = " ".join(str(s) for s in options.seeds)
-    settings = (f"Preset `{options.preset}`, seeds {seeds}, epochs = {options.epoch_scale:g} x the paper's "
-                f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1); "
-                f"{len(runs)} of {len(options.seeds) * len(options.variants) * len(options.columns)} runs finished. "
-                f"Regenerate: `nice -n 10 python -m trainer.scripts.experiments --preset {options.preset} "
-                f"--epoch-scale {options.epoch_scale:g} --seeds {seeds}`.")
+    seeds = " ".join(str(s) for s in settings.seeds)
+    described = (f"Preset `{settings.preset}`, seeds {seeds}, epochs = {settings.epoch_scale:g} x the paper's "
+                 f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1); "
+                 f"{len(runs)} of {len(settings.seeds) * len(settings.variants) * len(settings.columns)} runs finished. "
+                 f"Regenerate: `nice -n 10 python -m trainer.scripts.experiments --preset {settings.preset} "
+                 f"--epoch-scale {settings.epoch_scale:g} --seeds {seeds}`.")
     aim = {column: {variant: aggregate(per_seed) for variant, per_seed in variants.items()}
-           for column, variants in random_target_aim(options, runs, session).items()}
-    report = {"settings": settings, "seeds": list(options.seeds), "table": table, "random_targets": aim,
+           for column, variants in random_target_aim(settings, runs, session).items()}
+    report = {"settings": described, "seeds": list(settings.seeds), "table": table, "random_targets": aim,
               "random_target_count": RANDOM_TARGETS, "training": training}
     atomic_write_text(results / "table4.json", json.dumps(report, indent=1) + "\n")
     atomic_write_text(results / "table4.md", table4_markdown(report))
@@ -187,22 +204,35 @@ def write_table_and_figures(options, results, session):
     return len(runs)
 
 
-def load_trained_agent(folder, preset):
-    """The torch agent of a finished run, from its checkpoint."""
+def load_trained_agent(folder):
+    """The torch agent of a finished run, rebuilt from its checkpoint's own settings (preset and variant)."""
     saved = checkpoint.load(folder / checkpoint.FILENAME)
-    agent = RLAnimateAgent(load_preset(preset)[0], saved["arguments"]["variant"])
+    agent = RLAnimateAgent(load_preset(saved["arguments"]["preset"])[0], saved["arguments"]["variant"])
     agent.load_state_dict(saved["trainer"]["agent"])
     return agent
 
 
-def write_length_flexibility(options, results, session):
+def write_length_flexibility(settings, results, session):
     """Section 4.4 for the first seed's RLAnimate both-behaviour agent on the held-out clips."""
-    folder = run_folder(options, options.seeds[0], "rlanimate", "both")
-    if not is_finished(folder, planned_epochs(options, "both")):
+    folder = run_folder(settings, settings.seeds[0], "rlanimate", "both")
+    if not is_finished(folder, planned_epochs(settings, "both")):
         return None
-    agent = load_trained_agent(folder, options.preset)
+    agent = load_trained_agent(folder)
     test = scoring.select_clips(session.test_clips, "both")
     flexibility = scoring.length_flexibility(agent, session.env, test, session.train_clips, LENGTH_SCALES)
     atomic_write_text(results / "length_flexibility.json", json.dumps(flexibility, indent=2) + "\n")
     plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)
     return flexibility
+
+
+def run_paper(settings):
+    """Train what is unfinished (unless `skip_training`), then write Table 4, Figure 3 and length flexibility
+    into `settings.results`; returns (finished runs, length flexibility or None)."""
+    torch.set_num_threads(1)
+    results = Path(settings.results)
+    results.mkdir(parents=True, exist_ok=True)
+    if not settings.skip_training:
+        train_all(settings)
+    session = LibrarySession(settings.clips)
+    finished = write_table_and_figures(settings, results, session)
+    return finished, write_length_flexibility(settings, results, session)

@@ -6,7 +6,7 @@ docs/REALMOCAP.md). Each BVH goes through trainer/blender_io/clip_import.py (Ble
 the canonicalisation); the capture has no fingers, so the synthesised clips' relaxed hand (motion/realmocap_takes.py)
 is put on, and labels come from the motion (trainer/motion/autolabel.py).
 
-Experiments, each trained with trainer.agent.run.train on a session of real clips (runs/realmocap/<name>/,
+Experiments, each trained with trainer.experiments.run.train on a session of real clips (runs/realmocap/<name>/,
 and runs/realmocap_seed<N>/<name>/ for each further seed):
     wave      wave agent on takes 001-008 of the 7 styles x 2 arms (112 clips), tested on takes
               009-010 (28) and on the 14 goodbye waves of dataset 1 (other actor takes, other styles)
@@ -20,6 +20,7 @@ the full tables and the figure; every seed's agents are scored on the wave sets 
 docs/results/realmocap_frames.png (generated and real frames side by side).
 """
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,18 +29,19 @@ import torch
 from rlanimate_addon.core import skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
-from trainer.agent.algorithm import ClipReferences
-from trainer.agent.run import RunSettings, train
 from trainer.blender_io.clip_import import import_clip
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines, scoring
+from trainer.experiments.run import RunSettings, train
 from trainer.motion import autolabel
+from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
                                             style_holdout_split, wave_split)
-from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, seed_folder, shown
+from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
+                           shown)
 from trainer.reporting.realmocap_report import frames_figure, seed_summary
 
 
@@ -63,7 +65,7 @@ def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_c
 
 
 class RealSession:
-    """What trainer.agent.run.train needs (env, references, train_clips, test_clips, problems), over real clips (every one
+    """What trainer.experiments.run.train needs (env, references, train_clips, test_clips, problems), over real clips (every one
     imported: a take that does not import stops the experiment)."""
 
     def __init__(self, env, references, train_clips, test_clips):
@@ -167,33 +169,45 @@ def _summary(result):
             **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result}}
 
 
-def run_experiments(options):
-    """All experiments; returns the realmocap results dict (also written to options.results)."""
+@dataclass(frozen=True)
+class RealMocapSettings:
+    """What the real-capture experiments run."""
+    realmocap: str = str(REALMOCAP_DIR)  # the capture's folder (wave/, bye/, guide/)
+    epochs: int = 50  # iterations of Algorithm 1 per agent (paper: 50)
+    preset: str = "default"
+    seeds: tuple[int, ...] = (0, 1, 2)  # the first seed's agents give the full tables and the figure
+    point_agent: str | None = None  # exported pointing agent for the guide clips (None: see point_agent_and_library)
+    runs: str = str(REALMOCAP_RUNS)
+    results: str = str(RESULTS_DIR)  # where realmocap_frames.png goes
+
+
+def run_experiments(settings):
+    """All experiments of `settings` (RealMocapSettings); returns the realmocap results dict."""
     torch.set_num_threads(1)
     new_empty_scene()
 
-    root = require_realmocap(options.realmocap)
-    Path(options.results).mkdir(parents=True, exist_ok=True)
-    cache = Path(options.runs) / "import_cache"
+    root = require_realmocap(settings.realmocap)
+    Path(settings.results).mkdir(parents=True, exist_ok=True)
+    cache = Path(settings.runs) / "import_cache"
     with blender_output():
         waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
         env = FKEnvironment()
     references = ClipReferences(env)
-    seeds = list(dict.fromkeys(options.seeds))
-    command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {options.epochs} --preset {options.preset} "
+    seeds = list(dict.fromkeys(settings.seeds))
+    command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {settings.epochs} --preset {settings.preset} "
                f"--seeds {' '.join(str(seed) for seed in seeds)}")
-    if options.point_agent:
-        command += f" --point-agent {options.point_agent}"
+    if settings.point_agent:
+        command += f" --point-agent {settings.point_agent}"
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
                "command": command,
-               "epochs": options.epochs, "preset": options.preset, "seeds": seeds,
+               "epochs": settings.epochs, "preset": settings.preset, "seeds": seeds,
                "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
 
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
     for name, (train_clips, test_clips) in experiments.items():
         session = RealSession(env, references, train_clips, test_clips)
-        agents = {seed: train_agent(session, name, "wave", options.epochs, options.preset, seed,
-                                    seed_folder(options.runs, seed)) for seed in seeds}
+        agents = {seed: train_agent(session, name, "wave", settings.epochs, settings.preset, seed,
+                                    seed_folder(settings.runs, seed)) for seed in seeds}
         report, agent = agents[seeds[0]]
         methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
                    "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
@@ -213,10 +227,10 @@ def run_experiments(options):
             chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
             generated = baselines.generate_for(methods["rlanimate"], chosen)
             frames_figure(env, [(f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
-                                for c, g in zip(chosen, generated)], Path(options.results) / "realmocap_frames.png")
+                                for c, g in zip(chosen, generated)], Path(settings.results) / "realmocap_frames.png")
 
     try:
-        point_method, point_clips = point_agent_and_library(options.point_agent, options.runs, options.epochs,
+        point_method, point_clips = point_agent_and_library(settings.point_agent, settings.runs, settings.epochs,
                                                             seeds[0])
     except RLAnimateError as error:  # no pointing agent and no sample library to train one on
         results["guide"] = {"skipped": str(error)}

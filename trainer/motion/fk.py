@@ -1,4 +1,4 @@
-"""Forward kinematics of action rotations, and the numpy FK environment.
+"""Forward kinematics of action rotations, the numpy FK environment, and the clips' own FK (ClipReferences).
 
 `FKEnvironmentBase` is the environment's interface: `evaluate(action_rotvecs, extra_rotvecs)` and
 `describe_actions(actions01, bounds)` -> FKResult, with one input check. Two environments answer it:
@@ -96,3 +96,18 @@ class NumpyFKEnvironment(FKEnvironmentBase):
     def _pose(self, rotvecs):
         pose = kinematics.pose_matrices({name: rotvecs[:, k] for k, name in enumerate(self._pose_names)})
         return kinematics.head_positions(pose), {eye: pose[:, slot, :3, 1] for eye, slot in self._EYE_SLOTS.items()}
+
+
+class ClipReferences:
+    """FK of each clip's own motion (descriptions (F, 42), joint positions (F, 10, 3)), computed once."""
+
+    def __init__(self, env):
+        self.env = env
+        self._cache = {}
+
+    def get(self, clip):
+        key = id(clip)
+        if key not in self._cache:
+            result = self.env.evaluate(np.asarray(clip.rotvecs, dtype=np.float64))
+            self._cache[key] = (clip, np.asarray(result.descriptions), np.asarray(result.joint_positions))
+        return self._cache[key][1:]

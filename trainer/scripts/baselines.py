@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from trainer.agent.algorithm import ClipReferences
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
 from trainer.evaluation.baselines import AgentMethod, NearestClip, generate_for, mean_start_pose
 from trainer.evaluation.scoring import score_motions, select_clips
 from trainer.motion import autolabel
+from trainer.motion.fk import ClipReferences
 from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.reporting.baselines_report import write_baselines_results
 from trainer.scripts.cli import run_main, script_args

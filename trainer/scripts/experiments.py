@@ -23,48 +23,44 @@ import json
 import sys
 from pathlib import Path
 
-import torch
-
 from trainer.agent.models import VARIANTS
-from trainer.blender_io.clip_session import LibrarySession
-from trainer.evaluation.experiments import COLUMNS, train_all, write_length_flexibility, write_table_and_figures
-from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR
+from trainer.experiments.paper import COLUMNS, PaperSettings, run_paper
 from trainer.scripts.cli import run_main, script_args
+
+DEFAULTS = PaperSettings()
 
 
 def build_parser():
     parser = argparse.ArgumentParser(prog="python -m trainer.scripts.experiments", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--preset", default="default")
-    parser.add_argument("--epoch-scale", type=float, default=1.0,
+    parser.add_argument("--preset", default=DEFAULTS.preset)
+    parser.add_argument("--epoch-scale", type=float, default=DEFAULTS.epoch_scale,
                         help="fraction of the paper's 50 / 100 epochs to train (CPU budget)")
-    parser.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(VARIANTS))
-    parser.add_argument("--columns", nargs="+", choices=COLUMNS, default=list(COLUMNS))
-    parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
-    parser.add_argument("--runs", default=str(REPO_ROOT / "runs" / "experiments"),
+    parser.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(DEFAULTS.variants))
+    parser.add_argument("--columns", nargs="+", choices=COLUMNS, default=list(DEFAULTS.columns))
+    parser.add_argument("--clips", default=DEFAULTS.clips)
+    parser.add_argument("--runs", default=DEFAULTS.runs,
                         help="seed 0's runs; seed N's go to the sibling folder <runs>_seed<N>")
-    parser.add_argument("--results", default=str(RESULTS_DIR))
-    parser.add_argument("--eval-every", type=int, default=5)
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2])
-    parser.add_argument("--jobs", type=int, default=1, help="training runs at a time, one process each")
+    parser.add_argument("--results", default=DEFAULTS.results)
+    parser.add_argument("--eval-every", type=int, default=DEFAULTS.eval_every)
+    parser.add_argument("--seeds", type=int, nargs="+", default=list(DEFAULTS.seeds))
+    parser.add_argument("--jobs", type=int, default=DEFAULTS.jobs, help="training runs at a time, one process each")
     parser.add_argument("--skip-training", action="store_true", help="report the runs that finished, train none")
     return parser
 
 
-def parse_options(argv=None):
-    return build_parser().parse_args(script_args(argv))
+def parse_settings(argv=None):
+    """PaperSettings from the command line."""
+    args = build_parser().parse_args(script_args(argv))
+    return PaperSettings(preset=args.preset, epoch_scale=args.epoch_scale, variants=tuple(args.variants),
+                         columns=tuple(args.columns), clips=args.clips, runs=args.runs, results=args.results,
+                         eval_every=args.eval_every, seeds=tuple(args.seeds), jobs=args.jobs,
+                         skip_training=args.skip_training)
 
 
 def main(argv=None):
-    options = parse_options(argv)
-    torch.set_num_threads(1)
-    results = Path(options.results)
-    results.mkdir(parents=True, exist_ok=True)
-    if not options.skip_training:
-        train_all(options)
-    session = LibrarySession(options.clips)
-    finished = write_table_and_figures(options, results, session)
-    print(f"{finished} finished runs\n" + (results / "table4.md").read_text())
-    flexibility = write_length_flexibility(options, results, session)
+    settings = parse_settings(argv)
+    finished, flexibility = run_paper(settings)
+    print(f"{finished} finished runs\n" + (Path(settings.results) / "table4.md").read_text())
     if flexibility:
         print("length flexibility:", json.dumps(flexibility))
     return 0

@@ -9,32 +9,41 @@ import argparse
 import json
 from pathlib import Path
 
-from trainer.evaluation.realmocap import baseline_sets, run_experiments
-from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
+from trainer.experiments.realmocap import RealMocapSettings, baseline_sets, run_experiments
 from trainer.reporting.baselines_report import write_baselines_results
 from trainer.reporting.realmocap_report import realmocap_markdown
 from trainer.scripts.cli import run_main, script_args
 
+DEFAULTS = RealMocapSettings()
+
 
 def build_parser():
     parser = argparse.ArgumentParser(prog="python -m trainer.scripts.realmocap", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--realmocap", default=str(REALMOCAP_DIR))
-    parser.add_argument("--epochs", type=int, default=50, help="iterations of Algorithm 1 per agent (paper: 50)")
-    parser.add_argument("--preset", default="default")
-    parser.add_argument("--seeds", type=int, nargs="+", default=[0, 1, 2],
+    parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
+    parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs,
+                        help="iterations of Algorithm 1 per agent (paper: 50)")
+    parser.add_argument("--preset", default=DEFAULTS.preset)
+    parser.add_argument("--seeds", type=int, nargs="+", default=list(DEFAULTS.seeds),
                         help="training seeds; the first seed's agents give the full tables and the figure")
     parser.add_argument("--point-agent", default=None,
                         help="exported pointing agent (.npz) for the guide clips (default: the installed "
                              "agent when trained, else one trained here on the sample library)")
-    parser.add_argument("--runs", default=str(REALMOCAP_RUNS))
-    parser.add_argument("--results", default=str(RESULTS_DIR))
+    parser.add_argument("--runs", default=DEFAULTS.runs)
+    parser.add_argument("--results", default=DEFAULTS.results)
     return parser
 
 
+def parse_settings(argv=None):
+    """RealMocapSettings from the command line."""
+    args = build_parser().parse_args(script_args(argv))
+    return RealMocapSettings(realmocap=args.realmocap, epochs=args.epochs, preset=args.preset, seeds=tuple(args.seeds),
+                             point_agent=args.point_agent, runs=args.runs, results=args.results)
+
+
 def main(argv=None):
-    options = build_parser().parse_args(script_args(argv))
-    results = run_experiments(options)
-    out = Path(options.results)
+    settings = parse_settings(argv)
+    results = run_experiments(settings)
+    out = Path(settings.results)
     (out / "realmocap.json").write_text(json.dumps(results, indent=2) + "\n")
     (out / "realmocap.md").write_text(realmocap_markdown(results))
     write_baselines_results(out, "real motion capture",

@@ -6,7 +6,7 @@
 
 With no arguments it trains the both-behaviour RLAnimate agent on the sample clip library into
 runs/default/. `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
-report to docs/results/. Outputs: see trainer/agent/run.py. `--resume` continues the run in --output
+report to docs/results/. Outputs: see trainer/experiments/run.py. `--resume` continues the run in --output
 from its checkpoint with the run's own settings; the continuation equals the uninterrupted run.
 """
 import argparse
@@ -14,8 +14,8 @@ from pathlib import Path
 
 from trainer.agent.algorithm import BEHAVIOUR_CHOICES
 from trainer.agent.models import VARIANTS
-from trainer.agent.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
 from trainer.blender_io.clip_session import LibrarySession
+from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
 from trainer.files import atomic_copy
 from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.scripts.cli import run_main, script_args

@@ -8,11 +8,11 @@ import torch
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint, pointing
-from trainer.agent.algorithm import ClipReferences, Trainer, clip_objective, clips_for_behaviour
+from trainer.agent.algorithm import Trainer, clip_objective, clips_for_behaviour
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
-from trainer.motion.fk import NumpyFKEnvironment
+from trainer.motion.fk import ClipReferences, NumpyFKEnvironment
 
 torch.set_num_threads(1)
 

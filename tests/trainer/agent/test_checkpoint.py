@@ -11,11 +11,11 @@ import torch
 from rlanimate_addon.core.errors import RLAnimateError
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint
-from trainer.agent.algorithm import ClipReferences, Trainer
+from trainer.agent.algorithm import Trainer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
-from trainer.agent.run import RunSettings, train
-from trainer.motion.fk import NumpyFKEnvironment
+from trainer.experiments.run import RunSettings, train
+from trainer.motion.fk import ClipReferences, NumpyFKEnvironment
 
 torch.set_num_threads(1)
 

@@ -5,9 +5,8 @@ import pytest
 from rlanimate_addon.core import skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from tests.trainer.synthetic_library import make_clip
-from trainer.agent.algorithm import ClipReferences
 from trainer.evaluation import baselines, scoring
-from trainer.motion.fk import NumpyFKEnvironment
+from trainer.motion.fk import ClipReferences, NumpyFKEnvironment
 
 JOINTS = len(skeleton.ACTION_JOINTS)
 

@@ -5,11 +5,11 @@ import torch
 
 from rlanimate_addon.core import metrics, spaces
 from tests.trainer.synthetic_library import make_library
-from trainer.agent.algorithm import ClipReferences, clip_objective
+from trainer.agent.algorithm import clip_objective
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
 from trainer.evaluation import scoring
-from trainer.motion.fk import NumpyFKEnvironment
+from trainer.motion.fk import ClipReferences, NumpyFKEnvironment
 
 torch.set_num_threads(1)
 

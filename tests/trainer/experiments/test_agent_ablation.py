@@ -1,9 +1,10 @@
-"""trainer.scripts.agent_ablation --only: trains and measures the named rows, keeps the others as they were."""
+"""The agent ablation (trainer.scripts.agent_ablation) with --only: trains and measures the named rows, keeps the others as they were."""
 import json
 import shutil
 
+from trainer.experiments import agent_ablation
 from trainer.paths import RESULTS_DIR
-from trainer.scripts import agent_ablation
+from trainer.scripts import agent_ablation as script
 
 
 def test_only_replaces_its_rows_and_keeps_the_others(tmp_path, monkeypatch):
@@ -19,7 +20,7 @@ def test_only_replaces_its_rows_and_keeps_the_others(tmp_path, monkeypatch):
     rerun = ["point_no_pointing_term", "point_random_targets"]
     argv = ["agent_ablation", "--only", *rerun, "--runs",
             str(tmp_path / "runs"), "--results", str(results)]
-    assert agent_ablation.main(argv) == 0
+    assert script.main(argv) == 0
     after = json.loads((results / "agent_ablation.json").read_text())
     assert trained == ["no_pointing_term", "default"]
     assert list(after) == [name for name in agent_ablation.ABLATIONS if name in before or name in rerun]

@@ -1,24 +1,24 @@
-"""trainer.scripts.experiments: every seed gets its own runs; Table 4 cells are mean ± sd over seeds."""
+"""trainer.experiments.paper and its script: every seed gets its own runs; Table 4 cells are mean ± sd over seeds."""
 import math
 from pathlib import Path
 
-from trainer.evaluation import experiments as harness
+from trainer.experiments import paper as harness
 from trainer.paths import REPO_ROOT, RESULTS_DIR
 from trainer.scripts import experiments
 
 
 def test_seed_zero_uses_the_shared_folders_and_three_seeds_by_default():
-    options = experiments.parse_options(["experiments"])
-    assert options.seeds == [0, 1, 2]
-    assert harness.run_folder(options, 0, "rlanimate", "wave") == REPO_ROOT / "runs" / "experiments" / "rlanimate_wave"
-    assert Path(options.results) == RESULTS_DIR
+    settings = experiments.parse_settings(["experiments"])
+    assert settings.seeds == (0, 1, 2)
+    assert harness.run_folder(settings, 0, "rlanimate", "wave") == REPO_ROOT / "runs" / "experiments" / "rlanimate_wave"
+    assert Path(settings.results) == RESULTS_DIR
 
 
 def test_another_seed_never_reuses_seed_zero_runs(tmp_path):
-    options = experiments.parse_options(["experiments", "--seeds", "0", "3", "--runs", str(tmp_path / "r")])
-    assert harness.run_folder(options, 3, "rlanimate", "wave") == tmp_path / "r_seed3" / "rlanimate_wave"
-    assert harness.run_folder(options, 0, "rlanimate", "wave") == tmp_path / "r" / "rlanimate_wave"
-    assert "--seed" in (command := harness.train_command(options, 3, "rlanimate", "wave"))
+    settings = experiments.parse_settings(["experiments", "--seeds", "0", "3", "--runs", str(tmp_path / "r")])
+    assert harness.run_folder(settings, 3, "rlanimate", "wave") == tmp_path / "r_seed3" / "rlanimate_wave"
+    assert harness.run_folder(settings, 0, "rlanimate", "wave") == tmp_path / "r" / "rlanimate_wave"
+    assert "--seed" in (command := harness.train_command(settings, 3, "rlanimate", "wave"))
     assert command[command.index("--seed") + 1] == "3"
 
 

@@ -3,12 +3,13 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import skeleton
-from trainer.agent.algorithm import ClipReferences
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
-from trainer.evaluation import baselines, realmocap
+from trainer.evaluation import baselines
+from trainer.experiments import realmocap
 from trainer.motion import autolabel
+from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import wave_split
 from trainer.motion.synthesis import neutral_pose
 from trainer.paths import REALMOCAP_DIR

@@ -5,7 +5,7 @@ import torch
 
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
-from trainer.agent.run import NEW_RUN_DEFAULTS, RunSettings, resolve
+from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve
 
 
 SAVED = {"behaviour": "wave", "clips": "clips/manifest.json", "preset": "debug", "variant": "single_state",

@@ -1,5 +1,5 @@
 """The one markdown-table writer, and Table 4 written with it."""
-from trainer.evaluation.experiments import aggregate
+from trainer.experiments.paper import aggregate
 from trainer.reporting.table4 import cell, table4_markdown
 from trainer.reporting.tables import markdown_table
 
