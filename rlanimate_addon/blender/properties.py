@@ -5,6 +5,7 @@ contract that outside tools and checks use: keep them.
 """
 import bpy
 
+from ..core.behaviours import POINT, WAVE
 from ..core.errors import RLAnimateError
 from . import preferences
 
@@ -12,7 +13,7 @@ from . import preferences
 FALLBACK_LENGTH = 60
 
 
-def learned_length(behaviour="POINT"):
+def learned_length(behaviour=POINT):
     """The bundled agent's average gesture length for the behaviour, in frames."""
     try:
         return int(round(preferences.load_agent(preferences.BUNDLED_AGENT).average_frames[behaviour]))
@@ -22,9 +23,9 @@ def learned_length(behaviour="POINT"):
 
 class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     behaviour: bpy.props.EnumProperty(
-        name="Behaviour", default="POINT",
-        items=[("POINT", "Point", "Point the index finger at the target"),
-               ("WAVE", "Wave", "Wave the hand; exaggeration sets its size")])
+        name="Behaviour", default=POINT,
+        items=[(POINT, "Point", "Point the index finger at the target"),
+               (WAVE, "Wave", "Wave the hand; exaggeration sets its size")])
     arm: bpy.props.EnumProperty(
         name="Arm", default="RIGHT",
         items=[("LEFT", "Left", "The character's left arm"), ("RIGHT", "Right", "The character's right arm")])

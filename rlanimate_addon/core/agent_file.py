@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import rhythm, spaces
+from . import behaviours, rhythm, spaces
 from .errors import RLAnimateError
 
 FORMAT_NAME = "rlanimate-agent"
@@ -289,11 +289,11 @@ def _check_metadata_values(path, metadata):
                              f"re-export it with trainer/agent/agent_export.py.")
     frames = metadata["average_frames"]
     if not isinstance(frames, dict) or not frames or any(
-            b not in spaces.BEHAVIOURS or not _is_number(n) or not 2 <= n <= MAX_AVERAGE_FRAMES
+            b not in behaviours.BEHAVIOURS or not _is_number(n) or not 2 <= n <= MAX_AVERAGE_FRAMES
             for b, n in frames.items()):
         raise RLAnimateError(f"The agent file {path} has invalid average_frames (need a length of 2 to "
                              f"{MAX_AVERAGE_FRAMES:,} frames for each behaviour it was trained for, among "
-                             f"{', '.join(spaces.BEHAVIOURS)}): re-export it.")
+                             f"{', '.join(behaviours.BEHAVIOURS)}): re-export it.")
     if metadata["wave_rhythm"] is not None:
         rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
     return {name: tuple(shape) for name, shape in expected.items()}

@@ -16,7 +16,7 @@ the rollout runs on one BLAS thread (core/blas_threads.py).
 """
 import numpy as np
 
-from . import agent_file, blas_threads, rhythm, spaces
+from . import agent_file, behaviours, blas_threads, rhythm, spaces
 from .errors import RLAnimateError
 
 
@@ -85,11 +85,12 @@ class GestureAgent:
         self.variant = metadata["variant"]
         self.action_bounds = np.asarray(metadata["action_bounds"], dtype=np.float64)  # (45, 2)
         trained = {b: float(n) for b, n in metadata["average_frames"].items()}
-        #: The behaviours the agent was trained for, in spaces.BEHAVIOURS order.
-        self.behaviours = tuple(b for b in spaces.BEHAVIOURS if b in trained)
+        #: The behaviours the agent was trained for, in behaviours.BEHAVIOURS order.
+        self.behaviours = tuple(b for b in behaviours.BEHAVIOURS if b in trained)
         #: Average gesture length in frames per behaviour (the UI's default length); a behaviour the
         #: agent was not trained for gets the mean of the others, so the UI always has a default.
-        self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values())))) for b in spaces.BEHAVIOURS}
+        self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values()))))
+                               for b in behaviours.BEHAVIOURS}
         rhythm_values = metadata.get("wave_rhythm")
         #: The training waves' rhythms (core/rhythm.py), or None for an agent trained on the paper's objective.
         self.rhythm_model = None if rhythm_values is None else rhythm.RhythmModel.from_dict(rhythm_values)
@@ -139,7 +140,8 @@ class GestureAgent:
                                  f"{objectives.shape}: give the gesture at least one frame and a valid target.")
         untrained = set(objectives[:, spaces.OBJECTIVE_TYPE]) - {spaces.BEHAVIOUR_TYPE[b] for b in self.behaviours}
         if untrained:
-            raise RLAnimateError(f"This agent was trained for {' and '.join(b.lower() for b in self.behaviours)} "
+            trained = " and ".join(behaviours.key(b) for b in self.behaviours)
+            raise RLAnimateError(f"This agent was trained for {trained} "
                                  f"only: choose an agent trained for the requested behaviour in the add-on "
                                  f"preferences.")
         with blas_threads.single_blas_thread():

@@ -20,14 +20,15 @@ The character frame is the armature's object space with its scale removed: +X th
 import numpy as np
 
 from . import skeleton
+from .behaviours import BEHAVIOURS, POINT, WAVE
 from .errors import RLAnimateError
 
 OBJECTIVE_SIZE = 7
 DESCRIPTION_SIZE = 42
 ACTION_SIZE = 3 * len(skeleton.ACTION_JOINTS)
 
-BEHAVIOURS = ("POINT", "WAVE")
-BEHAVIOUR_TYPE = {"POINT": 1.0, "WAVE": 2.0}
+#: The objective's type code of each behaviour (Table 2).
+BEHAVIOUR_TYPE = {POINT: 1.0, WAVE: 2.0}
 
 OBJECTIVE_TYPE = 0
 OBJECTIVE_ARM = slice(1, 3)
@@ -78,7 +79,7 @@ def make_objective(behaviour, arm, attributes, frame_count, rhythm=None):
     check_request(behaviour, arm, frame_count)
     n = int(frame_count)
     attrs = np.asarray(attributes, dtype=np.float64)
-    if behaviour == "POINT":
+    if behaviour == POINT:
         attrs = np.broadcast_to(attrs, (n, 3))
         norms = np.linalg.norm(attrs, axis=1, keepdims=True)
         if not np.all(np.isfinite(attrs)) or np.any(norms < 1e-9):

@@ -4,7 +4,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import behaviours, skeleton, spaces
 
 _ARM_JOINT = {arm: skeleton.ACTION_JOINTS.index(skeleton.ARM_PREFIX[arm] + "Arm") for arm in skeleton.ARMS}
 _FOREARM_JOINT = {arm: skeleton.ACTION_JOINTS.index(skeleton.ARM_PREFIX[arm] + "ForeArm") for arm in skeleton.ARMS}
@@ -47,6 +47,6 @@ def make_library(seed=0, per_behaviour=4):
                  else rng.uniform(0, 1))
         return make_clip(f"{behaviour.lower()}_{arm.lower()}_{k}", behaviour, arm, value, frames)
 
-    train = [clip(k, b, skeleton.ARMS[k % 2]) for b in spaces.BEHAVIOURS for k in range(per_behaviour)]
-    test = [clip(100 + k, b, arm) for b in spaces.BEHAVIOURS for k, arm in enumerate(skeleton.ARMS)]
+    train = [clip(k, b, skeleton.ARMS[k % 2]) for b in behaviours.BEHAVIOURS for k in range(per_behaviour)]
+    test = [clip(100 + k, b, arm) for b in behaviours.BEHAVIOURS for k, arm in enumerate(skeleton.ARMS)]
     return SimpleNamespace(train=train, test=test)

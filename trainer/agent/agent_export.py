@@ -11,12 +11,12 @@ from dataclasses import asdict, is_dataclass
 
 import numpy as np
 
-from rlanimate_addon.core import agent_file, skeleton, spaces
+from rlanimate_addon.core import agent_file, behaviours, skeleton, spaces
 from trainer.files import atomic_open
 from trainer.paths import REPO_ROOT
 
 #: Average gesture length in frames (30 fps) when the caller gives none: the UI's default length.
-FALLBACK_AVERAGE_FRAMES = {"POINT": 90, "WAVE": 90}
+FALLBACK_AVERAGE_FRAMES = dict.fromkeys(behaviours.BEHAVIOURS, 90)
 
 
 def export_agent(agent, path, metadata=None):
@@ -63,7 +63,7 @@ def _json_value(value):
 
 def _spaces():
     return {"objective_size": spaces.OBJECTIVE_SIZE, "description_size": spaces.DESCRIPTION_SIZE,
-            "action_size": spaces.ACTION_SIZE, "behaviours": list(spaces.BEHAVIOURS),
+            "action_size": spaces.ACTION_SIZE, "behaviours": list(behaviours.BEHAVIOURS),
             "behaviour_type": dict(spaces.BEHAVIOUR_TYPE), "action_joints": list(skeleton.ACTION_JOINTS),
             "action_encoding": "rotation vector relative to rest, (r - low) / (high - low)",
             "description_joints": [list(j) for j in skeleton.DESCRIPTION_JOINTS],

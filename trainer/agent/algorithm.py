@@ -22,7 +22,7 @@ import numpy as np
 import torch
 from torch.optim.swa_utils import AveragedModel
 
-from rlanimate_addon.core import rhythm, spaces
+from rlanimate_addon.core import behaviours, rhythm, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 
 from trainer.agent import checkpoint, pointing
@@ -30,16 +30,14 @@ from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
 
-BEHAVIOUR_CHOICES = ("point", "wave", "both")
-
-
 def clips_for_behaviour(clips, behaviour):
-    """Clips grouped as Algorithm 1 draws them: [[point clips], [wave clips]] for 'both', else one group."""
-    wanted = ("POINT", "WAVE") if behaviour == "both" else (behaviour.upper(),)
-    groups = [[clip for clip in clips if clip.behaviour.upper() == name] for name in wanted]
+    """Clips grouped as Algorithm 1 draws them: one group per behaviour of the training set `behaviour`
+    ([[point clips], [wave clips]] for 'both')."""
+    wanted = behaviours.training_set(behaviour)
+    groups = [[clip for clip in clips if clip.behaviour == name] for name in wanted]
     for name, group in zip(wanted, groups):
         if not group:
-            raise RLAnimateError(f"The clip library has no {name.lower()} training clips: add some, "
+            raise RLAnimateError(f"The clip library has no {behaviours.key(name)} training clips: add some, "
                                  f"or train with --behaviour set to a behaviour it has.")
     return groups
 
@@ -54,10 +52,10 @@ def clip_objective(clip, frame_count=None, rhythm_model=None, with_rhythm=True):
     """
     frames = len(clip.rotvecs) if frame_count is None else frame_count
     signals = None
-    if clip.behaviour.upper() == "WAVE" and with_rhythm:
+    if clip.behaviour == behaviours.WAVE and with_rhythm:
         drawn = wave_rhythm.clip_rhythm(clip) if rhythm_model is None else rhythm_model.draw(clip.attributes)
         signals = np.zeros((frames, 2)) if drawn is None else rhythm.signals(drawn, frames)
-    return spaces.make_objective(clip.behaviour.upper(), clip.arm.upper(), clip.attributes, frames, signals)
+    return spaces.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
 
 
 def rollout_actions(agent, objectives, deterministic=True, generator=None):
@@ -82,17 +80,15 @@ def gradient_step(agent, optimizer, batch, config, bounds):
 class Trainer:
     """Algorithm 1's state (agent, optimiser, buffer, RNGs, epoch, history) and one iteration of it."""
 
-    def __init__(self, agent, env, clips, train_config, behaviour="both", seed=0,
+    def __init__(self, agent, env, clips, train_config, behaviour=behaviours.BOTH, seed=0,
                  bounds=spaces.DEFAULT_ACTION_BOUNDS, references=None, epochs=None):
-        if behaviour not in BEHAVIOUR_CHOICES:
-            raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use point, wave or both.")
         self.agent = agent
         self.env = env
         self.train_config = train_config
         self.behaviour = behaviour
         self.bounds = np.asarray(bounds, dtype=np.float64)
         self.clip_groups = clips_for_behaviour(clips, behaviour)
-        waves = [clip for group in self.clip_groups for clip in group if clip.behaviour.upper() == "WAVE"]
+        waves = [clip for group in self.clip_groups for clip in group if clip.behaviour == behaviours.WAVE]
         #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
         self.rhythm_model = None
         if waves and train_config.wave_rhythm:
@@ -129,13 +125,13 @@ class Trainer:
         drawn = [self.draw(k) for k in range(len(self.clip_groups))]
         objectives = [clip_objective(clip, with_rhythm=self.train_config.wave_rhythm) for clip in drawn]
         imitated = [True] * len(drawn)
-        points = [clip for group in self.clip_groups for clip in group if clip.behaviour.upper() == "POINT"]
+        points = [clip for group in self.clip_groups for clip in group if clip.behaviour == behaviours.POINT]
         if points and self.agent.variant != "supervised":
             for _ in range(self.train_config.random_targets):
                 clip = points[int(self.rng.integers(len(points)))]
                 drawn.append(clip)
-                objectives.append(spaces.make_objective("POINT", clip.arm.upper(),
-                                                        self._random_direction(clip.arm.upper()), len(clip.rotvecs)))
+                objectives.append(spaces.make_objective(behaviours.POINT, clip.arm, self._random_direction(clip.arm),
+                                                        len(clip.rotvecs)))
                 imitated.append(False)
         self.agent.eval()
         actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
@@ -161,7 +157,7 @@ class Trainer:
         """A unit pointing direction for `arm`, uniform in azimuth and elevation over the range of the
         arm's training clips widened by the config's margin (elevation kept within 80 degrees)."""
         angles = np.degrees([pointing.azimuth_elevation(arm, clip.attributes) for group in self.clip_groups
-                             for clip in group if clip.behaviour.upper() == "POINT" and clip.arm.upper() == arm])
+                             for clip in group if clip.behaviour == behaviours.POINT and clip.arm == arm])
         margin = self.train_config.random_target_margin_deg
         low = np.maximum(angles.min(axis=0) - margin, (-180.0, -80.0))
         high = np.minimum(angles.max(axis=0) + margin, (180.0, 80.0))

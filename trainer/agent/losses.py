@@ -32,7 +32,7 @@ import torch
 import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
-from rlanimate_addon.core import spaces
+from rlanimate_addon.core import behaviours, spaces
 from rlanimate_addon.core.agent_file import INITIAL_ACTION
 from trainer.agent import pointing
 from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
@@ -76,7 +76,8 @@ def agent_losses(agent, batch, config, bounds=None):
         terms["pointing"] = pointing.pointing_error(policy.mean[hold], objective[hold],
                                                     torch.as_tensor(bounds, dtype=objective.dtype)).mean()
     if config.wrist_scale and bounds is not None:  # only then: runs without it log the terms they always had
-        waving = (objective[..., spaces.OBJECTIVE_TYPE] == spaces.BEHAVIOUR_TYPE["WAVE"]) & (imitate > 0.5)  # (C, L)
+        wave_type = spaces.BEHAVIOUR_TYPE[behaviours.WAVE]
+        waving = (objective[..., spaces.OBJECTIVE_TYPE] == wave_type) & (imitate > 0.5)  # (C, L)
         terms["wrist"] = (wrist_error(policy.mean[waving], motion[waving], objective[waving],
                                       torch.as_tensor(bounds, dtype=objective.dtype)).mean()
                           if waving.any() else torch.zeros((), dtype=objective.dtype))

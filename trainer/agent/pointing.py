@@ -14,7 +14,7 @@ target REFERENCE_DISTANCE away), averaged over the frames the reference clip hol
 import numpy as np
 import torch
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import behaviours, skeleton, spaces
 from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
 
 #: Metres: the nearest target distance the agent is asked to hit (targets are 1.5-4 m away).
@@ -58,7 +58,7 @@ def direction_from_angles(arm, azimuth, elevation):
 def hold_frames(objective, motion_description):
     """(F,) 1.0 where a POINT reference (descriptions (F, 42)) holds its finger on the objective's ray."""
     objective = np.asarray(objective)
-    if objective[0, spaces.OBJECTIVE_TYPE] != spaces.BEHAVIOUR_TYPE["POINT"]:
+    if objective[0, spaces.OBJECTIVE_TYPE] != spaces.BEHAVIOUR_TYPE[behaviours.POINT]:
         return np.zeros(len(objective))
     arm = skeleton.ARMS[int(np.argmax(objective[0, spaces.OBJECTIVE_ARM]))]
     side = skeleton.ARMS.index(arm)

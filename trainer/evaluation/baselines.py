@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import rhythm, rotations, spaces
+from rlanimate_addon.core import behaviours, rhythm, rotations, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 
@@ -44,6 +44,15 @@ def time_warp(rotvecs, frame_count):
     return rotations.quat_to_rotvec(slerp(quats[low], quats[high], weight))
 
 
+def clips_of(clips, behaviour, arm, baseline):
+    """The clips of `behaviour` and `arm`; RLAnimateError naming the `baseline` that needs one when there are none."""
+    group = [c for c in clips if c.behaviour == behaviour and c.arm == arm]
+    if not group:
+        raise RLAnimateError(f"No {behaviours.key(behaviour)} training clip uses the {arm.lower()} arm: "
+                             f"add one to the library to use the {baseline} baseline.")
+    return group
+
+
 class NearestClip:
     """Motion-matching retrieval over labelled training clips (MotionClip-like: behaviour, arm,
     attributes, rotvecs)."""
@@ -53,16 +62,13 @@ class NearestClip:
 
     def nearest(self, behaviour, arm, attributes):
         """The training clip of `behaviour` and `arm` whose label is closest to `attributes`."""
-        candidates = [c for c in self.clips if c.behaviour.upper() == behaviour and c.arm.upper() == arm]
-        if not candidates:
-            raise RLAnimateError(f"No {behaviour.lower()} training clip uses the {arm.lower()} arm: "
-                                 "add one to the library to use the nearest-clip baseline.")
+        candidates = clips_of(self.clips, behaviour, arm, "nearest-clip")
         return min(candidates, key=lambda c: self.label_distance(behaviour, c.attributes, attributes))
 
     @staticmethod
     def label_distance(behaviour, a, b):
         """Angle (rad) between pointing directions, or |difference| of exaggerations."""
-        if behaviour == "POINT":
+        if behaviour == behaviours.POINT:
             a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
             cos = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
             return float(np.arccos(np.clip(cos, -1.0, 1.0)))
@@ -94,10 +100,7 @@ class ClassMean:
 
     def generate(self, behaviour, arm, attributes, frame_count):
         spaces.check_request(behaviour, arm, frame_count)
-        group = [c for c in self.clips if c.behaviour.upper() == behaviour and c.arm.upper() == arm]
-        if not group:
-            raise RLAnimateError(f"No {behaviour.lower()} training clip uses the {arm.lower()} arm: "
-                                 "add one to the library to use the class-mean baseline.")
+        group = clips_of(self.clips, behaviour, arm, "class-mean")
         quats = rotations.rotvec_to_quat(np.stack([time_warp(c.rotvecs, frame_count) for c in group]))  # (C, F, 15, 4)
         quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
         mean = quats.mean(axis=0)
@@ -121,7 +124,7 @@ class TrainedAgentMethod:
         self.agent.eval()
         generator = None if seed is None else torch.Generator().manual_seed(int(seed))
         signals = (rhythm.signals(self.rhythm_model.draw(attributes, seed), frame_count)
-                   if behaviour == "WAVE" and self.rhythm_model is not None else None)
+                   if behaviour == behaviours.WAVE and self.rhythm_model is not None else None)
         actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count, signals),
                                   deterministic=seed is None, generator=generator)
         return spaces.decode_action(actions, self.bounds)
@@ -139,11 +142,11 @@ class AgentMethod:
     def generate(self, behaviour, arm, attributes, frame_count, seed=None):
         """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed), and for
         a wave the rhythm the agent draws for the seed."""
-        signals = self.agent.wave_rhythm(attributes, frame_count, seed) if behaviour == "WAVE" else None
+        signals = self.agent.wave_rhythm(attributes, frame_count, seed) if behaviour == behaviours.WAVE else None
         objectives = spaces.make_objective(behaviour, arm, attributes, frame_count, signals)
         return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
 
 
 def generate_for(baseline, clips):
     """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
-    return [baseline.generate(c.behaviour.upper(), c.arm.upper(), c.attributes, len(c.rotvecs)) for c in clips]
+    return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs)) for c in clips]

@@ -13,7 +13,7 @@ method's own aim, or after aim correction (`aim.aim_at`) with exact_aim.
 """
 import numpy as np
 
-from rlanimate_addon.core import aim, metrics, skeleton, spaces
+from rlanimate_addon.core import aim, behaviours, metrics, skeleton, spaces
 from rlanimate_addon.core import behaviour_metrics as bm
 
 #: Pointing targets as the sample library draws them (trainer/motion/library_plan.py): azimuth from
@@ -31,7 +31,7 @@ def class_lengths(training_clips):
     """{behaviour: mean frame count} of the training clips ('POINT', 'WAVE')."""
     lengths = {}
     for clip in training_clips:
-        lengths.setdefault(clip.behaviour.upper(), []).append(len(clip.rotvecs))
+        lengths.setdefault(clip.behaviour, []).append(len(clip.rotvecs))
     return {b: int(round(np.mean(v))) for b, v in lengths.items()}
 
 
@@ -44,7 +44,7 @@ def clip_target(clip):
 def _answer(method, behaviour, arm, attributes, frames, target, exact_aim, seed=None):
     rotvecs = (method.generate(behaviour, arm, attributes, frames) if seed is None
                else method.generate(behaviour, arm, attributes, frames, seed=seed))
-    if exact_aim and behaviour == "POINT":
+    if exact_aim and behaviour == behaviours.POINT:
         rotvecs = aim.aim_at(rotvecs, arm, target)
     return rotvecs
 
@@ -55,14 +55,14 @@ def request_rows(method, clips, references, describe, lengths, exact_aim=False, 
     `seed`: the method's variation seed (None: its deterministic answer)."""
     rows = []
     for clip in clips:
-        behaviour, arm, target = clip.behaviour.upper(), clip.arm.upper(), clip_target(clip)
+        behaviour, arm, target = clip.behaviour, clip.arm, clip_target(clip)
         own = describe(_answer(method, behaviour, arm, clip.attributes, len(clip.rotvecs), target, exact_aim, seed))
         at_class = describe(_answer(method, behaviour, arm, clip.attributes, lengths[behaviour], target, exact_aim,
                                     seed))
         reference, reference_positions = references.get(clip)
         positions = spaces.description_joint_positions(own)
         class_positions = spaces.description_joint_positions(at_class)
-        row = {"name": clip.name, "behaviour": behaviour.lower(), "arm": arm.lower(),
+        row = {"name": clip.name, "behaviour": behaviours.key(behaviour), "arm": arm.lower(),
                "score": metrics.score(positions, reference_positions),
                "smoothness": metrics.smoothness(positions),
                "score_class_length": bm.score_at_length(class_positions, reference_positions),
@@ -77,12 +77,12 @@ def seed_variation(method, clips, describe, seeds):
     the deterministic answer (no seed) repeats exactly. -> [{name, behaviour, variation, deterministic}]"""
     rows = []
     for clip in clips:
-        behaviour, arm, frames = clip.behaviour.upper(), clip.arm.upper(), len(clip.rotvecs)
+        behaviour, arm, frames = clip.behaviour, clip.arm, len(clip.rotvecs)
         outputs = [spaces.description_joint_positions(describe(method.generate(behaviour, arm, clip.attributes,
                                                                                frames, seed=seed)))
                    for seed in seeds]
         first, again = (method.generate(behaviour, arm, clip.attributes, frames) for _ in range(2))
-        rows.append({"name": clip.name, "behaviour": behaviour.lower(), "variation": bm.variation(outputs),
+        rows.append({"name": clip.name, "behaviour": behaviours.key(behaviour), "variation": bm.variation(outputs),
                      "deterministic": bool(np.array_equal(first, again))})
     return rows
 
@@ -116,7 +116,7 @@ def pointing_sweep(method, arm, targets, frames, describe, exact_aim=False):
     angles, holds = [], []
     for target in targets:
         direction = spaces.pointing_direction(arm, target)
-        rotvecs = _answer(method, "POINT", arm, direction, frames, target, exact_aim)
+        rotvecs = _answer(method, behaviours.POINT, arm, direction, frames, target, exact_aim)
         descriptions = describe(rotvecs)
         measures = bm.point_measures(spaces.description_joint_positions(descriptions),
                                      bm.finger_direction(descriptions, arm), arm, target)
@@ -129,7 +129,7 @@ def pointing_sweep(method, arm, targets, frames, describe, exact_aim=False):
 def exaggeration_sweep(method, arm, frames, describe, exaggerations=EXAGGERATIONS):
     """Wave measures at each exaggeration, and whether the swing rises strictly with it."""
     measures = [bm.wave_measures(spaces.description_joint_positions(
-        describe(method.generate("WAVE", arm, e, frames))), arm) for e in exaggerations]
+        describe(method.generate(behaviours.WAVE, arm, e, frames))), arm) for e in exaggerations]
     swings = [m["swing"] for m in measures]
     return {"exaggerations": list(exaggerations), "swing": swings, "cycles": [m["cycles"] for m in measures],
             "frequency": [m["frequency"] for m in measures],
@@ -152,7 +152,7 @@ def summarise(rows):
                 entry[key] = float(values(key).mean())
         for key in ("elevation_first_error", "elevation_last_error"):
             entry[f"{key}_median"], entry[f"{key}_max"] = float(np.median(values(key))), float(values(key).max())
-        if behaviour == "wave":
+        if behaviour == behaviours.key(behaviours.WAVE):
             for key in ("swing_ratio", "frequency_ratio", "hand_height_ratio"):
                 entry[f"{key}_median"] = float(np.nanmedian(values(key)))
             entry["swing_ratio_min"], entry["swing_ratio_max"] = (float(values("swing_ratio").min()),

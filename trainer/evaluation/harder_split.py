@@ -12,7 +12,7 @@ played twice as fast.
 """
 import numpy as np
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import behaviours, skeleton, spaces
 from trainer.evaluation.baselines import time_warp
 from trainer.motion import library_plan
 from trainer.motion.clip import MotionClip
@@ -60,17 +60,18 @@ def harder_clips(seed=SEED):
     for arm in skeleton.ARMS:
         for k in range(POINTS_PER_ARM):
             target = outside_target(rng, arm, ("azimuth", "elevation", "distance")[k % 3])
-            specs.append(GestureSpec("POINT", arm, target=tuple(float(v) for v in target),
+            specs.append(GestureSpec(behaviours.POINT, arm, target=tuple(float(v) for v in target),
                                      seed=int(rng.integers(2**31 - 1))))
         for exaggeration in np.linspace(0.0, 1.0, WAVES_PER_ARM):
-            specs.append(GestureSpec("WAVE", arm, exaggeration=float(exaggeration), seed=int(rng.integers(2**31 - 1))))
+            specs.append(GestureSpec(behaviours.WAVE, arm, exaggeration=float(exaggeration),
+                                     seed=int(rng.integers(2**31 - 1))))
     clips = []
     for k, spec in enumerate(specs):
         rotvecs = synthesise(spec).action_rotvecs()
         scale = LENGTH_SCALES[k % len(LENGTH_SCALES)]
-        point = spec.behaviour == "POINT"
+        point = spec.behaviour == behaviours.POINT
         clips.append(MotionClip(
-            name=f"harder_{spec.behaviour.lower()}_{spec.arm.lower()}_{k:02d}_x{scale:g}", source="synthesised",
+            name=f"harder_{behaviours.key(spec.behaviour)}_{spec.arm.lower()}_{k:02d}_x{scale:g}", source="synthesised",
             fps=float(FPS), rotvecs=time_warp(rotvecs, max(2, int(round(scale * len(rotvecs))))),
             behaviour=spec.behaviour, arm=spec.arm,
             attributes=spaces.pointing_direction(spec.arm, spec.target) if point else spec.exaggeration,

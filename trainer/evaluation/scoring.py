@@ -11,7 +11,7 @@ and extremes of `evaluation.behaviour.summarise`.
 """
 import numpy as np
 
-from rlanimate_addon.core import behaviour_metrics, metrics, spaces
+from rlanimate_addon.core import behaviour_metrics, behaviours, metrics, spaces
 
 from trainer.agent.algorithm import clip_objective, rollout_actions
 from trainer.evaluation.behaviour import clip_target, summarise
@@ -20,10 +20,9 @@ SEEN_CLIP_COUNT = 10
 
 
 def select_clips(clips, behaviour, count=None):
-    """The clips of `behaviour` ('point', 'wave' or 'both'); with `count`, that many spread evenly
-    over them (the paper's 10 training clips), balanced between behaviours for 'both'."""
-    wanted = ("POINT", "WAVE") if behaviour == "both" else (behaviour.upper(),)
-    groups = [[c for c in clips if c.behaviour.upper() == name] for name in wanted]
+    """The clips of the training set `behaviour` ('point', 'wave' or 'both'); with `count`, that many spread
+    evenly over them (the paper's 10 training clips), balanced between behaviours for 'both'."""
+    groups = [[c for c in clips if c.behaviour == name] for name in behaviours.training_set(behaviour)]
     if count is None:
         return [c for group in groups for c in group]
     chosen = []
@@ -62,19 +61,19 @@ def score_motions(env, motions, clips, references):
 def clip_row(clip, generated, reference):
     """One clip's figures from generated and reference descriptions (F, 42): name, behaviour, score,
     smoothness, aligned_score and the behaviour measures (pointing ones only when the clip has a target)."""
-    behaviour = clip.behaviour.upper()
+    behaviour = clip.behaviour
     positions = spaces.description_joint_positions(generated)
     reference_positions = spaces.description_joint_positions(reference)
-    row = {"name": getattr(clip, "name", ""), "behaviour": behaviour.lower(),
+    row = {"name": getattr(clip, "name", ""), "behaviour": behaviours.key(behaviour),
            "score": float(metrics.score(positions, reference_positions)),
            "smoothness": float(metrics.smoothness(positions)),
            "aligned_score": behaviour_metrics.aligned_score(positions, reference_positions)}
     target = clip_target(clip)
-    if behaviour == "WAVE" or target is not None:
-        row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm.upper(), target))
+    if behaviour == behaviours.WAVE or target is not None:
+        row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm, target))
     else:  # a pointing clip without a target (real capture): its elevation only
         row.update({f"elevation_{k}": v for k, v in behaviour_metrics.raise_lower(
-            positions, reference_positions, clip.arm.upper()).items()})
+            positions, reference_positions, clip.arm).items()})
     return row
 
 
@@ -104,15 +103,15 @@ def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.
     agent.eval()
     average = {}
     for clip in training_clips:
-        average.setdefault(clip.behaviour.lower(), []).append(len(clip.rotvecs))
+        average.setdefault(clip.behaviour, []).append(len(clip.rotvecs))
     result = {}
-    for behaviour in sorted({c.behaviour.lower() for c in clips}):
-        group = [c for c in clips if c.behaviour.lower() == behaviour]
+    for behaviour in sorted({c.behaviour for c in clips}):
+        group = [c for c in clips if c.behaviour == behaviour]
         mean_length = float(np.mean(average[behaviour]))
-        result[behaviour] = {}
+        smoothness = result[behaviours.key(behaviour)] = {}
         for scale in scales:
             frames = max(2, int(round(scale * mean_length)))
             generated = generate_descriptions(agent, env, [objective(c, frames) for c in group], bounds)
-            result[behaviour][f"{scale:g}"] = float(np.mean([metrics.smoothness(spaces.description_joint_positions(d))
+            smoothness[f"{scale:g}"] = float(np.mean([metrics.smoothness(spaces.description_joint_positions(d))
                                                              for d in generated]))
     return result

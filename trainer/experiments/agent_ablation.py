@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import kinematics
+from rlanimate_addon.core import behaviours, kinematics
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
@@ -61,19 +61,20 @@ def measure(path, behaviour_name, session, target_count):
     """The behaviour measures of the agent at `path` on the held-out requests of its behaviour."""
     method = AgentMethod(path)
     lengths = behaviour.class_lengths(session.train_clips)
-    clips = [c for c in session.test_clips if c.behaviour.lower() == behaviour_name]
+    clips = [c for c in session.test_clips if c.behaviour in behaviours.training_set(behaviour_name)]
     rows = behaviour.request_rows(method, clips, session.references, describe, lengths)
     result = {"held_out": behaviour.summarise(rows)[behaviour_name],
               "update_steps": method.agent.metadata["train_config"]["update_steps"]}
     if behaviour_name == "wave":
         result["seeded"] = behaviour.summarise(sum((behaviour.request_rows(
             method, clips, session.references, describe, lengths, seed=seed) for seed in SEEDS), []))["wave"]
-        result["sweep"] = {arm.lower(): behaviour.exaggeration_sweep(method, arm, lengths["WAVE"], describe)
+        result["sweep"] = {arm.lower(): behaviour.exaggeration_sweep(method, arm, lengths[behaviours.WAVE], describe)
                            for arm in ("LEFT", "RIGHT")}
         result["variation"] = float(np.median([r["variation"] for r in behaviour.seed_variation(
             method, clips, describe, SEEDS)]))
     else:
-        result["random_targets"] = behaviour.random_target_sweeps(method, lengths["POINT"], describe, target_count)
+        result["random_targets"] = behaviour.random_target_sweeps(method, lengths[behaviours.POINT], describe,
+                                                                  target_count)
     return result
 
 

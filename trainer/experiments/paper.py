@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import metrics
+from rlanimate_addon.core import behaviours, metrics
 from trainer.agent import checkpoint
 from trainer.agent.config import load_preset
 from trainer.agent.models import VARIANTS, RLAnimateAgent
@@ -29,7 +29,7 @@ from trainer.reporting.table4 import table4_markdown
 
 COLUMNS = tuple(plots.COLUMN_LABELS)  # wave, point, both
 #: The paper's training lengths (Figure 3): 50 epochs for one behaviour, 100 for both.
-PAPER_EPOCHS = {"point": 50, "wave": 50, "both": 100}
+PAPER_EPOCHS = {column: 50 * len(behaviours.training_set(column)) for column in COLUMNS}
 #: Random unseen pointing targets per arm at which every pointing agent's own aim is measured.
 RANDOM_TARGETS = 100
 LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
@@ -111,10 +111,6 @@ def finished_runs(settings):
             for c in settings.columns if is_finished(run_folder(settings, s, v, c), planned_epochs(settings, c))}
 
 
-def column_behaviours(column):
-    return ("WAVE", "POINT") if column == "both" else (column.upper(),)
-
-
 def evaluate_runs(settings, runs, session):
     """{split: {column: {method: [behaviour.summarise of each seed]}}}: every finished run's agent (its
     agent.npz, numpy runtime) and each baseline on the held-out clips and the harder split; an agent trained
@@ -132,7 +128,7 @@ def evaluate_runs(settings, runs, session):
     results = {}
     for split, clips in splits.items():
         for column in settings.columns:
-            wanted = [c for c in clips if c.behaviour.upper() in column_behaviours(column)]
+            wanted = [c for c in clips if c.behaviour in behaviours.training_set(column)]
             entry = results.setdefault(split, {}).setdefault(column, {})
             for (seed, variant, run_column), folder in sorted(runs.items()):
                 if run_column == column:
@@ -146,10 +142,10 @@ def random_target_aim(settings, runs, session):
     """{column: {variant: [per seed: {'left', 'right': {'median', 'max'}}]}}: each pointing agent's own aim
     (no aim correction, degrees at the hold) at RANDOM_TARGETS random unseen targets per arm, at the
     class-average pointing length."""
-    frames = behaviour.class_lengths(session.train_clips)["POINT"]
+    frames = behaviour.class_lengths(session.train_clips)[behaviours.POINT]
     results = {}
     for (seed, variant, column), folder in sorted(runs.items()):
-        if "POINT" in column_behaviours(column):
+        if behaviours.POINT in behaviours.training_set(column):
             sweeps = behaviour.random_target_sweeps(AgentMethod(folder / "agent.npz"), frames, session.describe,
                                                      RANDOM_TARGETS)
             results.setdefault(column, {}).setdefault(variant, []).append(
@@ -214,11 +210,11 @@ def load_trained_agent(folder):
 
 def write_length_flexibility(settings, results, session):
     """Section 4.4 for the first seed's RLAnimate both-behaviour agent on the held-out clips."""
-    folder = run_folder(settings, settings.seeds[0], "rlanimate", "both")
-    if not is_finished(folder, planned_epochs(settings, "both")):
+    folder = run_folder(settings, settings.seeds[0], "rlanimate", behaviours.BOTH)
+    if not is_finished(folder, planned_epochs(settings, behaviours.BOTH)):
         return None
     agent = load_trained_agent(folder)
-    test = scoring.select_clips(session.test_clips, "both")
+    test = scoring.select_clips(session.test_clips, behaviours.BOTH)
     flexibility = scoring.length_flexibility(agent, session.env, test, session.train_clips, LENGTH_SCALES)
     atomic_write_text(results / "length_flexibility.json", json.dumps(flexibility, indent=2) + "\n")
     plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)

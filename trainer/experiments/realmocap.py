@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import skeleton
+from rlanimate_addon.core import behaviours, skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
 from trainer.blender_io.clip_import import import_clip
@@ -53,7 +53,7 @@ def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache"):
     """
     info = parse_name(path)
     clip = relaxed_hand(import_clip(path, cache_dir=cache_dir))
-    autolabel.label_clip(clip, "POINT" if info["content"] == "guide" else "WAVE")
+    autolabel.label_clip(clip, behaviours.POINT if info["content"] == "guide" else behaviours.WAVE)
     clip.content, clip.style, clip.take, clip.named_arm = info["content"], info["style"], info["take"], info["arm"]
     return clip
 
@@ -123,7 +123,7 @@ def compare(methods, clips, env, references):
     for name, method in methods.items():
         motions = baselines.generate_for(method, clips)
         result = scoring.score_motions(env, motions, clips, references)
-        if all(c.behaviour == "WAVE" for c in clips):
+        if all(c.behaviour == behaviours.WAVE for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
                                                    for m, c in zip(motions, clips)]))
         results[name] = result
@@ -151,16 +151,18 @@ def point_agent_and_library(point_agent, runs, epochs, seed):
     `point_agent` None: the add-on's installed default agent when it is trained, else a point agent
     trained here on the sample library (runs/realmocap/sample_point/)."""
     library = LibrarySession(DEFAULT_MANIFEST)
-    clips = [c for c in library.train_clips if c.behaviour == "POINT"]
+    clips = [c for c in library.train_clips if c.behaviour == behaviours.POINT]
     if point_agent is None:
         try:
             installed = baselines.AgentMethod(INSTALLED_AGENT)
             training = installed.agent.metadata.get("training", {})
-            if not training.get("untrained") and training.get("behaviour") in ("point", "both"):
+            trained = behaviours.TRAINING_SETS.get(training.get("behaviour"), ())
+            if not training.get("untrained") and behaviours.POINT in trained:
                 return installed, clips
         except RLAnimateError as error:
             print(f"realmocap: not using the installed agent: {error}", file=sys.stderr)
-        return train_agent(library, "sample_point", "point", epochs, "default", seed, runs)[1], clips
+        return train_agent(library, "sample_point", behaviours.key(behaviours.POINT), epochs, "default", seed,
+                           runs)[1], clips
     return baselines.AgentMethod(point_agent), clips
 
 
@@ -206,7 +208,7 @@ def run_experiments(settings):
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
     for name, (train_clips, test_clips) in experiments.items():
         session = RealSession(env, references, train_clips, test_clips)
-        agents = {seed: train_agent(session, name, "wave", settings.epochs, settings.preset, seed,
+        agents = {seed: train_agent(session, name, behaviours.key(behaviours.WAVE), settings.epochs, settings.preset, seed,
                                     seed_folder(settings.runs, seed)) for seed in seeds}
         report, agent = agents[seeds[0]]
         methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),

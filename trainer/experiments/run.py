@@ -14,6 +14,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
 from trainer.agent.agent_export import export_agent
@@ -35,7 +36,7 @@ class RunSettings:
     """What a run is. None means "not given": a new run takes the default below (`epochs`: the preset's,
     the paper's 50 for one behaviour and 100 for both), a resumed run its checkpoint's value."""
     output: str
-    behaviour: str = None  # "point", "wave" or "both"
+    behaviour: str = None  # the training set: "point", "wave" or "both" (core.behaviours.TRAINING_SETS)
     clips: str = None  # the clip library's manifest.json (or its folder), recorded in the report
     epochs: int = None  # iterations of Algorithm 1
     seed: int = None
@@ -49,7 +50,7 @@ class RunSettings:
 
 #: Seed 2: of seeds 0-3 of the default preset (T = 120 updates an epoch), the one whose agent meets issue
 #: 10's bounds with the most room; the shipped agent is that run (docs/AGENT.md, "Fitting the budget").
-NEW_RUN_DEFAULTS = {"behaviour": "both", "clips": str(DEFAULT_MANIFEST), "seed": 2, "preset": "default",
+NEW_RUN_DEFAULTS = {"behaviour": behaviours.BOTH, "clips": str(DEFAULT_MANIFEST), "seed": 2, "preset": "default",
                     "variant": "rlanimate", "eval_every": 10}
 
 
@@ -151,7 +152,7 @@ def train(settings, session):
     saved = checkpoint.load(output / checkpoint.FILENAME) if settings.resume else None
     settings = _resolved(settings, saved)
     agent_config, train_config = load_preset(settings.preset)
-    epochs = settings.epochs or (train_config.epochs_both if settings.behaviour == "both"
+    epochs = settings.epochs or (train_config.epochs_both if settings.behaviour == behaviours.BOTH
                                  else train_config.epochs_single)
 
     seed_everything(settings.seed)
@@ -210,7 +211,7 @@ def _agent_metadata(report, trainer):
     lengths = {}
     for group in trainer.clip_groups:
         for clip in group:
-            lengths.setdefault(clip.behaviour.upper(), []).append(len(clip.rotvecs))
+            lengths.setdefault(clip.behaviour, []).append(len(clip.rotvecs))
     return {"training": {key: report[key] for key in ("behaviour", "variant", "preset", "seed", "clips",
                                                        "epochs", "episodes", "train_seconds")},
             "train_config": trainer.train_config,

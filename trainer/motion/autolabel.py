@@ -27,7 +27,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from rlanimate_addon.core import kinematics, skeleton, spaces
+from rlanimate_addon.core import behaviours, kinematics, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.motion import fk
 
@@ -144,18 +144,15 @@ def label_point(rotvecs, arm=None):
 
 
 def label_clip(clip, behaviour):
-    """Label an unlabelled MotionClip in place from its motion and return it: `behaviour` 'POINT' or
-    'WAVE' (the user says which; the arm and the attributes come from the motion). This is what an
-    `--autolabel` import or training path calls for a user's own clips."""
-    behaviour = behaviour.upper()
-    if behaviour == "WAVE":
+    """Label an unlabelled MotionClip in place from its motion and return it: `behaviour` point or wave,
+    either spelling (the user says which; the arm and the attributes come from the motion). This is what
+    an `--autolabel` import or training path calls for a user's own clips."""
+    if behaviours.parse(behaviour) == behaviours.WAVE:
         label = label_wave(clip.rotvecs, clip.fps)
-        clip.behaviour, clip.arm = "WAVE", label.arm
+        clip.behaviour, clip.arm = behaviours.WAVE, label.arm
         clip.exaggeration = clip.attributes = label.exaggeration
-    elif behaviour == "POINT":
-        label = label_point(clip.rotvecs)
-        clip.behaviour, clip.arm, clip.attributes = "POINT", label.arm, label.direction
     else:
-        raise RLAnimateError(f"Unknown behaviour {behaviour!r} to label clips with: use POINT or WAVE.")
+        label = label_point(clip.rotvecs)
+        clip.behaviour, clip.arm, clip.attributes = behaviours.POINT, label.arm, label.direction
     clip.label = label
     return clip

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import behaviours, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 
 
@@ -34,7 +34,7 @@ def labelled(clip, entry, manifest_path):
     """Attach a manifest entry's labels to `clip`; raises RLAnimateError for an unusable entry."""
     behaviour = str(entry.get("behaviour", "")).upper()
     arm = str(entry.get("arm", "")).upper()
-    if behaviour not in spaces.BEHAVIOURS or arm not in skeleton.ARMS:
+    if behaviour not in behaviours.BEHAVIOURS or arm not in skeleton.ARMS:
         raise RLAnimateError(f"{manifest_path}: entry {entry.get('file')!r} has behaviour {behaviour!r} and arm "
                              f"{arm!r}; use POINT or WAVE and LEFT or RIGHT.")
     frames = entry.get("frames")
@@ -42,7 +42,7 @@ def labelled(clip, entry, manifest_path):
         raise RLAnimateError(f"{clip.source}: the clip has {clip.frames} frames but the manifest says "
                              f"{frames}. Regenerate the clip library.")
     clip.behaviour, clip.arm, clip.split = behaviour, arm, entry.get("split")
-    if behaviour == "POINT":
+    if behaviour == behaviours.POINT:
         if entry.get("direction") is not None:
             direction = np.asarray(entry["direction"], dtype=np.float64)
             clip.attributes = direction / np.linalg.norm(direction)

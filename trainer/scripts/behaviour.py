@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import spaces
+from rlanimate_addon.core import behaviours, spaces
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
@@ -33,8 +33,8 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
                "nearest_clip": NearestClip(train), "procedural_ik": ProceduralIK(mean_start_pose(train))}
 
     lengths = behaviour.class_lengths(train)
-    waves = [c for c in test if c.behaviour.upper() == "WAVE"]
-    points = [c for c in test if c.behaviour.upper() == "POINT"]
+    waves = [c for c in test if c.behaviour == behaviours.WAVE]
+    points = [c for c in test if c.behaviour == behaviours.POINT]
     sets, clips = {"wave": {}, "point": {}, "point_exact_aim": {}}, {}
     for name, method in methods.items():
         rows = behaviour.request_rows(method, waves + points, session.references, session.describe, lengths)
@@ -44,10 +44,10 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
         sets["point_exact_aim"][name] = summary_aimed["point"]
         clips[name] = rows
 
-    own, exact = (behaviour.random_target_sweeps(agent, lengths["POINT"], session.describe, target_count,
+    own, exact = (behaviour.random_target_sweeps(agent, lengths[behaviours.POINT], session.describe, target_count,
                                                  exact_aim=exact_aim, seed=target_seed) for exact_aim in (False, True))
     random_targets = {arm: {"own": own[arm], "exact": exact[arm]} for arm in own}
-    sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths["WAVE"], session.describe)
+    sweeps = {arm.lower(): behaviour.exaggeration_sweep(agent, arm, lengths[behaviours.WAVE], session.describe)
               for arm in ("LEFT", "RIGHT")}
     seeded = {seed: behaviour.summarise(behaviour.request_rows(agent, waves + points, session.references,
                                                                session.describe, lengths, seed=seed))
@@ -58,11 +58,11 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
     for clip in waves:
         reference = spaces.description_joint_positions(session.references.get(clip)[0])
         answers = {label: spaces.description_joint_positions(session.describe(methods[key].generate(
-            "WAVE", clip.arm.upper(), clip.attributes, len(clip.rotvecs))))
+            behaviours.WAVE, clip.arm, clip.attributes, len(clip.rotvecs))))
             for key, label in (("rlanimate", "RLAnimate"), ("class_mean", "class mean"))}
         if seeds:
             answers[f"RLAnimate seed {seeds[0]}"] = spaces.description_joint_positions(session.describe(agent.generate(
-                "WAVE", clip.arm.upper(), clip.attributes, len(clip.rotvecs), seed=seeds[0])))
+                behaviours.WAVE, clip.arm, clip.attributes, len(clip.rotvecs), seed=seeds[0])))
         panels.append((f"{clip.name} (e = {float(np.ravel(clip.attributes)[0]):.2f})", clip.arm.upper(),
                        {"reference": reference, **answers}))
     Path(results_dir).mkdir(parents=True, exist_ok=True)

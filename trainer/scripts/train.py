@@ -12,7 +12,7 @@ from its checkpoint with the run's own settings; the continuation equals the uni
 import argparse
 from pathlib import Path
 
-from trainer.agent.algorithm import BEHAVIOUR_CHOICES
+from rlanimate_addon.core.behaviours import TRAINING_SETS
 from trainer.agent.models import VARIANTS
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
@@ -26,7 +26,7 @@ def build_parser():
     resumed run its checkpoint's values."""
     defaults = NEW_RUN_DEFAULTS
     parser = argparse.ArgumentParser(prog="trainer/train.py", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--behaviour", choices=BEHAVIOUR_CHOICES, help=f"default {defaults['behaviour']}")
+    parser.add_argument("--behaviour", choices=TRAINING_SETS, help=f"default {defaults['behaviour']}")
     parser.add_argument("--clips", help="clip library: a manifest.json or the folder that holds one "
                                         "(default sample_rigs/clips)")
     parser.add_argument("--epochs", type=int,

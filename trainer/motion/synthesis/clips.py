@@ -4,7 +4,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rlanimate_addon.core import skeleton, spaces
+from rlanimate_addon.core import behaviours, skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import matrix_to_rotvec
 
@@ -135,12 +135,12 @@ def _synthesise_wave(spec, style):
 
 def synthesise(spec):
     """GestureClip for a GestureSpec; raises RLAnimateError for an unusable spec."""
-    if spec.behaviour not in spaces.BEHAVIOURS:
+    if spec.behaviour not in behaviours.BEHAVIOURS:
         raise RLAnimateError(f"Unknown behaviour {spec.behaviour!r}: use POINT or WAVE.")
     if spec.arm not in skeleton.ARMS:
         raise RLAnimateError(f"Unknown arm {spec.arm!r}: use LEFT or RIGHT.")
     style = draw_style(spec.seed)
-    if spec.behaviour == "POINT":
+    if spec.behaviour == behaviours.POINT:
         if spec.target is None or np.shape(spec.target) != (3,):
             raise RLAnimateError("A pointing gesture needs a target (x, y, z) in the character frame.")
         return _synthesise_point(spec, style)
