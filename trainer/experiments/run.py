@@ -49,7 +49,8 @@ class RunSettings:
 
 
 #: Seed 2: of seeds 0-3 of the default preset (T = 120 updates an epoch), the one whose agent meets issue
-#: 10's bounds with the most room; the shipped agent is that run (docs/AGENT.md, "Fitting the budget").
+#: 10's bounds with the most room; the shipped agent is that run (docs/AGENT.md, "The budget and the shipped
+#: seed").
 NEW_RUN_DEFAULTS = {"behaviour": behaviours.BOTH, "clips": str(DEFAULT_MANIFEST), "seed": 2, "preset": "default",
                     "variant": "rlanimate", "eval_every": 10}
 
