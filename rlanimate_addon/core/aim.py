@@ -9,6 +9,7 @@ with its rotation vector scaled by a pointing-phase weight that ramps with minim
 the start of the stroke to 1 by its middle, and back to 0 over the return.
 """
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import kinematics, skeleton
 from .easing import minimum_jerk
@@ -23,7 +24,7 @@ PHASE_RAMP = (0.01, 0.5)
 MIN_RAMP_SHARE = 0.2
 
 
-def finger_lines(rotvecs, arm):
+def finger_lines(rotvecs: ArrayLike, arm: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Posed shoulder S, index base b and unit finger direction f, each (N, 3), and the Arm bone's
     armature-space pose rotation W (N, 3, 3), for canonical action-joint rotations (N, 15, 3)."""
     prefix = skeleton.ARM_PREFIX[arm]
@@ -37,7 +38,7 @@ def finger_lines(rotvecs, arm):
     return heads[:, arm_index], base, finger, pose[:, arm_index, :3, :3]
 
 
-def rotation_between(a, b):
+def rotation_between(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """(N, 3, 3) shortest rotations taking unit vectors a (N, 3) onto unit vectors b (N, 3)."""
     axis = np.cross(a, b)
     sin = np.linalg.norm(axis, axis=1)
@@ -46,7 +47,7 @@ def rotation_between(a, b):
     return rotvec_to_matrix(rotvec)
 
 
-def shoulder_corrections(shoulder, base, finger, targets):
+def shoulder_corrections(shoulder: ArrayLike, base: ArrayLike, finger: ArrayLike, targets: ArrayLike) -> np.ndarray:
     """(N, 3) armature-space rotation vectors about the shoulder that aim each finger line at its target.
 
     shoulder, base, targets: (N, 3) positions; finger: (N, 3) unit directions. In the arm's own frame
@@ -68,7 +69,7 @@ def _unit(vectors):
     return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
 
 
-def pointing_phase(base):
+def pointing_phase(base: ArrayLike) -> np.ndarray:
     """(N,) weight in [0, 1] for finger-base positions (N, 3): 0 at the first and last frames, 1 from
     the middle of the stroke to the middle of the return.
 
@@ -95,7 +96,7 @@ def pointing_phase(base):
     return weight
 
 
-def aim_at(rotvecs, arm, targets, weights=None):
+def aim_at(rotvecs: ArrayLike, arm: str, targets: ArrayLike, weights: ArrayLike | None = None) -> np.ndarray:
     """Canonical action-joint rotations (N, 15, 3) with the pointing Arm bone turned towards targets.
 
     targets: (N, 3) or (3,) positions on the canonical skeleton. weights: (N,) in [0, 1], the share of

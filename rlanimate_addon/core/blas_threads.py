@@ -8,7 +8,7 @@ busy processes a 120-frame rollout took a median 0.9 s, against 47 ms on one thr
 threadpoolctl, which the extension bundles as a wheel, caps BLAS at one thread for the rollout and
 restores the user's setting afterwards. Where it is not installed, nothing is capped.
 """
-from contextlib import nullcontext
+from contextlib import AbstractContextManager, nullcontext
 from functools import lru_cache
 
 
@@ -22,7 +22,7 @@ def _controller():
     return ThreadpoolController()
 
 
-def single_blas_thread():
+def single_blas_thread() -> AbstractContextManager:
     """A context manager in which numpy's BLAS uses one thread."""
     controller = _controller()
     return nullcontext() if controller is None else controller.limit(limits=1, user_api="blas")

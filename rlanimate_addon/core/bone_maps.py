@@ -10,6 +10,7 @@ A BoneMap names, for one source skeleton:
                   neutrally (the Bandai Namco capture: its zero-rotation pose is a straight line).
 """
 from collections import namedtuple
+from collections.abc import Iterable, Sequence
 
 from . import skeleton
 
@@ -38,12 +39,12 @@ BONE_MAPS = (MIXAMO, BANDAI_NAMCO)
 CLIP_BONES = tuple(j for j in skeleton.ACTION_JOINTS if "HandIndex" not in j)
 
 
-def source_key(bone_name):
+def source_key(bone_name: str) -> str:
     """A source bone's name without its namespace prefix: 'mixamorig1:LeftArm' -> 'LeftArm'."""
     return bone_name.rsplit(":", 1)[-1]
 
 
-def match_bones(source_names, bone_map):
+def match_bones(source_names: Iterable[str], bone_map: BoneMap) -> dict[str, str]:
     """{canonical name: source bone name} for the source bones that `bone_map` knows."""
     matched = {}
     for name in source_names:
@@ -53,7 +54,7 @@ def match_bones(source_names, bone_map):
     return matched
 
 
-def missing_bones(source_names, bone_map, required=CLIP_BONES):
+def missing_bones(source_names: Iterable[str], bone_map: BoneMap, required: Sequence[str] = CLIP_BONES) -> list[str]:
     """Source-side names of the bones `bone_map` needs for `required` that `source_names` lacks."""
     present = match_bones(source_names, bone_map)
     wanted = [c for c in required if c not in bone_map.shared_bend]
@@ -61,6 +62,6 @@ def missing_bones(source_names, bone_map, required=CLIP_BONES):
     return [from_canonical[c] for c in wanted if c not in present]
 
 
-def best_bone_map(source_names, maps=BONE_MAPS):
+def best_bone_map(source_names: Iterable[str], maps: Sequence[BoneMap] = BONE_MAPS) -> BoneMap:
     """The map that recognises the most of `source_names` (ties go to the earlier map)."""
     return max(maps, key=lambda m: (len(match_bones(source_names, m)), -maps.index(m)))

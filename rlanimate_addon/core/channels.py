@@ -5,6 +5,7 @@ Blender's NLA Combine blends each channel by its kind: quaternions multiply
 keys the difference from the rotation underneath, and a Replace layer the rotation itself.
 """
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .rotations import matrix_to_euler, matrix_to_quat, quat_to_axis_angle, quat_to_matrix  # noqa: F401
 
@@ -26,7 +27,8 @@ def _continuous(quats):
     return quats * np.concatenate([[1.0], np.cumprod(steps)])[:, None]
 
 
-def rotation_keys(mode, keyed, below, below_values, blend_type):
+def rotation_keys(mode: str, keyed: ArrayLike, below: ArrayLike, below_values: ArrayLike,
+                  blend_type: str) -> np.ndarray:
     """(N, C) values for a bone's rotation channels: 4 for QUATERNION and AXIS_ANGLE, 3 for Euler orders.
 
     keyed: (N, 4) the rotation the bone must have; below: (N, 4) the rotation underneath, and

@@ -7,16 +7,17 @@ Blender plays. Keys are added greedily where the played rotation strays furthest
 one, until it stays within the tolerance on every frame; all channels of a bone share their keys.
 """
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .rotations import euler_to_matrix, quat_to_matrix, rotvec_to_matrix
 
 
-def slopes(values):
+def slopes(values: np.ndarray) -> np.ndarray:
     """(N, C) per-frame slopes of (N, C) values: central differences, one-sided at the ends."""
     return np.gradient(np.asarray(values, dtype=np.float64), axis=0)
 
 
-def hermite(values, tangents, keys):
+def hermite(values: np.ndarray, tangents: np.ndarray, keys: np.ndarray) -> np.ndarray:
     """(N, C) values played between the keys (sorted frame indices into values (N, C)), with handles a
     third of the way to the neighbouring keys along the slopes `tangents` (N, C)."""
     values = np.asarray(values, dtype=np.float64)
@@ -30,7 +31,7 @@ def hermite(values, tangents, keys):
     return out
 
 
-def rotation_matrices(mode, values):
+def rotation_matrices(mode: str, values: np.ndarray) -> np.ndarray:
     """(N, 3, 3) rotations that Blender plays from (N, C) channel values in a rotation mode."""
     values = np.asarray(values, dtype=np.float64)
     if mode == "QUATERNION":
@@ -41,13 +42,14 @@ def rotation_matrices(mode, values):
     return euler_to_matrix(values, mode)
 
 
-def angles_between(a, b):
+def angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(N,) degrees between (N, 3, 3) rotations a and b."""
     cos = (np.trace(np.swapaxes(a, -1, -2) @ b, axis1=-2, axis2=-1) - 1.0) / 2.0
     return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
 
 
-def reduce_keys(mode, values, tolerance_deg, offset=None):
+def reduce_keys(mode: str, values: ArrayLike, tolerance_deg: float,
+                offset: ArrayLike | None = None) -> tuple[np.ndarray, float]:
     """(kept frame indices (K,), worst deviation in degrees) for one bone's (N, C) rotation channels.
 
     offset: (N, C) values the channels are added to when played (an Euler or axis-angle Combine layer

@@ -4,7 +4,10 @@ The environment the agent learns in is real Blender (trainer/blender_io/fk_env.p
 pose evaluation (pose = parent_pose @ parent_rest^-1 @ rest @ basis) so that bpy-free code, such as
 the clip generator's inverse kinematics, can predict what Blender will show.
 """
+from collections.abc import Collection, Mapping
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import skeleton, spaces
 from .rotations import rotvec_to_matrix
@@ -16,11 +19,11 @@ _REST = skeleton.rest_matrices()
 _REST_LOCAL = np.array([_REST[i] if p < 0 else np.linalg.inv(_REST[p]) @ _REST[i] for i, p in enumerate(_PARENT)])
 
 
-def bone_index(name):
+def bone_index(name: str) -> int:
     return _INDEX[name]
 
 
-def pose_matrices(local_rotvecs, only=None):
+def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] | None = None) -> np.ndarray:
     """Armature-space pose matrices (..., B, 4, 4) from {bone name: (..., 3) local rotation vector}.
 
     Bones not named keep their rest rotation. Every value must share one batch shape. only: bone
@@ -52,7 +55,7 @@ def _with_ancestors(names):
     return sorted(indices)
 
 
-def head_positions(pose):
+def head_positions(pose: np.ndarray) -> np.ndarray:
     """(..., B, 4, 4) pose matrices -> (..., B, 3) bone head positions."""
     return pose[..., :3, 3]
 
@@ -61,7 +64,7 @@ _DESCRIBED = tuple(sorted({b for _, b in skeleton.DESCRIPTION_JOINTS}
                           | {b for _, start, end in skeleton.EFFECTORS for b in (start, end) if b}))
 
 
-def describe(action_rotvecs):
+def describe(action_rotvecs: ArrayLike) -> np.ndarray:
     """(..., 42) descriptions (spaces.describe) of the canonical skeleton posed by action-joint
     rotations (..., 15, 3): what the Blender environment reports, without Blender."""
     rotvecs = np.asarray(action_rotvecs, dtype=np.float64)

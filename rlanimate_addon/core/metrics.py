@@ -14,6 +14,7 @@ the high-frequency residual that a Savitzky-Golay filter removes, relative to th
 (its joints' path length), so it does not depend on the character's size or the gesture's extent.
 """
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import RLAnimateError
 
@@ -38,7 +39,7 @@ def _check_sequence(positions, name):
     return p
 
 
-def frame_errors(generated, reference):
+def frame_errors(generated: ArrayLike, reference: ArrayLike) -> np.ndarray:
     """(F,) per-frame error: the sum over joints of |dx| + |dy| + |dz|, in metres."""
     gen = _check_sequence(generated, "The generated clip")
     ref = _check_sequence(reference, "The reference clip")
@@ -48,21 +49,21 @@ def frame_errors(generated, reference):
     return np.abs(gen - ref).sum(axis=(1, 2))
 
 
-def frame_penalties(errors):
+def frame_penalties(errors: ArrayLike) -> np.ndarray:
     """(F,) the paper's penalty max(0, log_1.01 error_t): zero for errors of 1 m or less."""
     e = np.asarray(errors, dtype=np.float64)
     over = np.maximum(e, 1.0)  # log of anything <= 1 is <= 0, which the max clips to 0
     return np.log(over) / np.log(PENALTY_BASE)
 
 
-def score(generated, reference):
+def score(generated: ArrayLike, reference: ArrayLike) -> float:
     """The paper's score out of 100 (it can go negative for very poor imitations)."""
     errors = frame_errors(generated, reference)
     total_error = errors.sum() + frame_penalties(errors).sum()
     return float(100.0 - total_error / len(errors))
 
 
-def savgol_coefficients(window=SMOOTHING_WINDOW, order=SMOOTHING_ORDER):
+def savgol_coefficients(window: int = SMOOTHING_WINDOW, order: int = SMOOTHING_ORDER) -> np.ndarray:
     """(window, window) least-squares projection: row k evaluates at offset k the polynomial of
     degree `order` fitted to `window` equally spaced samples."""
     if window % 2 == 0 or order >= window:
@@ -72,7 +73,7 @@ def savgol_coefficients(window=SMOOTHING_WINDOW, order=SMOOTHING_ORDER):
     return basis @ np.linalg.pinv(basis)  # (W, W)
 
 
-def savgol_smooth(values, window=SMOOTHING_WINDOW, order=SMOOTHING_ORDER):
+def savgol_smooth(values: ArrayLike, window: int = SMOOTHING_WINDOW, order: int = SMOOTHING_ORDER) -> np.ndarray:
     """Savitzky-Golay smoothing along axis 0 of (F, ...) values.
 
     Equals scipy.signal.savgol_filter(values, window, order, axis=0) in its default 'interp' mode:
@@ -95,7 +96,7 @@ def savgol_smooth(values, window=SMOOTHING_WINDOW, order=SMOOTHING_ORDER):
     return smoothed.reshape(x.shape)
 
 
-def roughness(positions):
+def roughness(positions: ArrayLike) -> float:
     """High-frequency residual relative to the motion: sum|p - savgol(p)| / path length (both in metres)."""
     p = _check_sequence(positions, "The clip")
     residual = np.linalg.norm(p - savgol_smooth(p), axis=-1).sum()
@@ -105,6 +106,6 @@ def roughness(positions):
     return float(residual / path_length)
 
 
-def smoothness(positions):
+def smoothness(positions: ArrayLike) -> float:
     """Smoothness out of 100 of a (F, J, 3) joint-position sequence; below 98.5 artefacts show."""
     return float(np.clip(100.0 * (1.0 - SMOOTHNESS_GAIN * roughness(positions)), 0.0, 100.0))

@@ -14,6 +14,7 @@ proportionally longer). During training the task module reads these from each cl
 nearby exaggeration: their kernel-weighted mean for `seed=None`, one of them (by weight) at any phase
 for a seed, so seeds vary the phase, rate and number of swings within what the training waves do.
 """
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -36,11 +37,11 @@ class Rhythm:
     phase: float  # radians, at `start`
     ramp: float  # frames over which the envelope rises and falls
 
-    def to_dict(self):
+    def to_dict(self) -> dict:
         return asdict(self)
 
 
-def signals(rhythm, frame_count):
+def signals(rhythm: "Rhythm", frame_count: int) -> np.ndarray:
     """(N, 2) [A_t sin(phi_t), A_t cos(phi_t)] of `rhythm` over a gesture of `frame_count` frames."""
     t = np.arange(int(frame_count), dtype=np.float64)
     span = max(int(frame_count) - 1, 1)
@@ -67,7 +68,7 @@ class RhythmModel:
         self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
 
     @classmethod
-    def fit(cls, exaggerations, rhythms):
+    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm]) -> "RhythmModel":
         """From the training clips' exaggerations (K,) and their Rhythms (K)."""
         if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
@@ -76,12 +77,12 @@ class RhythmModel:
         phase = float(np.angle(np.mean(np.exp(1j * np.array([r.phase for r in rhythms])))))
         return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])))
 
-    def to_dict(self):
+    def to_dict(self) -> dict:
         return {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
                 "bandwidth": self.bandwidth}
 
     @classmethod
-    def from_dict(cls, values):
+    def from_dict(cls, values: dict) -> "RhythmModel":
         try:
             model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
                         float(values["ramp"]), float(values["bandwidth"]))
@@ -97,13 +98,13 @@ class RhythmModel:
                                  f"bandwidth): re-export the agent.")
         return model
 
-    def weights(self, exaggeration):
+    def weights(self, exaggeration: float) -> np.ndarray:
         """(K,) how much each training wave weighs in a request of this exaggeration (sum 1)."""
         squared = ((self.examples[:, 0] - float(exaggeration)) / self.bandwidth) ** 2
         kernel = np.exp(-0.5 * (squared - squared.min()))  # shifted, so that a far request still has weights
         return kernel / kernel.sum()
 
-    def draw(self, exaggeration, seed=None):
+    def draw(self, exaggeration: float, seed: int | None = None) -> Rhythm:
         """The Rhythm for a wave of this exaggeration: for seed None the kernel-weighted mean of the
         training waves' rhythms, else a seeded draw of one training wave's (by weight) at any phase."""
         weights = self.weights(exaggeration)

@@ -4,11 +4,12 @@ Quaternions are (w, x, y, z), Blender's order. Rotation vectors (exponential map
 with angle in [0, pi]. Every function takes arrays with any leading batch shape.
 """
 import numpy as np
+from numpy.typing import ArrayLike
 
 _SMALL = 1e-8
 
 
-def quat_to_rotvec(quat):
+def quat_to_rotvec(quat: ArrayLike) -> np.ndarray:
     """(..., 4) unit quaternions -> (..., 3) rotation vectors, on the short arc (angle <= pi)."""
     q = np.asarray(quat, dtype=np.float64)
     q = np.where(q[..., :1] < 0.0, -q, q)  # same rotation, w >= 0 gives angle <= pi
@@ -21,7 +22,7 @@ def quat_to_rotvec(quat):
     return xyz * scale[..., None]
 
 
-def rotvec_to_quat(rotvec):
+def rotvec_to_quat(rotvec: ArrayLike) -> np.ndarray:
     """(..., 3) rotation vectors -> (..., 4) unit quaternions with w >= 0."""
     r = np.asarray(rotvec, dtype=np.float64)
     angle = np.linalg.norm(r, axis=-1)
@@ -31,7 +32,7 @@ def rotvec_to_quat(rotvec):
     return np.concatenate([np.cos(half)[..., None], r * scale[..., None]], axis=-1)
 
 
-def quat_to_matrix(quat):
+def quat_to_matrix(quat: ArrayLike) -> np.ndarray:
     """(..., 4) quaternions -> (..., 3, 3) rotation matrices (columns are the rotated axes)."""
     q = np.asarray(quat, dtype=np.float64)
     q = q / np.linalg.norm(q, axis=-1, keepdims=True)
@@ -44,7 +45,7 @@ def quat_to_matrix(quat):
     return m.reshape(q.shape[:-1] + (3, 3))
 
 
-def matrix_to_quat(matrix):
+def matrix_to_quat(matrix: ArrayLike) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0 (Shepperd's method)."""
     m = np.asarray(matrix, dtype=np.float64)
     batch = m.shape[:-2]
@@ -80,12 +81,12 @@ def matrix_to_quat(matrix):
     return q.reshape(batch + (4,))
 
 
-def rotvec_to_matrix(rotvec):
+def rotvec_to_matrix(rotvec: ArrayLike) -> np.ndarray:
     """(..., 3) rotation vectors -> (..., 3, 3) rotation matrices."""
     return quat_to_matrix(rotvec_to_quat(rotvec))
 
 
-def matrix_to_rotvec(matrix):
+def matrix_to_rotvec(matrix: ArrayLike) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 3) rotation vectors."""
     return quat_to_rotvec(matrix_to_quat(matrix))
 
@@ -100,7 +101,7 @@ def _axis_matrix(axis, angle):
     return rotvec_to_matrix(rotvec)
 
 
-def euler_to_matrix(euler, order="XYZ"):
+def euler_to_matrix(euler: ArrayLike, order: str = "XYZ") -> np.ndarray:
     """(..., 3) Euler angles in Blender's convention -> (..., 3, 3): order 'XYZ' applies X first (Rz Ry Rx)."""
     e = np.asarray(euler, dtype=np.float64)
     m = np.broadcast_to(np.eye(3), e.shape[:-1] + (3, 3))
@@ -109,7 +110,7 @@ def euler_to_matrix(euler, order="XYZ"):
     return m
 
 
-def matrix_to_euler(matrix, order="XYZ", previous=None):
+def matrix_to_euler(matrix: ArrayLike, order: str = "XYZ", previous: ArrayLike | None = None) -> np.ndarray:
     """(N, 3, 3) rotations -> (N, 3) Euler angles (Blender's order convention, channels X, Y, Z).
 
     Each frame takes, of the two Euler triples of its rotation and their 2 pi turns, the one nearest
@@ -139,7 +140,7 @@ def matrix_to_euler(matrix, order="XYZ", previous=None):
     return out
 
 
-def quat_to_axis_angle(quat):
+def quat_to_axis_angle(quat: ArrayLike) -> np.ndarray:
     """(..., 4) quaternions -> (..., 4) Blender axis-angle (angle, x, y, z); continuous quaternions give
     continuous values (the angle runs up to 2 pi rather than flipping the axis)."""
     q = np.asarray(quat, dtype=np.float64)

@@ -14,13 +14,16 @@ the rollout runs on one BLAS thread (core/blas_threads.py).
                default_rng(seed), while a_t stays the Beta mean. Drawn once, the noise varies the
                gesture coherently; drawn afresh every frame (z_t or a_t) it only adds jitter.
 """
+from pathlib import Path
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import agent_file, behaviours, blas_threads, rhythm, spaces
 from .errors import RLAnimateError
 
 
-def load_agent(path):
+def load_agent(path: str | Path) -> "GestureAgent":
     """The validated agent file at `path` as a GestureAgent (RLAnimateError if it is unusable)."""
     weights, metadata = agent_file.load_agent_file(path)
     return GestureAgent(weights, metadata)
@@ -124,14 +127,14 @@ class GestureAgent:
         self._from_z = np.hstack([cell_z, animation_z])  # (Z, 3E + hidden)
         self._from_a = cell_a  # (A, 3E)
 
-    def wave_rhythm(self, exaggeration, frame_count, seed=None):
+    def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None) -> np.ndarray | None:
         """(N, 2) rhythm signals for a wave's objectives (spaces.make_objective), drawn as core/rhythm.py
         says (the training waves' mean for seed None), or None for an agent without a rhythm model."""
         if self.rhythm_model is None:
             return None
         return rhythm.signals(self.rhythm_model.draw(exaggeration, seed), frame_count)
 
-    def rollout(self, objectives, seed=None):
+    def rollout(self, objectives: ArrayLike, seed: int | None = None) -> np.ndarray:
         """Objectives (N, 7) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""
         objectives = np.asarray(objectives, dtype=np.float64)
         if objectives.ndim != 2 or objectives.shape[1] != spaces.OBJECTIVE_SIZE or len(objectives) == 0 \

@@ -115,7 +115,7 @@ ARMS = ("LEFT", "RIGHT")
 ARM_PREFIX = {"LEFT": "Left", "RIGHT": "Right"}
 
 
-def rest_frame(bone):
+def rest_frame(bone: Bone) -> np.ndarray:
     """(3, 3) rest rotation of a bone in armature space; columns are its local X, Y, Z axes."""
     y = np.subtract(bone.tail, bone.head)
     y = y / np.linalg.norm(y)
@@ -126,7 +126,7 @@ def rest_frame(bone):
     return np.stack([x, y, z], axis=1)
 
 
-def rest_matrices():
+def rest_matrices() -> np.ndarray:
     """(B, 4, 4) armature-space rest matrices of BONES, in BONES order."""
     mats = np.tile(np.eye(4), (len(BONES), 1, 1))
     for i, bone in enumerate(BONES):
@@ -135,11 +135,11 @@ def rest_matrices():
     return mats
 
 
-def shoulder_rest_position(arm):
+def shoulder_rest_position(arm: str) -> np.ndarray:
     """Rest position (3,) of the pointing arm's shoulder joint: where pointing vectors start."""
     return np.asarray(BONE_BY_NAME[ARM_PREFIX[arm] + "Arm"].head)
 
 
-def strip_prefix(name):
+def strip_prefix(name: str) -> str:
     """'mixamorig:LeftArm', 'mixamorig1:LeftArm' or 'LeftArm' -> 'LeftArm'."""
     return name.split(":", 1)[1] if ":" in name else name

@@ -17,7 +17,10 @@ Action a_t (45): the local rotations of skeleton.ACTION_JOINTS, 3 numbers each, 
 The character frame is the armature's object space with its scale removed: +X the character's left,
 -Y forward, +Z up, origin on the ground between the feet.
 """
+from collections.abc import Mapping
+
 import numpy as np
+from numpy.typing import ArrayLike
 
 from . import skeleton
 from .behaviours import BEHAVIOURS, POINT, WAVE
@@ -59,7 +62,7 @@ DEFAULT_ACTION_BOUNDS = np.array(
     [[-_joint_bound(j), _joint_bound(j)] for j in skeleton.ACTION_JOINTS for _ in range(3)])
 
 
-def check_request(behaviour, arm, frame_count):
+def check_request(behaviour: str, arm: str, frame_count: int) -> None:
     """RLAnimateError naming what no agent or baseline can answer: an unknown behaviour or arm, or under 2 frames."""
     if behaviour not in BEHAVIOURS:
         raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(BEHAVIOURS)}.")
@@ -69,7 +72,8 @@ def check_request(behaviour, arm, frame_count):
         raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}: set a longer length.")
 
 
-def make_objective(behaviour, arm, attributes, frame_count, rhythm=None):
+def make_objective(behaviour: str, arm: str, attributes: ArrayLike, frame_count: int,
+                   rhythm: ArrayLike | None = None) -> np.ndarray:
     """(N, 7) objectives for a gesture of `frame_count` frames.
 
     `attributes` is, for POINT, a unit vector (3,) or one per frame (N, 3), so a moving target is
@@ -104,7 +108,7 @@ def make_objective(behaviour, arm, attributes, frame_count, rhythm=None):
     return objective
 
 
-def pointing_direction(arm, target):
+def pointing_direction(arm: str, target: ArrayLike) -> np.ndarray:
     """Unit vector (3,) from the arm's rest shoulder joint to `target` (3,), both in the character frame."""
     offset = np.asarray(target, dtype=np.float64) - skeleton.shoulder_rest_position(arm)
     norm = np.linalg.norm(offset)
@@ -113,14 +117,14 @@ def pointing_direction(arm, target):
     return offset / norm
 
 
-def encode_action(rotvecs, bounds=DEFAULT_ACTION_BOUNDS):
+def encode_action(rotvecs: ArrayLike, bounds: np.ndarray = DEFAULT_ACTION_BOUNDS) -> np.ndarray:
     """(..., 15, 3) rotation vectors -> (..., 45) actions in [0, 1] (clipped to the bounds)."""
     flat = np.asarray(rotvecs, dtype=np.float64).reshape(np.shape(rotvecs)[:-2] + (ACTION_SIZE,))
     low, high = bounds[:, 0], bounds[:, 1]
     return np.clip((flat - low) / (high - low), 0.0, 1.0)
 
 
-def decode_action(action, bounds=DEFAULT_ACTION_BOUNDS):
+def decode_action(action: ArrayLike, bounds: np.ndarray = DEFAULT_ACTION_BOUNDS) -> np.ndarray:
     """(..., 45) actions in [0, 1] -> (..., 15, 3) rotation vectors in radians."""
     a = np.asarray(action, dtype=np.float64)
     low, high = bounds[:, 0], bounds[:, 1]
@@ -128,7 +132,7 @@ def decode_action(action, bounds=DEFAULT_ACTION_BOUNDS):
     return rot.reshape(a.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
 
 
-def describe(positions, eye_axes):
+def describe(positions: Mapping[str, ArrayLike], eye_axes: Mapping[str, ArrayLike]) -> np.ndarray:
     """Description (..., 42) from world data in the character frame.
 
     positions: mapping bone name -> (..., 3) head position in metres (DESCRIPTION_JOINTS, fingertips).
@@ -143,7 +147,7 @@ def describe(positions, eye_axes):
     return np.concatenate(vectors + joints, axis=-1)
 
 
-def description_joint_positions(description):
+def description_joint_positions(description: ArrayLike) -> np.ndarray:
     """(..., 42) descriptions -> (..., 10, 3) joint positions, the joints the paper's score compares."""
     d = np.asarray(description)
     return d[..., DESCRIPTION_POSITIONS].reshape(d.shape[:-1] + (len(skeleton.DESCRIPTION_JOINTS), 3))

@@ -15,16 +15,20 @@ the training clips start in.
 AgentMethod (an exported .npz, numpy runtime) and TrainedAgentMethod (a trainer's torch agent) put
 RLAnimate behind the same generate() interface, so all are scored by one code path.
 """
+from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rlanimate_addon.core import behaviours, rhythm, rotations, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
+from trainer.motion.clip import MotionClip
 
 
-def mean_start_pose(clips):
+def mean_start_pose(clips: Sequence[MotionClip]) -> np.ndarray:
     """(15, 3) start pose: the mean first frame of `clips` (they all start standing neutrally)."""
     if not clips:
         raise RLAnimateError("No training clips: a baseline needs at least one clip to start from.")
@@ -34,7 +38,7 @@ def mean_start_pose(clips):
     return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
 
 
-def time_warp(rotvecs, frame_count):
+def time_warp(rotvecs: ArrayLike, frame_count: int) -> np.ndarray:
     """(M, 15, 3) -> (frame_count, 15, 3), uniform time scaling with per-joint slerp, ends kept."""
     quats = rotations.rotvec_to_quat(np.asarray(rotvecs, dtype=np.float64))  # (M, 15, 4)
     position = np.linspace(0.0, len(quats) - 1, int(frame_count))
@@ -44,7 +48,7 @@ def time_warp(rotvecs, frame_count):
     return rotations.quat_to_rotvec(slerp(quats[low], quats[high], weight))
 
 
-def clips_of(clips, behaviour, arm, baseline):
+def clips_of(clips: Sequence[MotionClip], behaviour: str, arm: str, baseline: str) -> list[MotionClip]:
     """The clips of `behaviour` and `arm`; RLAnimateError naming the `baseline` that needs one when there are none."""
     group = [c for c in clips if c.behaviour == behaviour and c.arm == arm]
     if not group:
@@ -147,6 +151,6 @@ class AgentMethod:
         return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
 
 
-def generate_for(baseline, clips):
+def generate_for(baseline: Any, clips: Sequence[MotionClip]) -> list[np.ndarray]:
     """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
     return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs)) for c in clips]

@@ -118,7 +118,7 @@ def markdown(results, command):
     return "\n".join(lines) + "\n"
 
 
-def run_ablation(settings):
+def run_ablation(settings: AblationSettings) -> str:
     """Train the unfinished ablations of `settings` (all, or `only`), measure them, and write
     agent_ablation.json and .md into `settings.results`; returns the markdown."""
     torch.set_num_threads(1)

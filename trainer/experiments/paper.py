@@ -153,7 +153,7 @@ def random_target_aim(settings, runs, session):
     return results
 
 
-def aggregate(per_seed):
+def aggregate(per_seed: list[dict]) -> dict:
     """[summary per seed] -> {behaviour: {metric: {mean, sd, n}}}; sd 0 for one value, NaN values (a ratio
     to a zero reference) left out."""
     out = {}
@@ -184,9 +184,10 @@ def write_table_and_figures(settings, results, session):
         if seed == settings.seeds[0]:
             histories.setdefault(variant, {})[column] = history
     seeds = " ".join(str(s) for s in settings.seeds)
+    planned = len(settings.seeds) * len(settings.variants) * len(settings.columns)
     described = (f"Preset `{settings.preset}`, seeds {seeds}, epochs = {settings.epoch_scale:g} x the paper's "
                  f"(50 for one behaviour, 100 for both; an epoch is one iteration of Algorithm 1); "
-                 f"{len(runs)} of {len(settings.seeds) * len(settings.variants) * len(settings.columns)} runs finished. "
+                 f"{len(runs)} of {planned} runs finished. "
                  f"Regenerate: `nice -n 10 python -m trainer.scripts.experiments --preset {settings.preset} "
                  f"--epoch-scale {settings.epoch_scale:g} --seeds {seeds}`.")
     aim = {column: {variant: aggregate(per_seed) for variant, per_seed in variants.items()}
@@ -200,7 +201,7 @@ def write_table_and_figures(settings, results, session):
     return len(runs)
 
 
-def load_trained_agent(folder):
+def load_trained_agent(folder: Path) -> RLAnimateAgent:
     """The torch agent of a finished run, rebuilt from its checkpoint's own settings (preset and variant)."""
     saved = checkpoint.load(folder / checkpoint.FILENAME)
     agent = RLAnimateAgent(load_preset(saved["arguments"]["preset"])[0], saved["arguments"]["variant"])
@@ -221,7 +222,7 @@ def write_length_flexibility(settings, results, session):
     return flexibility
 
 
-def run_paper(settings):
+def run_paper(settings: PaperSettings) -> tuple[int, dict | None]:
     """Train what is unfinished (unless `skip_training`), then write Table 4, Figure 3 and length flexibility
     into `settings.results`; returns (finished runs, length flexibility or None)."""
     torch.set_num_threads(1)

@@ -183,7 +183,7 @@ class RealMocapSettings:
     results: str = str(RESULTS_DIR)  # where realmocap_frames.png goes
 
 
-def run_experiments(settings):
+def run_experiments(settings: RealMocapSettings) -> dict:
     """All experiments of `settings` (RealMocapSettings); returns the realmocap results dict."""
     torch.set_num_threads(1)
     new_empty_scene()
@@ -208,8 +208,8 @@ def run_experiments(settings):
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
     for name, (train_clips, test_clips) in experiments.items():
         session = RealSession(env, references, train_clips, test_clips)
-        agents = {seed: train_agent(session, name, behaviours.key(behaviours.WAVE), settings.epochs, settings.preset, seed,
-                                    seed_folder(settings.runs, seed)) for seed in seeds}
+        agents = {seed: train_agent(session, name, behaviours.key(behaviours.WAVE), settings.epochs, settings.preset,
+                                    seed, seed_folder(settings.runs, seed)) for seed in seeds}
         report, agent = agents[seeds[0]]
         methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
                    "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
@@ -249,7 +249,7 @@ def _method_rows(comparison):
     return {method: _summary(result) for method, result in comparison.items()}
 
 
-def baseline_sets(results):
+def baseline_sets(results: dict) -> dict:
     """The real-data section of baselines.json: {set: {method: {score, smoothness, clips}}}."""
     sets = {"waves, takes 009-010 (28)": _method_rows(results["wave"]["test"]),
             "goodbye waves, dataset 1 (14)": _method_rows(results["wave"]["bye"]),

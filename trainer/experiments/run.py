@@ -9,6 +9,7 @@ import json
 import random
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import torch
@@ -55,7 +56,7 @@ NEW_RUN_DEFAULTS = {"behaviour": behaviours.BOTH, "clips": str(DEFAULT_MANIFEST)
                     "variant": "rlanimate", "eval_every": 10}
 
 
-def resolve(settings):
+def resolve(settings: RunSettings) -> RunSettings:
     """`settings` with every None filled: from the run's checkpoint when resuming (RLAnimateError when a
     given value conflicts with the run's own), else from NEW_RUN_DEFAULTS. `epochs` stays None when not
     given to a new run (the preset decides)."""
@@ -64,7 +65,7 @@ def resolve(settings):
     return _resolved(settings, saved)
 
 
-def check_settings(settings):
+def check_settings(settings: RunSettings) -> None:
     """RLAnimateError naming every setting no run can use: called before any work is done."""
     problems = []
     if settings.epochs is not None and not (_is_count(settings.epochs) and settings.epochs >= 1):
@@ -110,7 +111,7 @@ def _resolved(settings, saved):
                    epochs=settings.epochs or saved_arguments["epochs"])
 
 
-def seed_everything(seed):
+def seed_everything(seed: int) -> None:
     random.seed(seed)
     np.random.seed(seed)
     torch.manual_seed(seed)
@@ -143,7 +144,7 @@ class MetricsLog:
             self.tensorboard.close()
 
 
-def train(settings, session):
+def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     """Train (or resume) the run `settings` describes on `session` (env, references, train_clips, test_clips,
     problems: trainer.blender_io.clip_session.LibrarySession of `resolve(settings).clips`, or the real-mocap
     one); returns (report dict, Trainer). report.json lists the clips the session skipped."""

@@ -8,11 +8,14 @@ built from: the same numbers without Blender, for fast tests and checks; tests/t
 test_fk_env.py shows they agree).
 """
 from collections import namedtuple
+from collections.abc import Mapping
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from rlanimate_addon.core import kinematics, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion.clip import MotionClip
 
 #: descriptions (P, 42), joint_positions (P, 10, 3) of skeleton.DESCRIPTION_JOINTS, bone_heads
 #: (P, n_bones, 3) in the environment's bone_names order; all in the character frame, metres.
@@ -21,7 +24,7 @@ FKResult = namedtuple("FKResult", "descriptions joint_positions bone_heads")
 _EYES = ("LeftEye", "RightEye")
 
 
-def pose_matrices(action_rotvecs, extra_rotvecs=None):
+def pose_matrices(action_rotvecs: ArrayLike, extra_rotvecs: Mapping[str, ArrayLike] | None = None) -> np.ndarray:
     """(..., B, 4, 4) canonical pose matrices (skeleton.BONE_NAMES order) of action rotations (..., 15, 3)
     and optional {bone name: (..., 3)} rotations of other bones; every other bone stays at rest."""
     rotvecs = np.asarray(action_rotvecs, dtype=np.float64)
@@ -30,7 +33,7 @@ def pose_matrices(action_rotvecs, extra_rotvecs=None):
     return kinematics.pose_matrices(local)
 
 
-def bone_heads(action_rotvecs, extra_rotvecs=None):
+def bone_heads(action_rotvecs: ArrayLike, extra_rotvecs: Mapping[str, ArrayLike] | None = None) -> np.ndarray:
     """(..., B, 3) head positions, skeleton.BONE_NAMES order, of the pose `pose_matrices` makes."""
     return kinematics.head_positions(pose_matrices(action_rotvecs, extra_rotvecs))
 
@@ -43,7 +46,7 @@ class FKEnvironmentBase:
     bone_names = ()
     _pose_names = ()
 
-    def evaluate(self, action_rotvecs, extra_rotvecs=None):
+    def evaluate(self, action_rotvecs: ArrayLike, extra_rotvecs: Mapping[str, ArrayLike] | None = None) -> FKResult:
         """FKResult for P poses.
 
         action_rotvecs: (P, 15, 3) local rotation vectors of skeleton.ACTION_JOINTS, relative to rest.
@@ -54,7 +57,7 @@ class FKEnvironmentBase:
         descriptions = spaces.describe(positions, eye_axes)
         return FKResult(descriptions, spaces.description_joint_positions(descriptions), heads)
 
-    def describe_actions(self, actions01, bounds=spaces.DEFAULT_ACTION_BOUNDS):
+    def describe_actions(self, actions01: ArrayLike, bounds: np.ndarray = spaces.DEFAULT_ACTION_BOUNDS) -> FKResult:
         """FKResult for (P, 45) actions in [0, 1], decoded with `bounds` (45, 2) by spaces.decode_action."""
         actions = np.asarray(actions01, dtype=np.float64)
         if actions.ndim != 2 or actions.shape[1] != spaces.ACTION_SIZE:
@@ -101,11 +104,11 @@ class NumpyFKEnvironment(FKEnvironmentBase):
 class ClipReferences:
     """FK of each clip's own motion (descriptions (F, 42), joint positions (F, 10, 3)), computed once."""
 
-    def __init__(self, env):
+    def __init__(self, env: FKEnvironmentBase):
         self.env = env
         self._cache = {}
 
-    def get(self, clip):
+    def get(self, clip: MotionClip) -> tuple[np.ndarray, np.ndarray]:
         key = id(clip)
         if key not in self._cache:
             result = self.env.evaluate(np.asarray(clip.rotvecs, dtype=np.float64))
