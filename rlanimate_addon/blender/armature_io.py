@@ -80,7 +80,7 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
         poses.append(np.array([pb.matrix for pb in pose_bones], dtype=np.float64))
         for pb in pose_bones:
             values[pb.name].append(_rotation_values(pb))
-        targets.append(_to_armature(obj, _world_point(target, target_bone, scene)))
+        targets.append(target_point(obj, target, target_bone, scene))
     count = len(frames)
     under, poses = (np.broadcast_to(np.array(m), (count,) + np.shape(m)[1:]) for m in (under, poses))
     values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
@@ -104,6 +104,12 @@ def may_move(obj):
     active = action_adapter.active_target(obj)
     targets += [active] if active is not None else []
     return any(not fcurve.data_path.startswith("pose.") for t in targets for fcurve in t.fcurves())
+
+
+def target_point(obj, target, target_bone, scene):
+    """(3,) the target (an object, a bone of an armature when target_bone names one, or the 3D cursor
+    when target is None) in obj's armature space, as the scene is evaluated now."""
+    return _to_armature(obj, _world_point(target, target_bone, scene))
 
 
 def _world_point(target, target_bone, scene):

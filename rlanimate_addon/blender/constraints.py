@@ -11,6 +11,9 @@ later gestures multiply in over their own frames, and it shows as an editable cu
 editor. Outside the gestures the constraint works as before, and at their ends the pose is the one
 the constraint made, so nothing jumps.
 """
+from contextlib import contextmanager
+
+import bpy
 import numpy as np
 
 from ..core import gesture, skeleton
@@ -38,7 +41,7 @@ def overriding(obj, bone_names):
         for constraint in pose_bone.constraints:
             if constraint.mute or not constraint.is_valid:
                 continue
-            if constraint.influence == 0.0 and _influence_curve(obj, constraint) is None:
+            if constraint.influence == 0.0 and influence_curve(obj, constraint) is None:
                 continue
             if driven & set(_acted_on(pose_bone, constraint)):
                 found.append((pose_bone.name, constraint))
@@ -54,10 +57,67 @@ def _acted_on(pose_bone, constraint):
     return [bone.name for bone in (chain[:count] if count else chain)]
 
 
+#: A message names this many constraints, then counts the rest.
+NAMED = 3
+
+
 def describe(found):
-    """'IK' on RightHand, ... as a message fragment."""
+    """"'IK' (Inverse Kinematics) on RightHand, ... and 23 more" as a message fragment: the first NAMED
+    constraints, then a count."""
     kinds = type(found[0][1]).bl_rna.properties["type"].enum_items if found else {}
-    return ", ".join(f"{constraint.name!r} ({kinds[constraint.type].name}) on {bone}" for bone, constraint in found)
+    named = ", ".join(f"{constraint.name!r} ({kinds[constraint.type].name}{_target(constraint)}) on {bone}"
+                      for bone, constraint in found[:NAMED])
+    return named + (f" and {len(found) - NAMED} more" if len(found) > NAMED else "")
+
+
+def _target(constraint):
+    """', target <target>' for a constraint with a target (its bone when it has one), else ''."""
+    target = getattr(constraint, "target", None)
+    if target is None:
+        return ""
+    bone = getattr(constraint, "subtarget", "")
+    return f", target {bone if bone and target.type == 'ARMATURE' else target.name}"
+
+
+_ROTATIONS = ("rotation_quaternion", "rotation_euler", "rotation_axis_angle")
+
+
+def drivers_on(obj, bone_names):
+    """'<bone>.<channel>' of each working driver on a rotation channel of the named bones: a driver
+    overrides the keys of the channel it drives."""
+    data = obj.animation_data
+    if data is None:
+        return []
+    paths = {f'pose.bones["{bpy.utils.escape_identifier(b)}"].{c}': f"{b}.{c}" for b in bone_names for c in _ROTATIONS}
+    return [f"{paths[d.data_path]}[{d.array_index}]" for d in data.drivers
+            if d.data_path in paths and not d.mute and d.is_valid]
+
+
+def check_drivers(obj, bone_names):
+    """RLAnimateError naming the drivers on rotation channels the gesture keys (`drivers_on`)."""
+    found = drivers_on(obj, bone_names)
+    if found:
+        more = f" and {len(found) - NAMED} more" if len(found) > NAMED else ""
+        raise RLAnimateError(
+            f"A driver on {', '.join(found[:NAMED])}{more} overrides the rotation the gesture keys, so the bake "
+            "would not play: remove the driver (right-click the channel > Delete Drivers) or mute it in the "
+            "Drivers editor, and generate again.")
+
+
+@contextmanager
+def muted(view_layer, found):
+    """Evaluate the rig with the constraints found muted (the pose the bake plays at full weight), and
+    leave them as they were."""
+    before = [(c, c.mute) for _, c in found]
+    for constraint, _ in before:
+        constraint.mute = True
+    view_layer.update()
+    try:
+        yield
+    finally:
+        for constraint, state in before:
+            constraint.mute = state
+        view_layer.update()
 
 
 def check(obj, found, start, end, mute):
@@ -65,11 +125,13 @@ def check(obj, found, start, end, mute):
     if not found:
         return
     if not mute:
+        several = len(found) > 1
         raise RLAnimateError(
-            f"Constraint {describe(found)} overrides the rotations the gesture keys, so the bake would not "
-            f"play. Click 'Generate, Muting Constraints' in the panel (mute_constraints=True) to mute it "
-            f"for frames {start}-{end} only, or bake the constraint into keys first (Pose > Animation > "
-            f"Bake Action, Visual Keying and Clear Constraints) and generate again.")
+            f"{'Constraints' if several else 'Constraint'} {describe(found)} {'override' if several else 'overrides'} "
+            "the rotations the gesture keys, so the bake would not play. Click 'Generate, Muting Constraints' in "
+            f"the panel (mute_constraints=True) to mute {'them' if several else 'it'} for frames {start}-{end} "
+            "only, or bake the constraints into keys first (Pose > Animation > Bake Action, Visual Keying and "
+            "Clear Constraints) and generate again.")
     animated = [(bone, c) for bone, c in found if not _mutable(obj, c)]
     if animated:
         raise RLAnimateError(
@@ -77,7 +139,7 @@ def check(obj, found, start, end, mute):
             f"key its influence to 0 over frames {start}-{end} yourself, or turn it off, and generate again.")
 
 
-def _influence_curve(obj, constraint):
+def influence_curve(obj, constraint):
     """The driver or F-curve of the active action that animates the constraint's influence, or None."""
     path = constraint.path_from_id("influence")
     data = obj.animation_data
@@ -93,7 +155,7 @@ def _influence_curve(obj, constraint):
 
 def _mutable(obj, constraint):
     """Whether the influence is static, or a frame curve of an earlier Generate's mute."""
-    curve = _influence_curve(obj, constraint)
+    curve = influence_curve(obj, constraint)
     return curve is None or _is_frame_curve(curve)
 
 
@@ -108,7 +170,7 @@ def mute(obj, found, start, end):
     frames = np.arange(start, end + 1)
     keep = 1.0 - gesture.blend_weights(len(frames))  # (N,) the influence's share left on each frame
     for _, constraint in found:
-        curve = _influence_curve(obj, constraint)
+        curve = influence_curve(obj, constraint)
         if curve is None:
             value = constraint.influence
             curve = constraint.driver_add("influence")

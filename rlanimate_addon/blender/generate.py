@@ -4,7 +4,7 @@ import numpy as np
 
 from ..core import blas_threads, channels, gesture, key_reduction, rig_roles
 from ..core.errors import RLAnimateError
-from . import armature_io, constraints, preferences, properties
+from . import armature_io, bake_check, constraints, preferences, properties
 
 
 def _check_target(settings):
@@ -93,7 +93,8 @@ class _Plan:
 
     def __init__(self, obj, family, roles, overriding):
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
-        self.rig = self.bones = self.keys = self.blend_type = self.settings = None
+        self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.settings = None
+        self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
         self.worst = 0.0
 
 
@@ -118,7 +119,9 @@ def _check(obj, settings, start, end, mute_constraints):
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
-    overriding = constraints.overriding(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm))
+    driven = constraints.driven_bones(roles, settings.behaviour, settings.arm)
+    constraints.check_drivers(obj, driven)
+    overriding = constraints.overriding(obj, driven)
     constraints.check(obj, overriding, start, end, mute_constraints)
     return _Plan(obj, family, roles, overriding)
 
@@ -130,9 +133,12 @@ def _compute(context, plan, settings, agent, frames):
         obj, scene = plan.obj, context.scene
         original_frame = scene.frame_current
         target = settings.target if settings.behaviour == "POINT" else None
+        bone = target_bone(settings) if target else ""
         try:
-            rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
-                                                                target_bone(settings) if target else "")
+            # Read with the constraints it mutes off: the pose the gesture plays over, which Exact Aim solves on.
+            with constraints.muted(context.view_layer, plan.overriding):
+                rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames,
+                                                                    target, bone)
         finally:
             if scene.frame_current != original_frame:
                 scene.frame_set(original_frame)
@@ -141,6 +147,9 @@ def _compute(context, plan, settings, agent, frames):
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
                                          exact_aim=settings.exact_aim)
         plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
+        plan.keyed = keyed
+        if target is not None:
+            plan.target, plan.target_bone, plan.targets = target, bone, targets
         plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
         plan.keys = {}
         for column, bone in enumerate(plan.bones):
@@ -162,7 +171,9 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
 
     Every check, for every armature, runs before the first write, so an RLAnimateError leaves the file
     as it was (the scene frame included). Constraints that would override the gesture are refused, or
-    muted over its frames with mute_constraints (blender/constraints.py).
+    muted over its frames with mute_constraints (blender/constraints.py). After the writes each rig is
+    played and its deformed hand measured (blender/bake_check.py): a bake that does not play is undone,
+    every armature's, and refused.
     """
     plans = []
     for obj in selected_armatures(context, settings):
@@ -181,7 +192,19 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
         start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
         _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
-    lines = [_write(plan, agent, context.scene) for plan in plans]
+    undo = [bake_check.BakeUndo(plan.obj, plan.overriding) for plan in plans]
+    scene = context.scene
+    original_frame = scene.frame_current
+    lines = [_write(plan, agent, scene) for plan in plans]
+    try:
+        for plan in plans:
+            bake_check.verify(scene, plan)
+    except RLAnimateError:
+        for record in reversed(undo):
+            record.restore()
+        raise
+    finally:
+        scene.frame_set(original_frame)
     progress(4)
     return "\n".join(lines)
 

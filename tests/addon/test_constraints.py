@@ -22,7 +22,7 @@ def _ik_rig():
 def test_a_constraint_overriding_the_arm_is_refused_by_name_and_changes_nothing(settings):
     rig, forearm, _ = _ik_rig()
     settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
-    _assert_refused(rig, rf"Constraint 'IK' \(Inverse Kinematics\) on {forearm.name} overrides the rotations the "
+    _assert_refused(rig, rf"Constraint 'IK' \(Inverse Kinematics, target IK Target\) on {forearm.name} overrides the rotations the "
                          rf"gesture keys, so the bake would not play\. Click 'Generate, Muting Constraints'")
 
 

@@ -1,0 +1,99 @@
+"""Does a baked gesture play? Where the gesture puts the hand and the finger, and how far the bones the
+mesh deforms with are from there, in plain numpy.
+
+The gesture plans each keyed bone's rotation (gesture.gesture_rotations); forward kinematics of the
+rig's role bones (RigSkeleton.pose_after, over the pose underneath) gives where the hand and the index
+finger will be. After the bake, Blender evaluates the rig as it plays it, constraints, drivers and
+helper bones included, and the bones the mesh deforms with carry the same points. A point of a role
+bone is carried by a deformed bone rigidly from its rest: p' = pose_D @ rest_D^-1 @ p_rest, so it
+needs no assumption about which deformed bone sits where, only that it moves with the role bone.
+"""
+import numpy as np
+
+from . import skeleton
+from .gesture import blend_weights
+from .rig import inverse
+from .rotations import quat_to_matrix
+
+#: The deformed hand may sit this far (metres of the scene) from where the gesture put it ...
+HAND_TOLERANCE = 0.02
+#: ... and the deformed finger line turn this many degrees from the planned one.
+FINGER_TOLERANCE_DEG = 3.0
+
+
+def line_bones(roles, arm):
+    """(hand bone, finger bones): the rig's bones whose joints the check measures. The finger runs from
+    the first index bone's head to the last one's tail (the hand's own head and tail without index bones)."""
+    prefix = skeleton.ARM_PREFIX[arm] + "Hand"
+    index = [roles[prefix + f"Index{k}"] for k in (1, 2, 3) if prefix + f"Index{k}" in roles]
+    return roles[prefix], (index[0], index[-1]) if index else (roles[prefix], roles[prefix])
+
+
+def measured_bones(roles, arm):
+    """The role bones carrying the wrist, the finger base and the finger tip (`line_bones`)."""
+    hand, (start, end) = line_bones(roles, arm)
+    return hand, start, end
+
+
+def rest_points(rig, arm):
+    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist (the hand's head),
+    the finger base (a head) and the finger tip (a tail). rig: a gesture.RigState."""
+    hand, start, end = measured_bones(rig.roles, arm)
+    return np.stack([rig.skeleton.rest_head(hand), rig.skeleton.rest_head(start),
+                     rig.skeleton.tails(rig.skeleton.rest, end)])
+
+
+def planned_pose(rig, arm, bones, keyed):
+    """(N, B, 4, 4) armature-space pose of the rig's role bones as the gesture plans it: the keyed
+    rotations (N, D, 4) on `bones` over the pose underneath; the measured bones (`measured_bones`)
+    and their ancestors are updated, the others keep the pose underneath."""
+    count = len(keyed)
+    columns = [rig.skeleton.index[b] for b in bones]
+    under = rig.under_at(count)
+    basis = under.copy()
+    scale = np.linalg.norm(under[:, columns, :3, :3], axis=-2, keepdims=True)  # (N, D, 1, 3)
+    basis[:, columns, :3, :3] = quat_to_matrix(np.asarray(keyed, dtype=np.float64)) * scale
+    return rig.skeleton.pose_after(rig.under_pose_at(count), under, basis, columns, only=measured_bones(rig.roles, arm))
+
+
+def planned_points(rig, arm, pose):
+    """(N, 3, 3) wrist, finger base and tip (armature space) carried by the role bones' pose (N, B, 4, 4)."""
+    rows = [rig.skeleton.index[b] for b in measured_bones(rig.roles, arm)]
+    return carried(pose[:, rows], rig.skeleton.rest[rows], rest_points(rig, arm))
+
+
+def carried(poses, rests, points):
+    """(K, P, 3) points (P, 3) at rest, each carried rigidly by its bone: poses (K, P, 4, 4) posed and
+    rests (P, 4, 4) rest matrices of the bone carrying each point."""
+    homogeneous = np.append(points, np.ones((len(points), 1)), axis=1)  # (P, 4)
+    local = np.einsum("pij,pj->pi", inverse(np.asarray(rests, dtype=np.float64)), homogeneous)
+    return np.einsum("kpij,pj->kpi", np.asarray(poses, dtype=np.float64), local)[..., :3]
+
+
+def turned(a, b):
+    """Degrees between the rotations of pose matrices a and b (..., 4, 4)."""
+    ra, rb = (m[..., :3, :3] / np.linalg.norm(m[..., :3, :3], axis=-2, keepdims=True) for m in (a, b))
+    trace = np.trace(np.swapaxes(ra, -1, -2) @ rb, axis1=-2, axis2=-1)
+    return np.degrees(np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0)))
+
+
+def check_frames(count, hand_path):
+    """Indices of three frames of a gesture of `count` frames to check: its apex (where the planned hand
+    (N, 3) is farthest from where it starts), and the frames a third and two thirds of the way through
+    the frames the gesture plays at full weight (no blend with the pose underneath, so constraints the
+    bake mutes are fully off)."""
+    full = np.flatnonzero(blend_weights(count) == 1.0)
+    if not len(full):
+        full = np.arange(count)
+    apex = full[int(np.argmax(np.linalg.norm(hand_path[full] - hand_path[0], axis=1)))]
+    return sorted({int(apex), int(full[len(full) // 3]), int(full[(2 * len(full)) // 3])})
+
+
+def misses(planned, played, world_scale):
+    """(hand distances (K,), finger angles in degrees (K,)) between planned and played points (K, 3, 3)
+    (wrist, finger base, finger tip in armature space); world_scale: the armature's world scale, so
+    distances are the scene's."""
+    distance = np.linalg.norm(played[:, 0] - planned[:, 0], axis=1) * world_scale
+    a, b = planned[:, 2] - planned[:, 1], played[:, 2] - played[:, 1]
+    cos = np.sum(a * b, axis=1) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+    return distance, np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
