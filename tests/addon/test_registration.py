@@ -175,7 +175,7 @@ def test_panel_offers_to_mute_constraints_that_override_the_gesture(settings):
     forearm.constraints.new("COPY_ROTATION").target = addon_helpers.add_empty("Other", (0, 0, 0))
     calls = _draw(settings)
     labels = " ".join(c[1].get("text", "") for c in calls if c[0] == "label")
-    assert f"'Copy Rotation' (Copy Rotation) on {forearm.name} would override the gesture" in labels
+    assert f"'Copy Rotation' (Copy Rotation, target Other) on {forearm.name} would override the gesture" in labels
     mute = [c for c in calls if c[0] == "operator" and c[2].get("text") == "Generate, Muting Constraints"]
     assert len(mute) == 1 and mute[0][1] == "rlanimate.generate_gesture"
     assert mute[0][2]["properties"].mute_constraints is True
