@@ -11,7 +11,9 @@ trainer/motion/canonicalise.py turns the source's world bone frames into canonic
 Imported clips are cached (trainer/motion/clip_cache.py) in a git-ignored `.import_cache/` beside the
 clips; manifests are read by trainer/motion/manifest.py.
 """
+import io
 import sys
+from contextlib import contextmanager, redirect_stderr
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +24,7 @@ from rlanimate_addon.core.errors import RLAnimateError, operator_error_reason
 from trainer.blender_io import rig_session
 from trainer.motion import canonicalise, clip_cache
 from trainer.motion.clip import ClipSet, MotionClip
-from trainer.motion.manifest import labelled, read_manifest
+from trainer.motion.manifest import ManifestEntry, checked_entries, labelled, read_manifest
 
 EXPECTED_FPS = 30.0
 CLIP_SUFFIXES = (".fbx", ".bvh")
@@ -30,15 +32,38 @@ _FINGER_BONES = tuple(b.name for b in skeleton.BONES
                       if "Hand" in b.name and b.name not in skeleton.ACTION_JOINTS)
 
 
+@contextmanager
+def _importer_output():
+    """Send what an importer prints through Python (its traceback when it fails) where Blender's own prints
+    go, file descriptor 2: held back by rig_session.blender_output unless --verbose, as its C-level output is.
+    The RLAnimateError raised for the failure names the reason."""
+    stream = sys.__stderr__ or io.StringIO()
+    try:
+        with redirect_stderr(stream):
+            yield
+    finally:
+        stream.flush()
+
+
+class FrameRateMismatch(RLAnimateError):
+    """A clip whose frame rate is not the expected one (import_clip_directory names the manifest that expects it)."""
+
+    def __init__(self, path, fps, expected):
+        super().__init__(f"{path}: the clip runs at {round(fps, 2):g} fps, but {expected:g} fps is expected. "
+                         f"Re-export or resample it at {expected:g} fps.")
+        self.path, self.fps, self.expected = path, fps, expected
+
+
 def _import_file(bpy, path):
     """Run Blender's importer on `path`; return the armature objects it created."""
     before = set(bpy.data.objects)
     suffix = path.suffix.lower()
     try:
-        if suffix == ".fbx":
-            bpy.ops.import_scene.fbx(filepath=str(path), use_anim=True)
-        else:
-            bpy.ops.import_anim.bvh(filepath=str(path), update_scene_fps=True, update_scene_duration=False)
+        with _importer_output():
+            if suffix == ".fbx":
+                bpy.ops.import_scene.fbx(filepath=str(path), use_anim=True)
+            else:
+                bpy.ops.import_anim.bvh(filepath=str(path), update_scene_fps=True, update_scene_duration=False)
     except (RuntimeError, ValueError, IndexError) as error:
         raise RLAnimateError(f"{path}: the file is corrupt or not a valid {suffix[1:].upper()} file "
                              f"({operator_error_reason(error)}). Re-export it from your animation tool.") from error
@@ -262,8 +287,7 @@ def _import_uncached(path, expected_fps, bone_map):
         frames = _frame_range(obj, path)  # no animation is the problem to report, whatever the frame rate
         fps = _clip_fps(bpy.context.scene)
         if abs(fps - expected_fps) > 1e-3:
-            raise RLAnimateError(f"{path}: the clip runs at {round(fps, 2):g} fps, but {expected_fps:g} fps is "
-                                 f"expected. Re-export or resample it at {expected_fps:g} fps.")
+            raise FrameRateMismatch(path, fps, expected_fps)
         motion = _read_armature(bpy, obj, chosen_map, frames)
     rotvecs, fingers = _to_canonical(*motion, chosen_map)
     return MotionClip(name=path.stem, source=str(path), fps=float(fps), rotvecs=rotvecs, fingers=fingers)
@@ -306,30 +330,40 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
     if manifest_path.is_file() and manifest_path.suffix.lower() == ".json":
         manifest = read_manifest(manifest_path)
         folder = manifest_path.parent
-        entries = manifest["clips"]
-        default_fps = float(manifest.get("fps", EXPECTED_FPS))
+        default_fps = float(expected_fps or manifest.get("fps") or EXPECTED_FPS)
+        entries, problems = checked_entries(manifest, manifest_path, default_fps)
     elif path.is_dir():
-        folder = path
-        entries = [{"file": p.name} for p in sorted(path.iterdir()) if p.suffix.lower() in CLIP_SUFFIXES]
-        default_fps, manifest_path = EXPECTED_FPS, None
+        folder, manifest_path, problems = path, None, []
+        entries = [ManifestEntry(k, p.name, None, None, fps=float(expected_fps or EXPECTED_FPS))
+                   for k, p in enumerate(sorted(path.iterdir()), start=1) if p.suffix.lower() in CLIP_SUFFIXES]
     else:
         raise _no_library(path)
     if cache_dir is None:  # cache beside a manifest's clips; never write into a plain folder such as
         cache_dir = folder / clip_cache.CACHE_DIR_NAME if manifest_path is not None else False  # ../shared/realmocap
     cache = Path(cache_dir) if cache_dir else None
-    clips, problems = [], []
+    clips = []
     for entry in tqdm(entries, desc="clips", unit="clip", file=progress, disable=progress is None, leave=False,
                       dynamic_ncols=True):
-        file = folder / str(entry.get("file", ""))
-        fps = float(entry.get("fps", expected_fps or default_fps))
         try:
-            clip = import_clip(file, fps, cache_dir=cache)
+            clip = import_clip(folder / entry.file, entry.fps, cache_dir=cache)
             if manifest_path is not None:
                 clip = labelled(clip, entry, manifest_path)
             clips.append(clip)
+        except FrameRateMismatch as error:
+            problems.append(str(error) if manifest_path is None else _manifest_fps_problem(error, entry, manifest,
+                                                                                            manifest_path))
         except RLAnimateError as error:
             problems.append(str(error))
     return clips, problems
+
+
+def _manifest_fps_problem(error, entry, manifest, manifest_path):
+    """The message for a clip whose frame rate is not the one its manifest gives: the manifest may be wrong."""
+    field = "the entry's field 'fps'" if "fps" in manifest["clips"][entry.number - 1] else \
+        "the manifest's field 'fps'" if manifest.get("fps") is not None else f"the default {EXPECTED_FPS:g} fps"
+    return (f"{entry.describe(manifest_path)}: the clip {error.path} runs at {round(error.fps, 2):g} fps, but "
+            f"{field} says {error.expected:g}. Correct the manifest if the clip is right, or re-export the clip "
+            f"at {error.expected:g} fps.")
 
 
 def _no_library(path):

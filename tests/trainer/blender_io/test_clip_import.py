@@ -1,6 +1,7 @@
 """Clip import through Blender's FBX and BVH importers: round trips, bone maps, bad clips, manifests, cache."""
 import json
 import shutil
+import zipfile
 
 import numpy as np
 import pytest
@@ -174,6 +175,51 @@ def test_bad_clips_raise_an_error_naming_the_file_and_the_problem(library, kind,
     assert "Location:" not in str(error.value) and "Traceback" not in str(error.value)
 
 
+@pytest.mark.parametrize("verbose", [False, True])
+def test_the_fbx_importers_own_traceback_is_held_back_unless_verbose(library, capfd, verbose):
+    files, _, _ = library
+    with rig_session.blender_output(verbose):
+        with pytest.raises(RLAnimateError, match="the file is corrupt or not a valid FBX file"):
+            clip_import.import_clip(files["garbage"])
+    shown = capfd.readouterr().err
+    assert ("Traceback" in shown and "import_fbx.py" in shown) == verbose
+
+
+def test_manifest_entries_are_checked_before_any_clip_is_imported(library, tmp_path, monkeypatch):
+    files, _, _ = library
+    manifest, _ = write_manifest(tmp_path, files)
+    data = json.loads(manifest.read_text())
+    data["clips"][0]["frames"] = "abc"
+    data["clips"].append("wave_right_000.bvh")  # an entry that is a string
+    manifest.write_text(json.dumps(data))
+    imported = count_imports(monkeypatch)
+    clips, problems = clip_import.import_clip_directory(manifest, cache_dir=False)
+    assert imported == ["wave_right_000.bvh", "point_right_001.fbx"], "the bad entries are never imported"
+    assert [c.name for c in clips] == ["wave_right_000"]
+    assert problems[:2] == [
+        f"{manifest}: entry 1 ('point_left_000.fbx'): field 'frames' is 'abc'; give the clip's frame count as a "
+        "whole number of at least 2, or leave it out. The entry is skipped.",
+        f"{manifest}: entry 4: the entry is 'wave_right_000.bvh', not an object; write it as "
+        '{"file": "clip.fbx", "behaviour": "POINT", "arm": "LEFT", ...} (docs/CLIPS.md). The entry is skipped.']
+    assert "point_right_001.fbx: the file is corrupt" in problems[2]
+    assert json.loads(manifest.read_text()) == data, "the manifest is left as it was"
+
+
+@pytest.mark.parametrize("where", ["entry", "top_level"])
+def test_a_clip_at_another_frame_rate_than_its_manifest_gives_blames_the_manifest_too(library, tmp_path, where):
+    files, _, _ = library
+    shutil.copy(files["bvh"], tmp_path / "wave_right_000.bvh")  # a 30 fps clip
+    entry = {"file": "wave_right_000.bvh", "behaviour": "WAVE", "arm": "RIGHT", "exaggeration": 0.3}
+    manifest = {"fps": 24, "clips": [entry]} if where == "top_level" else {"clips": [dict(entry, fps=24)]}
+    (tmp_path / "manifest.json").write_text(json.dumps(manifest))
+    clips, (problem,) = clip_import.import_clip_directory(tmp_path / "manifest.json", cache_dir=False)
+    field = "the manifest's field 'fps'" if where == "top_level" else "the entry's field 'fps'"
+    assert clips == [] and problem == (
+        f"{tmp_path / 'manifest.json'}: entry 1 ('wave_right_000.bvh'): the clip {tmp_path / 'wave_right_000.bvh'} "
+        f"runs at 30 fps, but {field} says 24. Correct the manifest if the clip is right, or re-export the clip at "
+        "24 fps.")
+
+
 def test_directory_import_reports_each_bad_file_and_keeps_the_good_ones(library, tmp_path):
     files, _, _ = library
     for kind in ("fbx", "bvh", "empty", "garbage", "nan"):
@@ -255,7 +301,8 @@ def test_a_manifest_whose_frame_count_disagrees_with_the_file_is_reported(librar
     manifest.write_text(json.dumps(data))
     clips, problems = clip_import.import_clip_directory(manifest, cache_dir=False)
     assert [c.name for c in clips] == ["wave_right_000"]
-    assert any(f"has {FRAMES} frames but the manifest says {FRAMES + 3}" in p for p in problems)
+    assert any(f"entry 1 ('point_left_000.fbx'): the manifest's field 'frames' says {FRAMES + 3}, but the clip" in p
+               and f"has {FRAMES} frames. Correct 'frames' in the manifest" in p for p in problems)
 
 
 def test_a_changed_skeleton_does_not_reuse_clips_cached_for_the_old_one(library, tmp_path, monkeypatch):
@@ -269,7 +316,33 @@ def test_a_changed_skeleton_does_not_reuse_clips_cached_for_the_old_one(library,
     assert len(list(tmp_path.glob("*.npz"))) == 2
 
 
-@pytest.mark.parametrize("damage", ["truncated", "garbage", "wrong_shape", "nan"])
+def rezipped(entry, member, change):
+    """Rewrite the zip `entry` with `change(bytes)` applied to its `member`, with valid checksums (as a tool
+    that rewrites the archive, not a flipped bit, would leave it)."""
+    with zipfile.ZipFile(entry) as archive:
+        members = {name: archive.read(name) for name in archive.namelist()}
+    members[member] = change(members[member])
+    with zipfile.ZipFile(entry, "w") as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+
+
+#: Changes to one array of a cache entry, each written as a valid archive: the entry is not the clip.
+ARRAY_DAMAGE = {
+    "wrong_shape": ("rotvecs", lambda a: a[:, :4]),
+    "nan": ("rotvecs", lambda a: a * np.nan),
+    "integer_rotations": ("rotvecs", lambda a: np.round(a).astype(np.int64)),  # was read as another clip
+    "fps_of_two_values": ("fps", lambda a: np.array([30.0, 30.0])),  # was a TypeError
+    "finger_names_numbers": ("finger_names", lambda a: np.arange(len(a))),
+    "unknown_finger_bone": ("finger_names", lambda a: np.array(["Tail"] * len(a))),
+}
+
+
+#: Changes to the text of rotvecs.npy's header (its shape's bracket left open, a quote lost).
+HEADER_DAMAGE = {"npy_header_unclosed": (b"), }", b"  }"), "npy_header_quote": (b"'descr'", b"'descr ")}
+
+
+@pytest.mark.parametrize("damage", ["truncated", "garbage", *HEADER_DAMAGE, *ARRAY_DAMAGE])
 def test_a_damaged_cache_entry_is_imported_again_and_rewritten(library, tmp_path, monkeypatch, capsys, damage):
     files, _, _ = library
     first = clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
@@ -279,10 +352,14 @@ def test_a_damaged_cache_entry_is_imported_again_and_rewritten(library, tmp_path
         entry.write_bytes(good[:len(good) // 2])
     elif damage == "garbage":
         entry.write_bytes(b"not an archive at all")
+    elif damage in HEADER_DAMAGE:  # the npy header's text: "unclosed" was a TokenError on every run
+        old, new = HEADER_DAMAGE[damage]
+        rezipped(entry, "rotvecs.npy", lambda data: data.replace(old, new, 1))
     else:
         with np.load(entry) as data:
             arrays = dict(data)
-        arrays["rotvecs"] = arrays["rotvecs"][:, :4] if damage == "wrong_shape" else arrays["rotvecs"] * np.nan
+        name, change = ARRAY_DAMAGE[damage]
+        arrays[name] = change(arrays[name])
         np.savez(entry, **arrays)
     imported = count_imports(monkeypatch)
     again = clip_import.import_clip(files["fbx"], cache_dir=tmp_path)
