@@ -88,12 +88,14 @@ def score_descriptions(clips, descriptions, references):
 
 
 def evaluate_seen_unseen(trainer, session):
-    """Held-out (unseen) and SEEN_CLIP_COUNT training (seen) clips of the trainer's behaviour(s)."""
+    """Held-out (unseen) and SEEN_CLIP_COUNT training (seen) clips of the trainer's behaviour(s): {split:
+    evaluate_clips's result} for each split that has clips (a library whose every clip is "train" has no
+    'unseen')."""
     unseen = select_clips(session.test_clips, trainer.behaviour)
     seen = select_clips(session.train_clips, trainer.behaviour, SEEN_CLIP_COUNT)
     return {split: evaluate_clips(trainer.played_agent, session.env, clips, session.references, trainer.bounds,
                                   trainer.request_objective)
-            for split, clips in (("unseen", unseen), ("seen", seen))}
+            for split, clips in (("unseen", unseen), ("seen", seen)) if clips}
 
 
 def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.DEFAULT_ACTION_BOUNDS,

@@ -7,6 +7,8 @@ installed. A resumed run takes its settings from its checkpoint and continues bi
 """
 import json
 import random
+import sys
+import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -22,7 +24,7 @@ from trainer.agent.agent_export import export_agent
 from trainer.agent.algorithm import Trainer
 from trainer.agent.config import PRESETS, load_preset
 from trainer.agent.models import RLAnimateAgent
-from trainer.evaluation.scoring import evaluate_seen_unseen
+from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
 from trainer.motion.manifest import manifest_path
 from trainer.paths import DEFAULT_MANIFEST
 from trainer.reporting import plots
@@ -81,8 +83,24 @@ def check_settings(settings: RunSettings) -> None:
         problems.append(f"--seed {settings.seed}: use a seed from 0 to {2 ** 32 - 1}")
     if settings.preset is not None and settings.preset not in PRESETS:
         problems.append(f"--preset {settings.preset}: unknown config preset; use one of {', '.join(PRESETS)}")
+    problems += _output_problems(settings.output)
     if problems:
         raise RLAnimateError("; ".join(problems) + ". Nothing was trained.")
+
+
+def _output_problems(output):
+    """[] when the run can write in `output` (or create it), else the one problem, found by creating and
+    removing a temporary file in its nearest existing folder (permission bits alone do not tell for root or
+    a read-only mount)."""
+    path = Path(output)
+    existing = next(p for p in (path, *path.parents) if p.exists())
+    if not existing.is_dir():
+        return [f"--output {output}: {existing} is a file, not a folder; choose a folder for the run's outputs"]
+    try:
+        tempfile.TemporaryFile(dir=existing).close()
+    except OSError as error:
+        return [f"--output {output}: cannot write in {existing} ({error.strerror}); choose a folder you can write to"]
+    return []
 
 
 def _is_count(value):
@@ -161,6 +179,10 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     agent = RLAnimateAgent(agent_config, settings.variant)
     trainer = Trainer(agent, session.env, session.train_clips, train_config, settings.behaviour, settings.seed,
                       references=session.references, epochs=epochs)
+    if not select_clips(session.test_clips, settings.behaviour):
+        print(f"note: the library has no held-out {settings.behaviour} clips (split \"test\"): the run is scored on "
+              "training clips only. Mark some clips \"split\": \"test\" in the manifest to measure unseen requests.",
+              file=sys.stderr)
     if saved is not None:
         trainer.load_state_dict(saved["trainer"])
     arguments = {**{name: getattr(settings, name) for name in RESUMED_SETTINGS}, "epochs": epochs}
@@ -190,7 +212,7 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
 
 
 def _flatten(evaluation):
-    return {f"{split}/{name}": evaluation[split][name] for split in ("seen", "unseen")
+    return {f"{split}/{name}": evaluation[split][name] for split in ("seen", "unseen") if split in evaluation
             for name in ("score", "smoothness")}
 
 
@@ -203,7 +225,7 @@ def _report(settings, trainer, final, epochs, skipped):
         "episodes": len(trainer.buffer),
         "frames": trainer.buffer.frames, "train_seconds": seconds, "train_cpu_seconds": cpu_seconds,
         "torch_threads": torch.get_num_threads(),
-        "held_out": final["unseen"], "training": final["seen"],
+        "held_out": final.get("unseen"), "training": final["seen"],  # held_out None: no held-out clips
         "final_losses": {k[5:]: v for k, v in trainer.history[-1].items() if k.startswith("loss/")},
         "skipped_clips": list(skipped),
     }
@@ -220,6 +242,6 @@ def _agent_metadata(report, trainer):
             "action_bounds": trainer.bounds,
             "average_frames": {name: float(np.mean(values)) for name, values in lengths.items()},
             "wave_rhythm": None if trainer.rhythm_model is None else trainer.rhythm_model.to_dict(),
-            "evaluation": {"held_out_score": report["held_out"]["score"],
-                           "held_out_smoothness": report["held_out"]["smoothness"]}}
+            "evaluation": {} if report["held_out"] is None else {  # {}: no held-out clips
+                "held_out_score": report["held_out"]["score"], "held_out_smoothness": report["held_out"]["smoothness"]}}
 

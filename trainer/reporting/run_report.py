@@ -13,6 +13,9 @@ def write_run_report(report, output):
         json.dump(report, handle, indent=2)
     rows = []
     for label, key in (("held-out (unseen)", "held_out"), ("training (seen)", "training")):
+        if report[key] is None:  # a library without held-out clips
+            rows.append([label, 0, "", "", "", "no clips with split \"test\""])
+            continue
         rows.append([label, len(report[key]["clips"]), f"{report[key]['score']:.2f}",
                      f"{report[key]['smoothness']:.2f}", "", ""])
         for behaviour, entry in report[key]["by_behaviour"].items():
@@ -29,7 +32,7 @@ def write_run_report(report, output):
                              rows), "", "Per held-out clip:", "",
              *markdown_table(["clip", "behaviour", "score", "smoothness"],
                              [[c["name"], c["behaviour"], f"{c['score']:.2f}", f"{c['smoothness']:.2f}"]
-                              for c in report["held_out"]["clips"]])]
+                              for c in (report["held_out"] or {"clips": []})["clips"]])]
     if report["skipped_clips"]:
         lines += ["", f"Skipped {len(report['skipped_clips'])} clip(s) of the library that did not import:", "",
                   *(f"- {problem}" for problem in report["skipped_clips"])]

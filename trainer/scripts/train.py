@@ -68,9 +68,10 @@ def main(argv=None):
     args = build_parser().parse_args(script_args(argv))
     settings = resolve(run_settings(args))
     report, _ = train(settings, LibrarySession(settings.clips, verbose=args.verbose))
+    scored, split = ((report["held_out"], "held-out") if report["held_out"] is not None
+                     else (report["training"], "no held-out clips; training-clip"))
     print(f"trained: {report['epochs']} epochs, {report['episodes']} episodes, {report['train_seconds'] / 60:.1f} min; "
-          f"held-out score {report['held_out']['score']:.2f}, smoothness {report['held_out']['smoothness']:.2f}; "
-          f"outputs in {args.output}")
+          f"{split} score {scored['score']:.2f}, smoothness {scored['smoothness']:.2f}; outputs in {args.output}")
     if args.install:
         install(Path(settings.output))
         print(f"installed: {shown(INSTALLED_AGENT)}, and the report in {shown(RESULTS_DIR)}")

@@ -80,3 +80,21 @@ def test_unusable_arguments_stop_the_script_before_any_clip_is_imported(tmp_path
     assert cli.run_main(train.main, argv) == 2
     assert message in capsys.readouterr().err
     assert not (tmp_path / "run").exists()
+
+
+@pytest.mark.parametrize("output, message", [
+    ("a_file/run", "a_file is a file, not a folder; choose a folder for the run's outputs"),
+    ("/sys/rlanimate_run", "cannot write in /sys (Permission denied); choose a folder you can write to"),
+])
+def test_an_output_that_cannot_be_written_is_refused_before_any_clip_is_imported(tmp_path, monkeypatch, capsys,
+                                                                                 output, message):
+    def no_import(clips, verbose=False):
+        raise AssertionError("the clips were imported before --output was checked")
+
+    monkeypatch.setattr(train, "LibrarySession", no_import)
+    (tmp_path / "a_file").write_text("not a folder")
+    output = output if output.startswith("/") else str(tmp_path / output)
+    assert cli.run_main(train.main, ["train.py", "--preset", "debug", "--output", output]) == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"error: --output {output}: ") and message in error and "Nothing was trained." in error
+    assert (tmp_path / "a_file").read_text() == "not a folder"
