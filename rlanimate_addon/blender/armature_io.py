@@ -32,7 +32,13 @@ def rig_roles_of(obj, bone_map_path=""):
     if bone_map_path:
         path = Path(bpy.path.abspath(bone_map_path))
         try:
-            text = path.read_text(encoding="utf-8")
+            with open(path, "rb") as handle:  # bounded: a bone map is a few KB, /dev/zero is endless
+                data = handle.read(rig_roles.MAX_BONE_MAP_BYTES + 1)
+            if len(data) > rig_roles.MAX_BONE_MAP_BYTES:
+                raise RLAnimateError(f"The bone-map file {str(path)!r} is larger than "
+                                     f"{rig_roles.MAX_BONE_MAP_BYTES >> 10} KB, so it is not a bone map: pick a "
+                                     "bone-map JSON file saved from the panel, or clear the Bone Map field.")
+            text = data.decode("utf-8")
         except OSError as error:
             raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({error.strerror}): pick an "
                                  "existing file, or clear the Bone Map field to detect the bones.") from None

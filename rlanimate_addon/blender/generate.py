@@ -2,7 +2,7 @@
 import bpy
 import numpy as np
 
-from ..core import blas_threads, channels, gesture, key_reduction, rig_roles
+from ..core import blas_threads, channels, gesture, key_reduction, rig_roles, rig_scale
 from ..core.errors import RLAnimateError
 from . import armature_io, bake_check, constraints, preferences, properties
 
@@ -116,6 +116,9 @@ def _check(obj, settings, start, end, mute_constraints):
     check_keepable(obj)
     check_nla(obj)
     check_inherited_rotation(obj, roles)
+    rig_scale.check_nonzero_scale(obj.name, obj.matrix_world, {  # the gesture's bones and their parents
+        p.name: tuple(p.scale) for b in constraints.driven_bones(roles, settings.behaviour, settings.arm)
+        for p in (obj.pose.bones[b], *obj.pose.bones[b].parent_recursive)})
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
@@ -219,6 +222,7 @@ def _write(plan, agent, scene):
     steps = gesture.rollout_length(count, agent.average_frames[settings.behaviour], settings.behaviour)
     if steps != count:
         note += f" (time-scaled from the agent's {steps}-frame gesture)"
+    note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
@@ -256,6 +260,6 @@ class RLANIMATE_OT_generate_gesture(bpy.types.Operator):
             return {"CANCELLED"}
         finally:
             window_manager.progress_end()
-        self.report({"INFO"}, summary)
+        self.report({"WARNING"} if gesture.LENGTH_WARNING in summary else {"INFO"}, summary)
         return {"FINISHED"}
 

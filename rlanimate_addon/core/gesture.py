@@ -65,6 +65,20 @@ def supported_length_range(average_frames):
     return max(2, int(round(low * average_frames))), max(2, int(round(high * average_frames)))
 
 
+#: How length_warning's notes begin (the operator reports a summary holding one as a warning).
+LENGTH_WARNING = "warning:"
+
+
+def length_warning(frame_count, average_frames):
+    """A note for a gesture shorter than the agent's supported range (its gesture squeezed into so few frames
+    that it is rushed), else ""."""
+    shortest, longest = supported_length_range(average_frames)
+    if int(frame_count) >= shortest:
+        return ""
+    return (f" ({LENGTH_WARNING} {int(frame_count)} frames is below the agent's supported {shortest}-{longest}, "
+            f"so the gesture is rushed; set Frames to {shortest} or more)")
+
+
 #: Rest joints that fix a rig's orientation: the torso and the shoulders (those the rig has).
 _ORIENTATION_BONES = ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
                       "LeftShoulder", "RightShoulder", "LeftArm", "RightArm")

@@ -202,13 +202,17 @@ def bone_map_json(family_name, roles):
     return json.dumps({"family": family_name, "bones": {r: roles[r] for r in ROLES if r in roles}}, indent=2)
 
 
+#: The largest bone-map file read (Save Bone Map writes about 2 KB).
+MAX_BONE_MAP_BYTES = 1 << 20
+
+
 def read_bone_map(text, bone_names):
     """(family name, {role: bone name}) from a bone-map file's text, checked against the rig's bone names."""
     try:
         data = json.loads(text)
         bones = data["bones"]
         family_name = str(data.get("family", "Bone-map file"))
-    except (ValueError, KeyError, TypeError, AttributeError):
+    except (ValueError, KeyError, TypeError, AttributeError, RecursionError):
         raise RLAnimateError('The bone-map file is not valid: it must be JSON like {"family": "...", '
                              '"bones": {"Spine": "my_spine", ...}}; save one from the panel to start.') from None
     if not isinstance(bones, dict) or not all(isinstance(b, str) and b for b in bones.values()):
