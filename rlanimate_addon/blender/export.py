@@ -1,5 +1,6 @@
 """Export FBX: the active armature, its meshes and its baked animation, through Blender's FBX exporter."""
 import os
+from contextlib import contextmanager
 from pathlib import Path
 
 import bpy
@@ -19,6 +20,28 @@ FBX_SETTINGS = dict(
     bake_anim_use_all_actions=False, bake_anim_force_startend_keying=True, bake_anim_step=1.0,
     bake_anim_simplify_factor=0.0, path_mode="AUTO",
 )
+
+
+@contextmanager
+def take_from_time_zero():
+    """Blender's exporter writes the scene's take with frame F at time F / fps, and its importer puts time 0
+    on frame 1 by default (anim_offset=1): a gesture baked from frame 1 came back one frame late (8 cm at
+    the sample's right hand). Within this context the scene's take starts at time 0 on its first frame, as
+    a Mixamo download's does and as the exporter already writes each NLA strip's and action's take
+    (its start_zero): `fbx_animations_do`, the exporter's one function that times a take, is called with
+    start_zero on. The exporter is left as it was on exit."""
+    from io_scene_fbx import export_fbx_bin  # Blender's bundled FBX add-on (4.2 to 5.0)
+
+    timed = export_fbx_bin.fbx_animations_do
+
+    def from_zero(scene_data, ref_id, f_start, f_end, start_zero, *args, **kwargs):
+        return timed(scene_data, ref_id, f_start, f_end, True, *args, **kwargs)
+
+    export_fbx_bin.fbx_animations_do = from_zero
+    try:
+        yield
+    finally:
+        export_fbx_bin.fbx_animations_do = timed
 
 
 def rig_meshes(rig, scene):
@@ -78,7 +101,9 @@ def export_rig(context, filepath):
             obj.select_set(True)
         if keyed is not None:
             scene.frame_start, scene.frame_end = min(frame_range[0], keyed[0]), max(frame_range[1], keyed[1])
-        bpy.ops.export_scene.fbx(filepath=str(path), **FBX_SETTINGS)
+        first = scene.frame_start
+        with take_from_time_zero():
+            bpy.ops.export_scene.fbx(filepath=str(path), **FBX_SETTINGS)
     except RuntimeError as error:
         raise RLAnimateError(f"Could not write {path}: {operator_error_reason(error)}. Choose a folder you can write "
                              "to.") from None
@@ -88,7 +113,9 @@ def export_rig(context, filepath):
             obj.select_set(False)
         for obj in selected:
             obj.select_set(True)
-    return f"Exported {rig.name!r} with {len(objects) - 1} mesh(es) to {filepath}"
+    where = "" if first == 1 else (f"; its take starts at time 0 on frame {first}, which Blender's FBX importer "
+                                   f"places on frame 1 (Animation Offset 1; give {first} to keep the frames)")
+    return f"Exported {rig.name!r} with {len(objects) - 1} mesh(es) to {filepath}{where}"
 
 
 class RLANIMATE_OT_export_fbx(bpy.types.Operator, ExportHelper):

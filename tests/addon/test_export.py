@@ -6,18 +6,30 @@ import bpy
 import numpy as np
 import pytest
 
+from rlanimate_addon.blender import export
 from rlanimate_addon.core import skeleton
 
 
 def _imported(path):
-    """Objects read from the FBX; keys land on the frames they were exported from (no import offset)."""
+    """Objects read from the FBX by Blender's importer with its defaults, as an animator imports a file
+    (anim_offset=1: the take's time 0 lands on frame 1)."""
     before = set(bpy.data.objects)
-    bpy.ops.import_scene.fbx(filepath=str(path), automatic_bone_orientation=False, anim_offset=0.0)
+    bpy.ops.import_scene.fbx(filepath=str(path))
     return [o for o in bpy.data.objects if o not in before]
 
 
+def _key_own_animation(rig):
+    """An idle of the character's own under the gestures: the spine sways from frame 1 to 90."""
+    spine = rig.pose.bones[helpers.rig_bone(rig, "Spine")]
+    for frame, angle in ((1, -0.1), (30, 0.1), (60, -0.1), (90, 0.1)):
+        spine.rotation_quaternion = (np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2))
+        spine.keyframe_insert("rotation_quaternion", frame=frame)
+
+
 def test_fbx_round_trip_reproduces_every_joint_within_a_millimetre(settings, tmp_path):
+    """With the importer's defaults, frame for frame: it came back one frame late (8-13 cm at the right hand)."""
     rig = helpers.load_sample_rig()
+    _key_own_animation(rig)
     target = helpers.add_empty("Target", (-1.2, -2.0, 1.7))
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, start_frame=1,
                             frame_count=40) == {"FINISHED"}
@@ -35,13 +47,27 @@ def test_fbx_round_trip_reproduces_every_joint_within_a_millimetre(settings, tmp
     assert sorted(o.type for o in imported) == ["ARMATURE", "MESH"], "armature and mesh, nothing else"
     copy = next(o for o in imported if o.type == "ARMATURE")
     assert sorted(b.name for b in copy.data.bones) == sorted(b.name for b in rig.data.bones), "no leaf bones"
-    frames = np.arange(1, 80)
+    assert copy.animation_data.action.frame_range[0] == 1.0, "the take starts at time 0: frame 1, not 2"
+    frames = np.arange(1, 91)
     names = [skeleton.PREFIX + b.name for b in skeleton.BONES]
     baked = helpers.bone_heads(rig, names, frames)
     read_back = helpers.bone_heads(copy, names, frames)
     assert np.ptp(baked[:, :, 2], axis=0).max() > 0.1, "the gesture should move the hands"
     error = np.linalg.norm(read_back - baked, axis=2)  # (frames, joints), metres
     assert error.max() < 1e-3, f"{error.max() * 1e3:.2f} mm on frame {frames[error.max(axis=1).argmax()]}"
+
+
+def test_a_take_that_starts_after_frame_1_says_where_the_importer_puts_it(settings, tmp_path):
+    rig = helpers.load_sample_rig()
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=30, frame_count=50) == \
+        {"FINISHED"}
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 30, 79
+    summary = export.export_rig(bpy.context, str(tmp_path / "late.fbx"))
+    assert summary.endswith("; its take starts at time 0 on frame 30, which Blender's FBX importer places on frame 1 "
+                            "(Animation Offset 1; give 30 to keep the frames)")
+    copy = next(o for o in _imported(tmp_path / "late.fbx") if o.type == "ARMATURE")
+    assert tuple(copy.animation_data.action.frame_range) == (1.0, 50.0)
 
 
 def test_export_refuses_without_an_armature(settings, tmp_path):
