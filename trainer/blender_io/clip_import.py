@@ -159,7 +159,7 @@ def _check_bvh_numbers(path):
     _, found, motion = path.read_text(errors="replace").partition("MOTION")
     if not found:
         return  # not a BVH with motion: the importer says what is wrong
-    bad = []
+    bad, kinds = [], set()
     for frame, line in enumerate(motion.strip().splitlines()[2:], start=1):  # after Frames: and Frame Time:
         try:
             values = np.array(line.split(), dtype=np.float64)
@@ -167,9 +167,15 @@ def _check_bvh_numbers(path):
             continue  # not numbers: the importer reports it
         if not np.all(np.isfinite(values)):
             bad.append(frame)
+            kinds |= _non_finite_kinds(values)
     if bad:
-        raise RLAnimateError(f"{path}: NaN values in the motion data at frames {bad[:10]}"
+        raise RLAnimateError(f"{path}: {' and '.join(sorted(kinds))} values in the motion data at frames {bad[:10]}"
                              f"{' and more' if len(bad) > 10 else ''}. Fix or re-export the clip.")
+
+
+def _non_finite_kinds(values):
+    """{'NaN', 'infinite'}, or the one of them, that the array `values` holds: a message calls inf infinite."""
+    return {word for word, test in (("NaN", np.isnan), ("infinite", np.isinf)) if np.any(test(values))}
 
 
 def _action_fcurves(action):
@@ -184,18 +190,20 @@ def _check_finite_keys(action, path):
     """Raise RLAnimateError naming the channels and frames whose keyframes are NaN or infinite.
 
     Blender's pose evaluation hides NaN keys (a NaN rotation evaluates as rest), so the keys are read."""
-    bad = {}
+    bad, kinds = {}, set()
     for curve in _action_fcurves(action):
         points = np.zeros(len(curve.keyframe_points) * 2)
         curve.keyframe_points.foreach_get("co", points)
         points = points.reshape(-1, 2)
         broken = ~np.all(np.isfinite(points), axis=1)
         if np.any(broken):
+            kinds |= _non_finite_kinds(points[broken])
             frames = bad.setdefault(curve.data_path, set())
             frames.update(int(f) if np.isfinite(f) else -1 for f in points[broken, 0])
     if bad:
         channels = "; ".join(f"{name} at frames {sorted(frames)[:5]}" for name, frames in sorted(bad.items())[:5])
-        raise RLAnimateError(f"{path}: NaN values in the animation ({channels}). Fix or re-export the clip.")
+        raise RLAnimateError(f"{path}: {' and '.join(sorted(kinds))} values in the animation ({channels}). Fix or "
+                             "re-export the clip.")
 
 
 def _frame_range(obj, path):

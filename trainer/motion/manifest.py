@@ -150,8 +150,12 @@ def _checked(number, raw, default_fps):
     behaviour = _label(raw, "behaviour", behaviours.BEHAVIOURS)
     arm = _label(raw, "arm", skeleton.ARMS)
     frames = raw.get("frames")
-    if frames is not None and not (isinstance(frames, int) and not isinstance(frames, bool) and frames >= 2):
-        raise _field("frames", frames, "give the clip's frame count as a whole number of at least 2, or leave it out")
+    if frames is not None:
+        whole = isinstance(frames, float) and frames.is_integer() or _is_number(frames) and isinstance(frames, int)
+        if not (whole and frames >= 2):
+            raise _field("frames", frames, "give the clip's frame count as a whole number of at least 2, or leave it "
+                                           "out")
+        frames = int(frames)
     fps = raw.get("fps", default_fps)
     if _frame_rate_problem(fps):
         raise _field("fps", fps, _frame_rate_problem(fps))

@@ -109,6 +109,10 @@ def library(tmp_path_factory):
     lines[motion] = " ".join(values)
     files["nan"] = folder / "nan.bvh"
     files["nan"].write_text("\n".join(lines) + "\n")
+    values[7] = "inf"  # an infinite value is called infinite, not NaN
+    lines[motion] = " ".join(values)
+    files["inf"] = folder / "inf.bvh"
+    files["inf"].write_text("\n".join(lines) + "\n")
 
     files["empty"] = folder / "empty.fbx"
     files["empty"].write_bytes(b"")
@@ -164,7 +168,8 @@ def test_import_leaves_the_scene_as_it_was(library):
     ("garbled_bvh", r"not a valid BVH file \(IndexError: list index out of range\)\. Re-export it"),
     ("no_animation", "no animation"),
     ("missing", "lacks the bones LeftForeArm, RightForeArm"),
-    ("nan", "NaN"),
+    ("nan", "NaN values in the motion data"),
+    ("inf", r": infinite values in the motion data at frames \[\d+\]\. Fix"),
     ("fps24", "runs at 24 fps, but 30 fps is expected"),
 ])
 def test_bad_clips_raise_an_error_naming_the_file_and_the_problem(library, kind, message):

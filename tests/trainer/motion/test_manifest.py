@@ -34,6 +34,8 @@ def check(path):
 
 @pytest.mark.parametrize("entry, field, shown, fix", [
     ({**POINT, "frames": "abc"}, "frames", "'abc'", "whole number of at least 2"),
+    ({**POINT, "frames": 40.5}, "frames", "40.5", "whole number of at least 2"),
+    ({**POINT, "frames": True}, "frames", "true", "whole number of at least 2"),
     ({**POINT, "fps": "fast"}, "fps", "'fast'", "frame rate as a number from 1 to 1000"),
     ({**POINT, "target": "here"}, "target", "'here'", "three finite numbers [x, y, z]"),
     ({**POINT, "target": [1, 2]}, "target", "[1, 2]", "three finite numbers [x, y, z]"),
@@ -103,8 +105,8 @@ def test_a_manifest_that_is_not_utf8_is_refused_naming_it(tmp_path):
 
 def test_a_clip_without_a_split_is_a_training_clip_and_entry_fps_defaults_to_the_manifests(tmp_path):
     point = {k: v for k, v in POINT.items() if k not in ("split", "fps")}
-    (entry,), _ = checked_entries({"clips": [point]}, tmp_path / "manifest.json", 24.0)
-    assert entry.split == "train" and entry.fps == 24.0
+    (entry,), _ = checked_entries({"clips": [dict(point, frames=40.0)]}, tmp_path / "manifest.json", 24.0)
+    assert entry.split == "train" and entry.fps == 24.0 and entry.frames == 40  # 40.0, as JavaScript writes 40
 
 
 def test_labels_of_checked_entries_make_finite_objectives(tmp_path):
