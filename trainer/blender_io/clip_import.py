@@ -317,12 +317,12 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
         try:
             return clip_cache.load_cached(cache_file, path)
         except RLAnimateError as error:  # import again and overwrite it
-            print(f"clip_import: {error} Importing {path.name} again.", file=sys.stderr)
+            tqdm.write(f"clip_import: {error} Importing {path.name} again.", file=sys.stderr)  # above the bar
     clip = _import_uncached(path, float(expected_fps), bone_map)
     try:
         clip_cache.save_cached(cache_file, clip)
     except OSError as error:  # a read-only clip folder: import without caching
-        print(f"clip_import: not caching {path.name}: {error}", file=sys.stderr)
+        tqdm.write(f"clip_import: not caching {path.name}: {error}", file=sys.stderr)
     return clip
 
 
