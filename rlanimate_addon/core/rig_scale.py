@@ -2,6 +2,7 @@
 collapses what it carries and has no inverse, so no gesture can be posed or aimed on it. Checked before
 Generate writes anything; bpy-free (the caller reads the matrices)."""
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import RLAnimateError
 
@@ -9,7 +10,7 @@ from .errors import RLAnimateError
 MIN_SCALE = 1e-6
 
 
-def check_nonzero_scale(rig_name, object_matrix, bone_scales):
+def check_nonzero_scale(rig_name: str, object_matrix: ArrayLike, bone_scales: dict[str, ArrayLike]) -> None:
     """RLAnimateError naming the armature object, or the bones, scaled to zero on some axis.
 
     object_matrix: the armature object's world matrix (4, 4); bone_scales: {bone name: its own pose
