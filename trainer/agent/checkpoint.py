@@ -6,6 +6,7 @@ history, and the python / numpy / torch RNG states) plus a format version and th
 It is written atomically (trainer/files.py), so a run killed mid-write leaves the previous checkpoint intact.
 """
 import random
+import re
 from pathlib import Path
 
 import torch
@@ -43,7 +44,12 @@ def save(path, trainer_state, run_arguments):
 
 
 def load(path):
-    """The checkpoint at `path` as written by `save`; RLAnimateError if it is missing or damaged."""
+    """The checkpoint at `path` as written by `save`; RLAnimateError if it is missing or damaged.
+
+    Every dict in it names its place in the file: a key that a reader (the run's settings, the
+    trainer's load_state_dict) needs and the file lacks raises an RLAnimateError naming the checkpoint
+    and the key, not a KeyError.
+    """
     path = Path(path)
     if not path.is_file():
         raise RLAnimateError(f"No checkpoint at {path}: start a new run without --resume, "
@@ -51,11 +57,42 @@ def load(path):
     try:
         payload = torch.load(path, map_location="cpu", weights_only=True)
     except Exception as error:  # torch raises several types for damaged files
-        raise RLAnimateError(f"The checkpoint {path} is damaged ({error}): delete it and start again.") from error
+        raise RLAnimateError(f"The checkpoint {path} is damaged ({_reason(error)}): delete it and start "
+                             f"again.") from error
     if not isinstance(payload, dict) or payload.get("format_version") != FORMAT_VERSION:
         raise RLAnimateError(f"The checkpoint {path} is not format version {FORMAT_VERSION}: "
                              f"it was written by another version of the trainer; start a new run.")
-    return payload
+    return _checked(payload, path, "")
+
+
+def _reason(error):
+    """What torch says is wrong with a file, without its advice to load with weights_only=False (which
+    would unpickle, and could run, whatever the file holds) or its terminal colour codes."""
+    text = re.sub(r"\x1b\[[0-9;]*m", "", str(error))
+    if "WeightsUnpickler error:" in text:  # torch's advice comes first, the reason after this marker
+        text = text.split("WeightsUnpickler error:", 1)[1]
+    return text.strip().split(". ", 1)[0].strip().rstrip(".") or type(error).__name__
+
+
+class _CheckedDict(dict):
+    """A checkpoint's dict that names the checkpoint and the missing key when a reader needs one."""
+
+    def __missing__(self, key):
+        raise RLAnimateError(f"The checkpoint {self.path} lacks {self.place}{key}: it is incomplete, or was "
+                             f"edited or written by another trainer; delete it and start a new run (without "
+                             f"--resume), or resume from another run's folder.")
+
+
+def _checked(value, path, place):
+    """`value` with every plain dict in it a _CheckedDict, lists and tuples rebuilt around them; anything
+    else as it is (tensors, and torch's own OrderedDict state_dicts, which torch checks itself)."""
+    if type(value) is dict:
+        checked = _CheckedDict((key, _checked(item, path, f"{place}{key}.")) for key, item in value.items())
+        checked.path, checked.place = path, place
+        return checked
+    if type(value) in (list, tuple):
+        return type(value)(_checked(item, path, f"{place}{k}.") for k, item in enumerate(value))
+    return value
 
 
 def _python_state_to_data(state):

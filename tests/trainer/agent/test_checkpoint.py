@@ -1,7 +1,10 @@
 """Checkpoints: atomic, plain data, clear errors; and a resumed run equals the uninterrupted one bit for bit."""
+import argparse
 import dataclasses
 import json
 import random
+import re
+import shutil
 from types import SimpleNamespace
 
 import numpy as np
@@ -53,6 +56,17 @@ def test_missing_damaged_and_foreign_checkpoints_raise_clear_errors(tmp_path):
     torch.save({"format_version": 99}, foreign)
     with pytest.raises(RLAnimateError, match="format version"):
         checkpoint.load(foreign)
+
+
+def test_a_checkpoint_holding_code_is_refused_without_torchs_advice_to_unpickle_it(tmp_path):
+    path = tmp_path / checkpoint.FILENAME
+    torch.save({"format_version": checkpoint.FORMAT_VERSION, "arguments": argparse.Namespace(seed=1)}, path)
+    with pytest.raises(RLAnimateError) as refused:
+        checkpoint.load(path)
+    message = str(refused.value)
+    assert message.startswith(f"The checkpoint {path} is damaged (Unsupported global: GLOBAL argparse.Namespace")
+    assert message.endswith("delete it and start again.")
+    assert "weights_only" not in message and "\x1b" not in message
 
 
 @pytest.fixture(scope="module")
@@ -116,3 +130,31 @@ def test_a_run_killed_mid_schedule_resumes_exactly(session, tmp_path):
     assert resumed.history[1]["learning_rate"] < train_config.learning_rate  # the schedule was decaying
     a, b = straight.agent.state_dict(), resumed.agent.state_dict()
     assert all(torch.equal(a[k], b[k]) for k in a)
+
+
+@pytest.fixture(scope="module")
+def two_epoch_run(session, tmp_path_factory):
+    folder = tmp_path_factory.mktemp("two_epochs") / "run"
+    _run(session, folder, 2)
+    return folder
+
+
+@pytest.mark.parametrize("missing", ["trainer.rng", "trainer.buffer", "trainer.rng.numpy", "arguments.clips",
+                                     "trainer"])
+def test_a_checkpoint_missing_a_key_is_refused_naming_it_and_the_run_is_kept(session, two_epoch_run, tmp_path,
+                                                                             missing):
+    run = tmp_path / "run"
+    shutil.copytree(two_epoch_run, run)
+    path = run / checkpoint.FILENAME
+    payload = torch.load(path, weights_only=True)
+    *parents, key = missing.split(".")
+    parent = payload
+    for name in parents:
+        parent = parent[name]
+    del parent[key]
+    torch.save(payload, path)
+    files = {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()}
+    with pytest.raises(RLAnimateError, match=rf"^The checkpoint {re.escape(str(path))} lacks {re.escape(missing)}: "
+                                             r"it is incomplete.*delete it and start a new run \(without --resume\)"):
+        _run(session, run, 4, resume=True)
+    assert {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()} == files, "the run's files are kept"
