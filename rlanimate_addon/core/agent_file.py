@@ -12,7 +12,9 @@ Layout (format FORMAT_NAME, version FORMAT_VERSION):
 variant has; the torch model, the exporter and the numpy runtime all agree with it.
 """
 import contextlib
+import io
 import json
+import lzma
 import math
 import struct
 import tokenize
@@ -118,19 +120,39 @@ def load_agent_file(path):
 #: before anything is read or allocated.
 MAX_FILE_BYTES = 256 * 2 ** 20
 MAX_ENTRIES = 1024
+#: A central directory of MAX_ENTRIES entries with names of up to 200 characters.
+MAX_DIRECTORY_BYTES = MAX_ENTRIES * 256
+#: numpy writes headers of a few hundred bytes; its own parser stops at 10,000.
+MAX_NPY_HEADER_BYTES = 10_000
 MAX_METADATA_BYTES = 4 * 2 ** 20
 MAX_PARAMETERS = 16 * 2 ** 20
+#: Any one entry: the largest array MAX_PARAMETERS allows, as float64.
+MAX_ENTRY_BYTES = 8 * MAX_PARAMETERS + 2 ** 16
 MAX_SIZE = 4096  # any one agent_config width
 MAX_HIDDEN_LAYERS = 16
 MAX_AVERAGE_FRAMES = 10_000
 MAX_ABS_BOUND = 2.0 * np.pi  # radians per rotation-vector component
 MAX_CONFIG_SCALAR = 1e6
+#: Trained weights stay within a few units (the shipped agent's largest is 2.8); 1e300 ones saturate
+#: every tanh and still bake finite keys, so they are refused.
+MAX_ABS_WEIGHT = 1e4
+#: Any number of the wave_rhythm model (exaggerations, frequencies, fractions, phase, ramp, bandwidth).
+MAX_RHYTHM_VALUE = 1e3
 #: What a hostile archive can raise from zipfile, zlib and numpy's npy header parser (ast, tokenize,
 #: dtype) before a check of ours sees it: `_unreadable` turns each into an RLAnimateError.
 _UNREADABLE = (OSError, EOFError, ValueError, TypeError, KeyError, IndexError, OverflowError, MemoryError,
                RecursionError, SyntaxError, NotImplementedError, RuntimeError, zipfile.BadZipFile, zlib.error,
-               struct.error, tokenize.TokenError)
+               lzma.LZMAError, struct.error, tokenize.TokenError)
 _NPY = ".npy"
+_NPY_MAGIC = b"\x93NUMPY"
+#: Zip compression methods an agent may use: numpy.savez stores, numpy.savez_compressed deflates.
+_METHODS = (zipfile.ZIP_STORED, zipfile.ZIP_DEFLATED)
+_METHOD_NAMES = {zipfile.ZIP_BZIP2: "bzip2", zipfile.ZIP_LZMA: "LZMA", 93: "Zstandard", 95: "xz", 98: "PPMd",
+                 99: "AES encryption"}
+#: The zip end record (22 bytes and a comment of up to 65,535) and the zip64 locator that may precede it.
+_END_SIGNATURE, _END_BYTES = b"PK\x05\x06", 22
+_END_SEARCH_BYTES = _END_BYTES + 2 ** 16
+_ZIP64_LOCATOR_SIGNATURE, _ZIP64_LOCATOR_BYTES = b"PK\x06\x07", 20
 
 
 @contextlib.contextmanager
@@ -147,6 +169,8 @@ def _open_archive(path):
         size = path.stat().st_size
         with open(path, "rb") as handle:
             magic = handle.read(2)
+            handle.seek(max(0, size - _END_SEARCH_BYTES))
+            tail = handle.read(_END_SEARCH_BYTES)
     if size > MAX_FILE_BYTES:
         raise RLAnimateError(f"The agent file {path} is {size / 2 ** 20:.0f} MB, more than any agent "
                              f"({MAX_FILE_BYTES // 2 ** 20} MB at most): choose a .npz written by "
@@ -156,12 +180,33 @@ def _open_archive(path):
     if magic != b"PK":  # a bare .npy, a pickle, text: numpy would have to unpickle some of them
         raise RLAnimateError(f"{path} is not an RLAnimate agent file (not a numpy .npz archive; pickled data is "
                              f"refused): choose a .npz written by trainer/agent/agent_export.py.")
+    _check_end_record(path, tail)
     with _unreadable(path):
         return zipfile.ZipFile(path)
 
 
+def _check_end_record(path, tail):
+    """The zip's end record, found as zipfile finds it in the file's last bytes `tail`, bounds what zipfile
+    will parse: the entry count and the central directory's size, before zipfile reads the directory."""
+    if tail[-_END_BYTES:-_END_BYTES + 4] == _END_SIGNATURE and tail[-2:] == b"\0\0":
+        at = len(tail) - _END_BYTES  # no archive comment, the usual case
+    else:
+        at = tail.rfind(_END_SIGNATURE)
+    if at < 0 or len(tail) - at < _END_BYTES:
+        raise _damaged(path, "no zip end record")
+    if tail[max(0, at - _ZIP64_LOCATOR_BYTES):at].startswith(_ZIP64_LOCATOR_SIGNATURE):
+        raise RLAnimateError(f"The agent file {path} is a zip64 archive, made for more entries or bytes than any "
+                             f"agent has: choose a .npz written by trainer/agent/agent_export.py.")
+    disk_entries, entries, directory_bytes = struct.unpack_from("<2HI", tail, at + 8)
+    if max(disk_entries, entries) > MAX_ENTRIES or directory_bytes > MAX_DIRECTORY_BYTES:
+        raise RLAnimateError(f"The agent file {path} declares {max(disk_entries, entries):,} entries in a "
+                             f"{directory_bytes:,}-byte directory, more than any agent ({MAX_ENTRIES:,} entries "
+                             f"in {MAX_DIRECTORY_BYTES:,} bytes at most): choose a .npz written by "
+                             f"trainer/agent/agent_export.py.")
+
+
 def _entries(path, archive):
-    """{array name: ZipInfo} of the archive, its size and names checked."""
+    """{array name: ZipInfo} of the archive, its size, names and compression methods checked."""
     infos = archive.infolist()
     if len(infos) > MAX_ENTRIES:
         raise _not_an_agent(path)
@@ -169,25 +214,43 @@ def _entries(path, archive):
     for info in infos:
         if not info.filename.endswith(_NPY) or info.filename[:-len(_NPY)] in entries:
             raise _damaged(path, f"entry {info.filename!r} is not one numpy array")
+        if info.compress_type not in _METHODS:
+            raise RLAnimateError(f"The agent file {path} compresses {info.filename!r} with zip method "
+                                 f"{info.compress_type} ({_METHOD_NAMES.get(info.compress_type, 'unknown')}); "
+                                 f"agents are stored or deflated, as numpy.savez writes them: re-export it with "
+                                 f"trainer/agent/agent_export.py, or re-zip it without that compression.")
+        if info.file_size > MAX_ENTRY_BYTES:
+            raise _damaged(path, f"entry {info.filename!r} declares {info.file_size:,} bytes, more than any "
+                                 f"agent's {MAX_ENTRY_BYTES:,}")
         entries[info.filename[:-len(_NPY)]] = info
     return entries
 
 
-def _npy_header(stream):
-    """(shape, fortran_order, dtype) from the npy header at the start of `stream`, by numpy's own parser."""
-    version = np.lib.format.read_magic(stream)
+def _npy_header(stream, name):
+    """(shape, fortran_order, dtype) from the npy header at the start of `stream`, by numpy's own parser
+    once the header's length field is checked: numpy would read as many bytes as the field claims."""
+    magic = stream.read(len(_NPY_MAGIC) + 2)
+    if len(magic) < len(_NPY_MAGIC) + 2 or not magic.startswith(_NPY_MAGIC):
+        raise ValueError(f"{name} is not a numpy array")
+    version = tuple(magic[-2:])
     read = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}.get(version)
     if read is None:
-        raise ValueError(f"npy format version {version}")
+        raise ValueError(f"{name} is npy format version {version}")
+    length_field = stream.read(2 if version == (1, 0) else 4)
+    length = int.from_bytes(length_field, "little")
+    if length > MAX_NPY_HEADER_BYTES:
+        raise ValueError(f"the npy header of {name} claims {length:,} bytes, more than "
+                         f"{MAX_NPY_HEADER_BYTES:,}")
+    header = io.BytesIO(length_field + stream.read(length))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # numpy's note on headers written by Python 2
-        return read(stream)
+        return read(header)
 
 
 def _read_npy(path, archive, info, name, check):
     """The array in the archive entry `info`; `check(shape, dtype)` sees the header before any data is read."""
     with _unreadable(path), archive.open(info) as stream:
-        shape, fortran_order, dtype = _npy_header(stream)
+        shape, fortran_order, dtype = _npy_header(stream, name)
         if dtype.hasobject:
             raise _pickled(path, name)
         if any(n < 0 for n in shape):
@@ -262,6 +325,35 @@ def _is_number(value):
     return _is_int(value) or isinstance(value, float) and math.isfinite(value)
 
 
+def _count(n, noun):
+    return f"{n:,} {noun}{'s' if n > 1 else ''}"
+
+
+def _largest_number(value):
+    """The largest magnitude among the numbers anywhere in the JSON value (NaN if one is NaN, 0 if none)."""
+    largest, pending = 0.0, [value]
+    while pending:
+        item = pending.pop()
+        if isinstance(item, dict):
+            pending.extend(item.values())
+        elif isinstance(item, list):
+            pending.extend(item)
+        elif _is_int(item) or isinstance(item, float):
+            if item != item:
+                return math.nan
+            largest = max(largest, abs(item))
+    return largest
+
+
+def _describe(number):
+    """A number as a message names it: NaN, infinite, or its value (integers of any size in short)."""
+    if isinstance(number, float) and math.isnan(number):
+        return "NaN"
+    if number == math.inf:
+        return "infinite"
+    return f"{number:.3g}" if isinstance(number, float) or abs(number) < 10 ** 15 else f"about 1e{len(str(number)) - 1}"
+
+
 def _check_metadata_values(path, metadata):
     """Every metadata value the add-on uses, checked for type and range; returns the expected weight shapes."""
     config = metadata["agent_config"]
@@ -295,6 +387,11 @@ def _check_metadata_values(path, metadata):
                              f"{MAX_AVERAGE_FRAMES:,} frames for each behaviour it was trained for, among "
                              f"{', '.join(behaviours.BEHAVIOURS)}): re-export it.")
     if metadata["wave_rhythm"] is not None:
+        largest = _largest_number(metadata["wave_rhythm"])
+        if not largest <= MAX_RHYTHM_VALUE:
+            raise RLAnimateError(f"The agent file {path} has a wave_rhythm value of {_describe(largest)}, beyond "
+                                 f"+-{MAX_RHYTHM_VALUE:g} (exaggerations, wave frequencies and fractions of a "
+                                 f"gesture are small numbers): re-export it with trainer/agent/agent_export.py.")
         rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
     return {name: tuple(shape) for name, shape in expected.items()}
 
@@ -306,7 +403,7 @@ def _read_weights(path, archive, entries, expected):
     headers = {}
     for name, info in entries.items():
         with _unreadable(path), archive.open(info) as stream:
-            headers[name] = _npy_header(stream)
+            headers[name] = _npy_header(stream, name)
         if headers[name][2].hasobject:
             raise _pickled(path, name)
     wrong = [f"{name} {headers[name][0]} (expected {expected[name]})"
@@ -329,7 +426,19 @@ def _read_weights(path, archive, entries, expected):
     weights = {}
     for name in sorted(expected):
         weights[name] = _read_npy(path, archive, entries[name], name, check(name))
-        if not np.all(np.isfinite(weights[name])):
-            raise RLAnimateError(f"The agent file {path} has NaN or infinite values in {name}: its training "
-                                 f"diverged; train it again (a lower learning rate or gradient clip helps).")
+        _check_weight_values(path, name, weights[name])
     return weights
+
+
+def _check_weight_values(path, name, array):
+    """RLAnimateError naming what is wrong with the weight array `name`: NaN, infinite or huge values."""
+    nan, infinite = int(np.isnan(array).sum()), int(np.isinf(array).sum())
+    finite = array[np.isfinite(array)]
+    largest = float(np.abs(finite).max()) if finite.size else 0.0
+    if nan or infinite or largest > MAX_ABS_WEIGHT:
+        found = ", ".join(([_count(nan, "NaN value")] if nan else []) +
+                          ([_count(infinite, "infinite value")] if infinite else []) +
+                          ([f"values as large as {largest:.3g}"] if largest > MAX_ABS_WEIGHT else []))
+        raise RLAnimateError(f"The agent file {path} has {found} in {name} (a trained agent's weights are finite "
+                             f"and within +-{MAX_ABS_WEIGHT:g}): its training diverged or the file was altered; "
+                             f"train it again (a lower learning rate or gradient clip helps).")

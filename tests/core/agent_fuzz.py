@@ -16,11 +16,23 @@ Kinds:
                                       1e12, strings, lists, huge integers...) or removed, in a valid zip
     metadata_text                     characters of the metadata JSON changed, in a valid zip
     deflate_bomb                      an entry replaced by megabytes of deflated zeros behind a valid header
+    compressed_raw                    bytes of an entry's deflated data changed (the archive deflated first)
+    other_method                      the archive, or one entry, compressed with LZMA or bzip2 (sometimes with
+                                      bytes of the compressed data changed), or the compression method field
+                                      of a stored entry set to another method (bzip2, LZMA, zstd, AES...)
+    npy_length                        an npy header's length field set to an edge value: in place, or as a
+                                      version 2.0 header of 2 to 4 GiB in a valid zip, 4 MB of deflated spaces
+                                      behind it
+    entry_bomb                        1,025 to 1,000,000 empty entries in the central directory (zip64 end
+                                      records past 65,535)
+    weight_value                      one weight array as float64 scaled by up to 1e300, or one of its
+                                      values set to an edge value, in a valid zip
 """
 import io
 import json
 import struct
 import zipfile
+import zlib
 
 import numpy as np
 
@@ -28,7 +40,8 @@ from rlanimate_addon.core import agent_file, gesture, runtime
 from rlanimate_addon.core.errors import RLAnimateError
 
 KINDS = ("zip_local", "zip_central", "zip_end", "npy_raw", "metadata_raw", "npy_header", "metadata_value",
-         "metadata_text", "deflate_bomb")
+         "metadata_text", "deflate_bomb", "compressed_raw", "other_method", "npy_length", "entry_bomb",
+         "weight_value")
 #: Outcomes the loader may have: refused with an RLAnimateError, the original agent exactly, or a
 #: still-valid changed file read exactly as numpy reads it and baking finite keys. Anything else fails.
 ACCEPTED = ("refused", "identical", "valid other file")
@@ -40,12 +53,18 @@ _METADATA_PATHS = (("action_bounds", 0, 0), ("action_bounds", 44, 1), ("action_b
                    ("agent_config", "hidden_layers"), ("agent_config", "hidden_size"),
                    ("agent_config", "task_size"), ("agent_config", "stochastic_size"), ("agent_config", "min_std"),
                    ("agent_config", "concentration_scale"), ("agent_config",), ("variant",), ("format_version",),
-                   ("format",))
+                   ("format",), ("wave_rhythm", "examples", 0, 1), ("wave_rhythm", "examples", 1, 0),
+                   ("wave_rhythm", "phase"), ("wave_rhythm", "ramp"), ("wave_rhythm", "bandwidth"), ("wave_rhythm",))
 _SHAPES = ("(1099511627776,)", "(1048576, 1048576)", "(-1, 64)", "(10000000000000000000000000000,)", "(0,)",
            "()", "(64,)", "(192, 64)", "(8796093022208, 8)")
 _DESCRS = ("'<f8'", "'|O'", "'<U2000000000000'", "'>f4'", "'|V0'", "'<i4'", "[('a', '<f4')]", "'garbage'",
            "'<f4'", "('<f4', (1000000000,))", "'<U1'")
 _HEADER_CHARACTERS = "{}()[],:'\" 0123456789\n\x00\\eéU<>|fO"
+#: Compression methods a zip header may name: bzip2, LZMA, zstd, xz, JPEG, WavPack, PPMd, AES, and unknown.
+_METHODS = (12, 14, 93, 95, 96, 97, 98, 99, 1, 6, 9, 0xFFFF)
+_HEADER_LENGTHS = (0, 1, 0x7FFF, 0xFFFF, 0x10000, 0x7FFFFFFF, 0x80000000, 0xFFFFFFFF)
+_ENTRY_COUNTS = (1025, 65535, 1_000_000)
+_WEIGHT_VALUES = (1e300, -1e300, 1e30, 1e5, float("inf"), float("-inf"), float("nan"), 0.0)
 _FRAMES = 40
 
 
@@ -144,6 +163,23 @@ class _Layout:
         self.end = len(data) - 22
         size, offset = struct.unpack_from("<II", data, self.end + 12)
         self.central = (offset, offset + size)
+        self.central_headers = [offset]  # where each central directory header starts
+        while len(self.central_headers) < len(self.infos):
+            start = self.central_headers[-1]
+            self.central_headers.append(start + 46 + sum(struct.unpack_from("<HHH", data, start + 28)))
+        self.repacked = {}  # compression method -> (archive bytes, [(start, stop) of each entry's data])
+
+    def repack(self, method):
+        """The archive with every entry compressed by `method`, and where each entry's compressed data lies."""
+        if method not in self.repacked:
+            data = _rezip(self, {}, None, method)
+            with zipfile.ZipFile(io.BytesIO(data)) as archive:
+                regions = []
+                for info in archive.infolist():
+                    body = info.header_offset + 30 + sum(struct.unpack_from("<HH", data, info.header_offset + 26))
+                    regions.append((body, body + info.compress_size))
+            self.repacked[method] = data, regions
+        return self.repacked[method]
 
 
 def _raw(data, region, rng):
@@ -274,6 +310,84 @@ def _deflate_bomb(layout, rng):
     return layout.bombs[name, megabytes]
 
 
+def _compressed_raw(layout, rng):
+    data, regions = layout.repack(zipfile.ZIP_DEFLATED)
+    return _raw(data, _pick(regions, rng), rng)
+
+
+def _other_method(layout, rng):
+    operation = rng.integers(3)
+    method = int(rng.choice([zipfile.ZIP_LZMA, zipfile.ZIP_BZIP2]))
+    if operation == 0:  # the whole archive repacked, its compressed data changed half the time
+        data, regions = layout.repack(method)
+        return _raw(data, _pick(regions, rng), rng) if rng.random() < 0.5 else data
+    if operation == 1:  # one entry compressed with another method, as zipfile writes it
+        name = _pick(list(layout.contents), rng)
+        buffer = io.BytesIO()
+        with zipfile.ZipFile(buffer, "w") as archive:
+            for info in layout.infos:
+                archive.writestr(info.filename, layout.contents[info.filename],
+                                 compress_type=method if info.filename == name else zipfile.ZIP_STORED)
+        return buffer.getvalue()
+    data = bytearray(layout.data)  # a stored entry's method field changed (0 -> 14 is the audit's 2-byte change)
+    value = _pick(_METHODS, rng)
+    entry = int(rng.integers(len(layout.infos)))
+    for offset in ((layout.local[entry][0] + 8,), (layout.central_headers[entry] + 10,),
+                   (layout.local[entry][0] + 8, layout.central_headers[entry] + 10))[rng.integers(3)]:
+        data[offset:offset + 2] = struct.pack("<H", value)
+    return bytes(data)
+
+
+def _npy_length(layout, rng):
+    if rng.random() < 0.5:  # in place: the field of a version 1.0 header (2 bytes), the CRC then wrong
+        data = bytearray(layout.data)
+        start = _pick(layout.npy, rng)[0] + 8
+        data[start:start + 2] = struct.pack("<H", _pick(_HEADER_LENGTHS, rng) & 0xFFFF)
+        return bytes(data)
+    name = _pick(layout.bomb_entries[:2], rng)
+    length = _pick(_HEADER_LENGTHS[-3:], rng)
+    key = name, "length", length
+    if key not in layout.bombs:  # a version 2.0 header claiming `length` bytes, and 4 MB of spaces behind it
+        entry = b"\x93NUMPY\x02\x00" + struct.pack("<I", length) + b" " * (4 * 2 ** 20)
+        layout.bombs[key] = _rezip(layout, {name: entry}, None, zipfile.ZIP_DEFLATED)
+    return layout.bombs[key]
+
+
+def _entry_bomb(layout, rng):
+    """The archive's central directory followed by `count` more entries' headers (empty stored files)."""
+    count = _pick(_ENTRY_COUNTS, rng)
+    if ("entries", count) not in layout.bombs:
+        start, stop = layout.central
+        header = struct.pack("<4s6H3I5H2I", b"PK\x01\x02", 20, 20, 0, 0, 0, 0, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0)
+        extra = b"".join([header + b"e%07d.npy" % k for k in range(count)])
+        directory = layout.data[start:stop] + extra
+        total = len(layout.infos) + count
+        end = b""
+        if total > 0xFFFF:  # zip64 end record and locator, as zipfile writes them
+            end = struct.pack("<4sQ2H2I4Q", b"PK\x06\x06", 44, 45, 45, 0, 0, total, total, len(directory),
+                              start) + struct.pack("<4sIQI", b"PK\x06\x07", 0, start + len(directory), 1)
+        end += struct.pack("<4s4H2IH", b"PK\x05\x06", 0, 0, min(total, 0xFFFF), min(total, 0xFFFF),
+                           min(len(directory), 0xFFFFFFFF), start, 0)
+        layout.bombs["entries", count] = layout.data[:start] + directory + end
+    return layout.bombs["entries", count]
+
+
+def _weight_value(layout, rng):
+    names = [name for name in layout.contents if name != agent_file.METADATA_KEY + ".npy"]
+    name = _pick(names, rng)
+    array = np.load(io.BytesIO(layout.contents[name])).astype(np.float64)
+    value = _pick(_WEIGHT_VALUES, rng)
+    if rng.random() < 0.5:
+        array *= value if abs(value) >= 1 else 1.0
+    else:
+        array.flat[int(rng.integers(array.size))] = value
+    buffer = io.BytesIO()
+    np.save(buffer, array)
+    return _rezip(layout, {name: buffer.getvalue()}, rng)
+
+
 _MUTATORS = {"zip_local": _zip_local, "zip_central": _zip_central, "zip_end": _zip_end, "npy_raw": _npy_raw,
              "metadata_raw": _metadata_raw, "npy_header": _npy_header, "metadata_value": _metadata_value,
-             "metadata_text": _metadata_text_mutation, "deflate_bomb": _deflate_bomb}
+             "metadata_text": _metadata_text_mutation, "deflate_bomb": _deflate_bomb,
+             "compressed_raw": _compressed_raw, "other_method": _other_method, "npy_length": _npy_length,
+             "entry_bomb": _entry_bomb, "weight_value": _weight_value}

@@ -129,11 +129,13 @@ def test_pickled_object_in_place_of_a_weight(tmp_path, exported):
         load_agent_file(rewrite(tmp_path / "pickled_weight.npz", weights, metadata))
 
 
-@pytest.mark.parametrize("bad", [np.nan, np.inf])
-def test_non_finite_weight(tmp_path, exported, bad):
+@pytest.mark.parametrize("bad, named", [(np.nan, "1 NaN value"), (np.inf, "1 infinite value"),
+                                        (-np.inf, "1 infinite value"), (2e4, "values as large as 2e\\+04")])
+def test_non_finite_or_huge_weight_is_named(tmp_path, exported, bad, named):
     weights, metadata = load_agent_file(exported)
     weights["posterior.layers.1.weight"][0, 0] = bad
-    with pytest.raises(RLAnimateError, match=r"NaN or infinite values in posterior\.layers\.1\.weight"):
+    with pytest.raises(RLAnimateError, match=rf"has {named} in posterior\.layers\.1\.weight \(a trained agent's "
+                                             rf"weights are finite and within \+-10000\).*train it again"):
         load_agent_file(rewrite(tmp_path / "nan.npz", weights, metadata))
 
 
@@ -255,7 +257,8 @@ def test_a_deflate_bomb_is_refused_without_inflating_it(tmp_path, exported):
     path.write_bytes(_rezip(exported, {entry: bomb}, zipfile.ZIP_DEFLATED))
     assert path.stat().st_size < 2 * 2 ** 20
     start = time.perf_counter()
-    with pytest.raises(RLAnimateError, match=r"truncated or damaged \(decoder\.layers\.0\.weight declares"):
+    with pytest.raises(RLAnimateError, match=r"truncated or damaged \(entry 'decoder\.layers\.0\.weight\.npy' declares "
+                                             r"268,436,224 bytes, more than any agent's"):
         load_agent_file(path)
     assert time.perf_counter() - start < 0.5
 
