@@ -8,13 +8,16 @@ import datetime
 import json
 import subprocess
 from dataclasses import asdict, is_dataclass
+from pathlib import Path
 
 import numpy as np
 
 from rlanimate_addon.core import agent_file, behaviours, skeleton, spaces
+from trainer import paths
 from trainer.files import atomic_open
-from trainer.paths import REPO_ROOT
 
+#: Entries of the metadata's "training" that are paths on the training machine.
+TRAINING_PATHS = ("clips",)
 #: Average gesture length in frames (30 fps) when the caller gives none: the UI's default length.
 FALLBACK_AVERAGE_FRAMES = dict.fromkeys(behaviours.BEHAVIOURS, 90)
 
@@ -23,7 +26,7 @@ def export_agent(agent, path, metadata=None):
     """Atomically write `agent` (an RLAnimateAgent) to `path` (.npz); returns the full metadata written.
 
     `metadata` may hold: "training" (provenance: clips, seed, epochs, ...; the git commit and date
-    are added), "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each
+    are added, and the clips' path is recorded relative to the repository, or as its file name), "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each
     behaviour trained, the mean length of its training clips), "wave_rhythm" (a
     core.rhythm.RhythmModel's dict, or None: the paper's wave objective), "action_bounds" ((45, 2), default the
     spaces' bounds), and any other JSON-serialisable entries (kept as given).
@@ -43,7 +46,7 @@ def export_agent(agent, path, metadata=None):
                 "required_bones": list(skeleton.REQUIRED_BONES)},
         "average_frames": {k: float(v) for k, v in extra.pop("average_frames", FALLBACK_AVERAGE_FRAMES).items()},
         "wave_rhythm": extra.pop("wave_rhythm", None),
-        "training": {"git_commit": _git_commit(), "date": _now(), **extra.pop("training", {})},
+        "training": _training(extra.pop("training", {})),
         **extra,
     }
     arrays = {name: tensor.detach().cpu().numpy().astype(np.float32)
@@ -52,6 +55,21 @@ def export_agent(agent, path, metadata=None):
     with atomic_open(path) as handle:
         np.savez(handle, **arrays)
     return full
+
+
+def _training(training):
+    """The provenance entry: the git commit and date added, and the paths among `training` (TRAINING_PATHS)
+    as recorded_path gives them."""
+    recorded = {key: recorded_path(value) if key in TRAINING_PATHS and value is not None else value
+                for key, value in training.items()}
+    return {"git_commit": _git_commit(), "date": _now(), **recorded}
+
+
+def recorded_path(path):
+    """A training path as an agent file records it: relative to the repository when inside it, else the
+    file's name alone, so that no agent carries the folders of the machine it was trained on."""
+    shown = paths.shown(path)
+    return (Path(shown.name) if shown.is_absolute() else shown).as_posix()
 
 
 def _json_value(value):
@@ -72,7 +90,7 @@ def _spaces():
 
 def _git_commit():
     try:
-        result = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO_ROOT, capture_output=True, text=True,
+        result = subprocess.run(["git", "rev-parse", "HEAD"], cwd=paths.REPO_ROOT, capture_output=True, text=True,
                                 timeout=10)
     except (OSError, subprocess.TimeoutExpired):
         return None

@@ -8,9 +8,11 @@ import torch
 from rlanimate_addon.core import agent_file, skeleton, spaces
 from rlanimate_addon.core.agent_file import load_agent_file
 from trainer.agent.agent_export import export_agent
-from trainer.agent.config import load_preset
+from trainer.agent.config import AgentConfig, load_preset
 from trainer.agent.models import VARIANTS, RLAnimateAgent
-from trainer.paths import INSTALLED_AGENT
+from trainer.experiments.run import NEW_RUN_DEFAULTS
+from trainer.motion.manifest import manifest_path
+from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, REPO_ROOT
 
 torch.set_num_threads(1)
 
@@ -68,3 +70,40 @@ def test_the_shipped_default_agent_loads():
     weights, metadata = load_agent_file(INSTALLED_AGENT)
     assert metadata["variant"] in VARIANTS
     assert (INSTALLED_AGENT).stat().st_size < 2_000_000
+
+
+@pytest.mark.parametrize("clips, recorded", [(str(DEFAULT_MANIFEST), "sample_rigs/clips/manifest.json"),
+                                             ("/home/ann/mocap/library/manifest.json", "manifest.json"),
+                                             (None, None)])
+def test_training_paths_are_recorded_relative_to_the_repository_or_as_a_file_name(tmp_path, clips, recorded):
+    path = tmp_path / "agent.npz"
+    metadata = export_agent(RLAnimateAgent(load_preset("debug")[0]), path, {"training": {"clips": clips, "seed": 1}})
+    assert metadata["training"]["clips"] == recorded
+    assert load_agent_file(path)[1]["training"] == metadata["training"]
+    text = json.dumps(metadata)
+    assert str(REPO_ROOT) not in text and "/home/ann" not in text
+
+
+def test_the_shipped_agent_is_what_the_readme_run_exports_and_names_no_machine_path(tmp_path):
+    """Exporting the shipped weights with the metadata the README's training run gives (run.py's
+    defaults, the clips' manifest as its report records it) writes the shipped file again: every array
+    bit for bit, the metadata equal but for the git commit and the date of the run."""
+    weights, shipped = load_agent_file(INSTALLED_AGENT)
+    assert "/" + str(REPO_ROOT).split("/")[1] not in json.dumps(shipped), "the shipped metadata names no machine path"
+    agent = RLAnimateAgent(AgentConfig.from_dict(shipped["agent_config"]), shipped["variant"])
+    agent.load_state_dict({name: torch.from_numpy(array) for name, array in weights.items()})
+    training = {key: shipped["training"][key] for key in ("behaviour", "variant", "preset", "seed", "epochs",
+                                                          "episodes", "train_seconds")}
+    training["clips"] = str(manifest_path(NEW_RUN_DEFAULTS["clips"]))  # as run.py's report records it
+    path = tmp_path / "agent.npz"
+    written = export_agent(agent, path, {
+        "training": training, "train_config": shipped["train_config"], "action_bounds": shipped["action_bounds"],
+        "average_frames": shipped["average_frames"], "wave_rhythm": shipped["wave_rhythm"],
+        "evaluation": shipped["evaluation"]})
+    for metadata in (written, shipped):
+        metadata["training"] = {k: v for k, v in metadata["training"].items() if k not in ("git_commit", "date")}
+    assert written == shipped
+    with np.load(path) as new, np.load(INSTALLED_AGENT) as old:
+        assert new.files == old.files
+        assert all(new[name].dtype == old[name].dtype and new[name].tobytes() == old[name].tobytes()
+                   for name in old.files if name != agent_file.METADATA_KEY)
