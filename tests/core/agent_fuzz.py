@@ -354,22 +354,27 @@ def _npy_length(layout, rng):
 
 
 def _entry_bomb(layout, rng):
-    """The archive's central directory followed by `count` more entries' headers (empty stored files)."""
     count = _pick(_ENTRY_COUNTS, rng)
     if ("entries", count) not in layout.bombs:
-        start, stop = layout.central
-        header = struct.pack("<4s6H3I5H2I", b"PK\x01\x02", 20, 20, 0, 0, 0, 0, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0)
-        extra = b"".join([header + b"e%07d.npy" % k for k in range(count)])
-        directory = layout.data[start:stop] + extra
-        total = len(layout.infos) + count
-        end = b""
-        if total > 0xFFFF:  # zip64 end record and locator, as zipfile writes them
-            end = struct.pack("<4sQ2H2I4Q", b"PK\x06\x06", 44, 45, 45, 0, 0, total, total, len(directory),
-                              start) + struct.pack("<4sIQI", b"PK\x06\x07", 0, start + len(directory), 1)
-        end += struct.pack("<4s4H2IH", b"PK\x05\x06", 0, 0, min(total, 0xFFFF), min(total, 0xFFFF),
-                           min(len(directory), 0xFFFFFFFF), start, 0)
-        layout.bombs["entries", count] = layout.data[:start] + directory + end
+        layout.bombs["entries", count] = with_empty_entries(layout.data, count)
     return layout.bombs["entries", count]
+
+
+def with_empty_entries(data, count):
+    """The archive `data` (no comment) with `count` more empty entries in its central directory, and
+    zip64 end records, as zipfile writes them, past 65,535 entries."""
+    end = len(data) - 22
+    entries, size, offset = struct.unpack_from("<HII", data, end + 10)
+    header = struct.pack("<4s6H3I5H2I", b"PK\x01\x02", 20, 20, 0, 0, 0, 0, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0)
+    directory = data[offset:offset + size] + b"".join([header + b"e%07d.npy" % k for k in range(count)])
+    total = entries + count
+    tail = b""
+    if total > 0xFFFF:
+        tail = struct.pack("<4sQ2H2I4Q", b"PK\x06\x06", 44, 45, 45, 0, 0, total, total, len(directory), offset) + \
+            struct.pack("<4sIQI", b"PK\x06\x07", 0, offset + len(directory), 1)
+    tail += struct.pack("<4s4H2IH", b"PK\x05\x06", 0, 0, min(total, 0xFFFF), min(total, 0xFFFF), len(directory),
+                        offset, 0)
+    return data[:offset] + directory + tail
 
 
 def _weight_value(layout, rng):

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import agent_fuzz
 from rlanimate_addon.core import agent_file, runtime
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -98,38 +99,22 @@ def test_an_npy_header_length_field_claiming_gigabytes_is_refused_before_numpy_r
                    r"more than 10,000\): export or copy it again")
 
 
-def _with_empty_entries(data, count):
-    """The archive `data` with `count` more empty entries in its central directory (zip64 past 65,535)."""
-    end = len(data) - 22
-    size, offset = struct.unpack_from("<II", data, end + 12)
-    header = struct.pack("<4s6H3I5H2I", b"PK\x01\x02", 20, 20, 0, 0, 0, 0, 0, 0, 0, 12, 0, 0, 0, 0, 0, 0)
-    directory = data[offset:offset + size] + b"".join([header + b"e%07d.npy" % k for k in range(count)])
-    total = len(_contents(data)) + count
-    tail = b""
-    if total > 0xFFFF:
-        tail = struct.pack("<4sQ2H2I4Q", b"PK\x06\x06", 44, 45, 45, 0, 0, total, total, len(directory), offset) + \
-            struct.pack("<4sIQI", b"PK\x06\x07", 0, offset + len(directory), 1)
-    tail += struct.pack("<4s4H2IH", b"PK\x05\x06", 0, 0, min(total, 0xFFFF), min(total, 0xFFFF), len(directory),
-                        offset, 0)
-    return data[:offset] + directory + tail
-
-
 def test_an_archive_of_65535_entries_is_refused_from_its_end_record(tmp_path, shipped):
     path = tmp_path / "entries.npz"
-    path.write_bytes(_with_empty_entries(shipped, 0xFFFF - 39))
+    path.write_bytes(agent_fuzz.with_empty_entries(shipped, 0xFFFF - 39))
     _refused(path, r"declares 65,535 entries in a 3,[0-9,]+-byte directory, more than any agent \(1,024 entries "
                    r"in 262,144 bytes at most\): choose a \.npz written by trainer/agent/agent_export\.py")
 
 
 def test_an_archive_of_a_million_entries_is_refused_from_its_end_record(tmp_path, shipped):
     path = tmp_path / "entries.npz"
-    path.write_bytes(_with_empty_entries(shipped, 1_000_000))
+    path.write_bytes(agent_fuzz.with_empty_entries(shipped, 1_000_000))
     _refused(path, r"is a zip64 archive, made for more entries or bytes than any agent has: choose a \.npz")
 
 
 def test_a_large_directory_of_few_entries_is_refused_too(tmp_path, shipped):
     """zipfile parses the central directory by its size, whatever the count says."""
-    data = bytearray(_with_empty_entries(shipped, 20_000))
+    data = bytearray(agent_fuzz.with_empty_entries(shipped, 20_000))
     data[-14:-10] = struct.pack("<2H", 39, 39)  # the end record claims the original 39 entries
     path = tmp_path / "entries.npz"
     path.write_bytes(bytes(data))
