@@ -14,7 +14,6 @@ variant has; the torch model, the exporter and the numpy runtime all agree with 
 import contextlib
 import io
 import json
-import lzma
 import math
 import struct
 import tokenize
@@ -27,6 +26,11 @@ import numpy as np
 
 from . import behaviours, rhythm, spaces
 from .errors import RLAnimateError
+
+try:
+    from lzma import LZMAError as _LZMAError
+except ImportError:  # a Python built without lzma, whose zipfile cannot inflate LZMA either
+    _LZMAError = zlib.error
 
 FORMAT_NAME = "rlanimate-agent"
 #: 2: waves' objectives carry their rhythm (core/rhythm.py) and the file its `wave_rhythm` model.
@@ -138,11 +142,11 @@ MAX_CONFIG_SCALAR = 1e6
 MAX_ABS_WEIGHT = 1e4
 #: Any number of the wave_rhythm model (exaggerations, frequencies, fractions, phase, ramp, bandwidth).
 MAX_RHYTHM_VALUE = 1e3
-#: What a hostile archive can raise from zipfile, zlib and numpy's npy header parser (ast, tokenize,
+#: What a hostile archive can raise from zipfile, its decompressors and numpy's npy header parser (ast, tokenize,
 #: dtype) before a check of ours sees it: `_unreadable` turns each into an RLAnimateError.
 _UNREADABLE = (OSError, EOFError, ValueError, TypeError, KeyError, IndexError, OverflowError, MemoryError,
                RecursionError, SyntaxError, NotImplementedError, RuntimeError, zipfile.BadZipFile, zlib.error,
-               lzma.LZMAError, struct.error, tokenize.TokenError)
+               _LZMAError, struct.error, tokenize.TokenError)
 _NPY = ".npy"
 _NPY_MAGIC = b"\x93NUMPY"
 #: Zip compression methods an agent may use: numpy.savez stores, numpy.savez_compressed deflates.
