@@ -54,7 +54,8 @@ def _entries(data):
     return bytes(data)
 
 
-@pytest.mark.parametrize("make, problem", [(_lzma, "zip method 14 (LZMA)"), (_header_bomb, "claims 4,294,967,295 bytes"),
+@pytest.mark.parametrize("make, problem", [(_lzma, "zip method 14 (LZMA)"),
+                                           (_header_bomb, "claims 4,294,967,295 bytes"),
                                            (_huge, "values as large as"), (_entries, "65,535 entries")],
                          ids=["lzma", "header_length", "1e300", "entry_count"])
 def test_a_bad_agent_file_keeps_the_panel_with_generate_and_export(settings, tmp_path, make, problem):

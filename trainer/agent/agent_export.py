@@ -26,10 +26,11 @@ def export_agent(agent, path, metadata=None):
     """Atomically write `agent` (an RLAnimateAgent) to `path` (.npz); returns the full metadata written.
 
     `metadata` may hold: "training" (provenance: clips, seed, epochs, ...; the git commit and date
-    are added, and the clips' path is recorded relative to the repository, or as its file name), "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each
-    behaviour trained, the mean length of its training clips), "wave_rhythm" (a
-    core.rhythm.RhythmModel's dict, or None: the paper's wave objective), "action_bounds" ((45, 2), default the
-    spaces' bounds), and any other JSON-serialisable entries (kept as given).
+    are added, and the clips' path is recorded relative to the repository, or as its file name),
+    "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each behaviour
+    trained, the mean length of its training clips), "wave_rhythm" (a core.rhythm.RhythmModel's dict,
+    or None: the paper's wave objective), "action_bounds" ((45, 2), default the spaces' bounds), and
+    any other JSON-serialisable entries (kept as given).
     """
     extra = dict(metadata or {})
     bounds = np.asarray(extra.pop("action_bounds", spaces.DEFAULT_ACTION_BOUNDS), dtype=np.float64)
