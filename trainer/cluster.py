@@ -1,12 +1,13 @@
 """Ray, the engine that runs training runs and clip imports side by side: on this machine by default, or
-on a cluster that `ray start` made (docs/TRAINING.md, "Many machines").
+on a cluster that `ray start` made (docs/TRAINING.md, "Many runs, many machines").
 
-`connect()` starts a local Ray with no set-up (`address` None) or joins a cluster (`"auto"`: the one
-started on this machine; `"ray://HOST:PORT"`: a remote head). `run_tasks(function, arguments)` runs
-`function(argument)` for each argument as a Ray task, one CPU and a fresh worker process each (so each
-has its own bpy and torch state, as the processes of a serial run would), and yields (argument, result)
-as they finish. Every node needs the repository at the same path: the workers import `trainer` from it.
-Ray's own logs stay in its session folder: nothing of it reaches the terminal but warnings.
+`connect()` starts a local Ray with no set-up (`address` None; never a cluster that happens to run here)
+or joins a cluster (`"auto"`: the one `ray start` made on this machine; `"HOST:PORT"`; `"ray://HOST:PORT"`:
+a remote head through Ray Client). `run_tasks(function, arguments)` runs `function(argument)` for each
+argument as a Ray task, one CPU and a fresh worker process each (so each has its own bpy and torch
+state, as the processes of a serial run would), and yields (argument, result) as they finish. Every
+node needs the repository at the same path: the workers import `trainer` from it. Ray's own logs stay
+in its session folder: nothing of it reaches the terminal but errors.
 """
 import logging
 import os
@@ -29,7 +30,7 @@ def connect(address: str | None = None, workers: int | None = None) -> None:
         options.update(num_cpus=workers, include_dashboard=False)
     else:
         options.update(runtime_env={"env_vars": {"PYTHONPATH": str(REPO_ROOT)}})
-    ray.init(address=address, **options)
+    ray.init(address=address or "local", **options)  # "local": a new Ray even when `ray start` made one here
 
 
 def run_tasks(function: Callable[[Any], Any], arguments: Iterable[Any]) -> Iterator[tuple[Any, Any]]:

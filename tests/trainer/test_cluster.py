@@ -1,9 +1,6 @@
 """Ray tasks (trainer/cluster.py) give what the serial code gives: a training run on a Ray worker is bit for
 bit the run trained in this process, and clips imported by two Blenders at once are the serial import's,
 in the same cache."""
-import json
-import shutil
-
 import numpy as np
 import pytest
 
@@ -11,22 +8,8 @@ from trainer.blender_io.clip_import import import_clip_directory
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect
 from trainer.experiments.run import RunSettings, train, train_runs
-from trainer.paths import CLIP_DIR, DEFAULT_MANIFEST
 
 ray = pytest.importorskip("ray", reason="Ray is a trainer dependency: pip install ray")
-
-
-@pytest.fixture(scope="module")
-def tiny_library(tmp_path_factory):
-    """Two training clips and one held-out clip per behaviour of the sample library, in a folder of their own."""
-    folder = tmp_path_factory.mktemp("clips")
-    entries = json.loads(DEFAULT_MANIFEST.read_text())["clips"]
-    chosen = [e for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
-              for e in [f for f in entries if f["behaviour"] == behaviour and f["split"] == split][:count]]
-    for entry in chosen:
-        shutil.copyfile(CLIP_DIR / entry["file"], folder / entry["file"])
-    (folder / "manifest.json").write_text(json.dumps({"fps": 30, "clips": chosen}))
-    return folder / "manifest.json"
 
 
 @pytest.fixture(scope="module")
