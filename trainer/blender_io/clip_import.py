@@ -3,13 +3,16 @@
     import_clip(path)                       -> MotionClip (raises RLAnimateError naming file and fix)
     import_clip_directory(dir_or_manifest)  -> (clips, problems): goes on past bad files
     load_clip_set(manifest_path)            -> ClipSet with the manifest's labels and split
+    import_into_cache(files, cache_dir, N)  -> the files the cache lacks imported as N Ray tasks at once
 
 A clip's `rotvecs` (F, 15, 3) are local rotations of skeleton.ACTION_JOINTS relative to the canonical
 rest frames (the action space before its [0, 1] mapping); `fingers` holds the other hand bones when the
 source has them. Bone names go through core.bone_maps (Mixamo with any `prefix:`, Bandai Namco);
 trainer/motion/canonicalise.py turns the source's world bone frames into canonical local rotations.
 Imported clips are cached (trainer/motion/clip_cache.py) in a git-ignored `.import_cache/` beside the
-clips; manifests are read by trainer/motion/manifest.py.
+clips; manifests are read by trainer/motion/manifest.py. With `workers` > 1 the files the cache lacks are
+imported first by Ray tasks (trainer/cluster.py), each worker with its own Blender, into the same cache;
+the clips are then read from it, so they are the serial import's.
 """
 import io
 import sys
@@ -22,6 +25,7 @@ from tqdm import tqdm
 from rlanimate_addon.core import bone_maps, rotations, skeleton
 from rlanimate_addon.core.errors import RLAnimateError, operator_error_reason
 from trainer.blender_io import rig_session
+from trainer.cluster import connect, run_tasks
 from trainer.motion import canonicalise, clip_cache
 from trainer.motion.clip import ClipSet, MotionClip
 from trainer.motion.manifest import ManifestEntry, checked_entries, labelled, read_manifest
@@ -311,8 +315,7 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
     path = Path(path)
     if cache_dir is None or not path.is_file():
         return _import_uncached(path, float(expected_fps), bone_map)
-    map_tag = "auto" if bone_map is None else bone_map.name.replace(" ", "_")
-    cache_file = Path(cache_dir) / f"{clip_cache.file_hash(path)}_{map_tag}_{float(expected_fps):g}.npz"
+    cache_file = _cache_file(path, expected_fps, bone_map, cache_dir)
     if cache_file.is_file():
         try:
             return clip_cache.load_cached(cache_file, path)
@@ -326,13 +329,45 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
     return clip
 
 
-def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, progress=None):
+def _cache_file(path, expected_fps, bone_map, cache_dir):
+    map_tag = "auto" if bone_map is None else bone_map.name.replace(" ", "_")
+    return Path(cache_dir) / f"{clip_cache.file_hash(path)}_{map_tag}_{float(expected_fps):g}.npz"
+
+
+def import_into_cache(files: list[tuple[Path, float]], cache_dir: Path, workers: int) -> int:
+    """Import the clip files (path, fps) that `cache_dir` lacks as `workers` Ray tasks, each a share of the
+    files in a Blender of its own (a local Ray, or the cluster this process joined); returns how many
+    were missing. A file that fails here is imported again, and its problem reported, by the caller's
+    serial pass."""
+    missing = [(str(path), float(fps)) for path, fps in files
+               if Path(path).is_file() and not _cache_file(Path(path), fps, None, cache_dir).is_file()]
+    if missing:
+        connect(workers=workers)
+        shares = [(missing[k::workers], str(cache_dir)) for k in range(min(workers, len(missing)))]
+        for _ in run_tasks(_import_share, shares):
+            pass
+    return len(missing)
+
+
+def _import_share(share):
+    """Import (path, fps) files into the cache folder, quietly, skipping the ones that fail: a Ray task."""
+    files, cache_dir = share
+    with rig_session.blender_output():
+        for path, fps in files:
+            try:
+                import_clip(path, fps, cache_dir=cache_dir)
+            except RLAnimateError:
+                pass
+
+
+def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, progress=None, workers=1):
     """Import every clip of a directory (its manifest.json when it has one, else every .fbx/.bvh) or
     of a manifest file. Returns (clips, problems): the clips that imported, and one message per file
     that did not. Clips listed in a manifest carry its labels. cache_dir: where imported clips are
     cached (default: `.import_cache/` beside a manifest; no cache for a folder without one, so that
     shared data folders stay untouched); False imports afresh without caching. progress: a stream to
-    show a progress bar on (None: no bar)."""
+    show a progress bar on (None: no bar). workers > 1: the files the cache lacks are imported first as
+    that many Ray tasks (import_into_cache); the clips are the same."""
     path = Path(path_or_manifest)
     manifest_path = path / "manifest.json" if path.is_dir() and (path / "manifest.json").is_file() else path
     if manifest_path.is_file() and manifest_path.suffix.lower() == ".json":
@@ -349,6 +384,8 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
     if cache_dir is None:  # cache beside a manifest's clips; never write into a plain folder such as
         cache_dir = folder / clip_cache.CACHE_DIR_NAME if manifest_path is not None else False  # ../shared/realmocap
     cache = Path(cache_dir) if cache_dir else None
+    if cache is not None and workers > 1:
+        import_into_cache([(folder / entry.file, entry.fps) for entry in entries], cache, workers)
     clips = []
     for entry in tqdm(entries, desc="clips", unit="clip", file=progress, disable=progress is None, leave=False,
                       dynamic_ncols=True):
@@ -389,11 +426,11 @@ def _no_library(path):
     return RLAnimateError(f"{path} does not exist: use a clip library's manifest.json or the folder that holds it.")
 
 
-def load_clip_set(manifest_path, progress=None):
+def load_clip_set(manifest_path, progress=None, workers=1):
     """The labelled clip library of `manifest_path` (or of the directory holding manifest.json), with a
     progress bar on the stream `progress` (None: none). Bad files are listed in ClipSet.problems; raises
-    RLAnimateError when none imports."""
-    clips, problems = import_clip_directory(manifest_path, progress=progress)
+    RLAnimateError when none imports. workers > 1: import what the cache lacks as Ray tasks first."""
+    clips, problems = import_clip_directory(manifest_path, progress=progress, workers=workers)
     if not clips:
         raise RLAnimateError(f"{manifest_path}: no clip could be imported ({len(problems)} problems: "
                              f"{'; '.join(problems[:3])}). Regenerate the clip library.")

@@ -21,7 +21,7 @@ from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
 from trainer.evaluation.baselines import AgentMethod
-from trainer.experiments.run import RunSettings, train
+from trainer.experiments.run import RunSettings, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, shown
 from trainer.reporting.tables import markdown_table
@@ -51,6 +51,8 @@ class AblationSettings:
     results: str = str(RESULTS_DIR)
     targets: int = 100  # random pointing targets per arm
     only: tuple[str, ...] = ()  # train and measure only these; the other rows stay as agent_ablation.json has them
+    address: str | None = None  # a Ray cluster to join for the training runs; None: a local Ray
+    workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
 
 
 def describe(rotvecs):
@@ -122,17 +124,19 @@ def run_ablation(settings: AblationSettings) -> str:
     """Train the unfinished ablations of `settings` (all, or `only`), measure them, and write
     agent_ablation.json and .md into `settings.results`; returns the markdown."""
     torch.set_num_threads(1)
+    names = settings.only or tuple(ABLATIONS)
+    untrained = [RunSettings(str(Path(settings.runs) / name), behaviour=ABLATIONS[name][0], preset=ABLATIONS[name][1],
+                             variant=ABLATIONS[name][2], eval_every=0, progress=False)
+                 for name in names if not (Path(settings.runs) / name / "report.json").is_file()]
+    for run, _ in train_runs(untrained, settings.address, settings.workers):
+        print(f"trained {Path(run.output).name}", flush=True)
     session = LibrarySession(DEFAULT_MANIFEST)
     results_dir = Path(settings.results)
     results_json = results_dir / "agent_ablation.json"
     results = json.loads(results_json.read_text()) if settings.only and results_json.is_file() else {}
-    for name in settings.only or ABLATIONS:
-        behaviour_name, preset, variant, _ = ABLATIONS[name]
+    for name in names:
         output = Path(settings.runs) / name
-        if not (output / "report.json").is_file():
-            train(RunSettings(str(output), behaviour=behaviour_name, preset=preset, variant=variant, eval_every=0,
-                              progress=False), session)
-        results[name] = measure(output / "agent.npz", behaviour_name, session, settings.targets)
+        results[name] = measure(output / "agent.npz", ABLATIONS[name][0], session, settings.targets)
         print(name, json.dumps(results[name]["held_out"]), flush=True)
     results = {name: results[name] for name in ABLATIONS if name in results}
     command = f"nice -n 10 python -m trainer.scripts.agent_ablation --runs {shown(settings.runs)}"

@@ -1,12 +1,9 @@
-"""The paper's Section 4 experiments: one training run per (seed, variant, column), each in its own
-process, then Table 4 (mean ± sd over seeds, with the baselines and the behaviour metrics, on the held-out
+"""The paper's Section 4 experiments: one training run per (seed, variant, column), each a Ray task
+(trainer/cluster.py), then Table 4 (mean ± sd over seeds, with the baselines and the behaviour metrics, on the held-out
 and the harder split), Figure 3 and length flexibility from the finished runs: `run_paper(PaperSettings)`
 (`python -m trainer.scripts.experiments` builds the settings from its command line).
 """
 import json
-import subprocess
-import sys
-import time
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,6 +19,7 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.evaluation import behaviour, scoring
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.evaluation.harder_split import harder_clips
+from trainer.experiments.run import RunSettings, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, seed_folder
 from trainer.reporting import plots
@@ -47,7 +45,8 @@ class PaperSettings:
     results: str = str(RESULTS_DIR)
     eval_every: int = 5
     seeds: tuple[int, ...] = (0, 1, 2)
-    jobs: int = 1  # training runs at a time, one process each
+    address: str | None = None  # a Ray cluster to join ("auto", "ray://HOST:PORT"); None: a local Ray
+    workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
     skip_training: bool = False  # report the runs that finished, train none
 
 
@@ -65,38 +64,21 @@ def is_finished(folder, epochs):
     return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
 
 
-def train_command(settings, seed, variant, column):
+def run_settings(settings: PaperSettings, seed: int, variant: str, column: str) -> RunSettings:
+    """The training run of (seed, variant, column), resumed from its checkpoint when it has one."""
     folder = run_folder(settings, seed, variant, column)
-    command = [sys.executable, "-m", "trainer.scripts.train", "--behaviour", column,
-               "--variant", variant, "--preset", settings.preset, "--clips", settings.clips,
-               "--epochs", str(planned_epochs(settings, column)), "--seed", str(seed),
-               "--output", str(folder), "--eval-every", str(settings.eval_every), "--quiet"]
-    return command + (["--resume"] if (folder / checkpoint.FILENAME).is_file() else [])
+    return RunSettings(output=str(folder), behaviour=column, clips=settings.clips,
+                       epochs=planned_epochs(settings, column), seed=seed, preset=settings.preset, variant=variant,
+                       eval_every=settings.eval_every, resume=(folder / checkpoint.FILENAME).is_file(), progress=False)
 
 
-def train_all(settings):
-    """Run every unfinished (seed, variant, column), --jobs processes at a time; raise if one fails."""
-    pending = [(s, v, c) for s in settings.seeds for v in settings.variants for c in settings.columns
-               if not is_finished(run_folder(settings, s, v, c), planned_epochs(settings, c))]
-    running = []
-    while pending or running:
-        while pending and len(running) < settings.jobs:
-            seed, variant, column = pending.pop(0)
-            folder = run_folder(settings, seed, variant, column)
-            folder.mkdir(parents=True, exist_ok=True)
-            log = open(folder / "train.log", "w")
-            running.append((seed, variant, column, log, subprocess.Popen(
-                train_command(settings, seed, variant, column), stdout=log, stderr=subprocess.STDOUT, cwd=REPO_ROOT)))
-        time.sleep(1.0)
-        for entry in list(running):
-            seed, variant, column, log, process = entry
-            if process.poll() is not None:
-                log.close()
-                running.remove(entry)
-                if process.returncode != 0:
-                    raise RuntimeError(f"{variant} {column} seed {seed} failed: see "
-                                       f"{run_folder(settings, seed, variant, column)}/train.log")
-                print(f"finished {variant} {column} seed {seed}", flush=True)
+def train_all(settings: PaperSettings) -> None:
+    """Train every unfinished (seed, variant, column) as a Ray task (trainer/cluster.py); each writes its
+    outputs and its train.log into its folder. Raises RuntimeError when a run fails."""
+    pending = [run_settings(settings, s, v, c) for s in settings.seeds for v in settings.variants
+               for c in settings.columns if not is_finished(run_folder(settings, s, v, c), planned_epochs(settings, c))]
+    for run, _ in train_runs(pending, settings.address, settings.workers):
+        print(f"finished {run.variant} {run.behaviour} seed {run.seed}", flush=True)
 
 
 def load_run(folder):

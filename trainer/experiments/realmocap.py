@@ -29,7 +29,7 @@ import torch
 from rlanimate_addon.core import behaviours, skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
-from trainer.blender_io.clip_import import import_clip
+from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip, import_into_cache
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.procedural_ik import ProceduralIK
@@ -58,9 +58,12 @@ def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache"):
     return clip
 
 
-def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_cache"):
-    """Every clip of root/folder ('wave', 'bye' or 'guide'), sorted by name."""
+def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_cache", import_workers=1):
+    """Every clip of root/folder ('wave', 'bye' or 'guide'), sorted by name; import_workers > 1: the takes
+    the cache lacks are imported by that many Ray tasks first (clip_import.import_into_cache)."""
     paths = sorted((require_realmocap(root) / folder).glob("*.bvh"))
+    if import_workers > 1:
+        import_into_cache([(p, EXPECTED_FPS) for p in paths], Path(cache_dir), import_workers)
     return [import_real_clip(p, cache_dir) for p in paths]
 
 
@@ -181,6 +184,7 @@ class RealMocapSettings:
     point_agent: str | None = None  # exported pointing agent for the guide clips (None: see point_agent_and_library)
     runs: str = str(REALMOCAP_RUNS)
     results: str = str(RESULTS_DIR)  # where realmocap_frames.png goes
+    import_workers: int = 1  # import the takes the cache lacks with this many Blenders at once (Ray tasks)
 
 
 def run_experiments(settings: RealMocapSettings) -> dict:
@@ -192,7 +196,7 @@ def run_experiments(settings: RealMocapSettings) -> dict:
     Path(settings.results).mkdir(parents=True, exist_ok=True)
     cache = Path(settings.runs) / "import_cache"
     with blender_output():
-        waves, byes, guides = (load_folder(f, root, cache) for f in ("wave", "bye", "guide"))
+        waves, byes, guides = (load_folder(f, root, cache, settings.import_workers) for f in ("wave", "bye", "guide"))
         env = FKEnvironment()
     references = ClipReferences(env)
     seeds = list(dict.fromkeys(settings.seeds))

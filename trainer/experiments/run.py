@@ -4,11 +4,16 @@ its checkpoint, metrics, report and training curves into the run's output folder
 Outputs in `output`: agent.npz, checkpoint.pt (every `checkpoint_every` epochs, atomically),
 metrics.jsonl, report.json, report.md, training_curves.png, and tensorboard/ when TensorBoard is
 installed. A resumed run takes its settings from its checkpoint and continues bit for bit.
+`train_runs` trains several runs of the sample-library kind as Ray tasks (trainer/cluster.py), each on its
+own LibrarySession and pinned to one torch thread, so each is bit for bit the run `train` makes alone.
 """
 import json
+import os
 import random
 import sys
 import tempfile
+from collections.abc import Iterable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -24,6 +29,8 @@ from trainer.agent.agent_export import export_agent
 from trainer.agent.algorithm import Trainer
 from trainer.agent.config import PRESETS, load_preset
 from trainer.agent.models import RLAnimateAgent
+from trainer.blender_io.clip_session import LibrarySession
+from trainer.cluster import connect, run_tasks
 from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
 from trainer.motion.manifest import manifest_path
 from trainer.paths import DEFAULT_MANIFEST
@@ -245,3 +252,40 @@ def _agent_metadata(report, trainer):
             "evaluation": {} if report["held_out"] is None else {  # {}: no held-out clips
                 "held_out_score": report["held_out"]["score"], "held_out_smoothness": report["held_out"]["smoothness"]}}
 
+
+def train_logged(settings: RunSettings) -> dict:
+    """`train` on a LibrarySession of `settings.clips`, everything it prints (Blender's too) going to
+    train.log in the run's folder; returns the report. What a Ray task of `train_runs` runs."""
+    output = Path(settings.output)
+    output.mkdir(parents=True, exist_ok=True)
+    with _output_to(output / "train.log"):
+        return train(settings, LibrarySession(settings.clips))[0]
+
+
+def train_runs(runs: Iterable[RunSettings], address: str | None = None,
+               workers: int | None = None) -> Iterator[tuple[RunSettings, dict]]:
+    """(settings, report) of each run, trained as Ray tasks on a local Ray of `workers` CPUs or on the
+    cluster at `address` (trainer/cluster.py), in the order they finish."""
+    runs = list(runs)
+    if runs:
+        connect(address, workers)
+        yield from run_tasks(train_logged, runs)
+
+
+@contextmanager
+def _output_to(path):
+    """File descriptors 1 and 2 (Python's prints and Blender's) into `path` for the duration."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    with open(path, "w") as log:
+        os.dup2(log.fileno(), 1)
+        os.dup2(log.fileno(), 2)
+        try:
+            yield
+        finally:
+            sys.stdout.flush()
+            sys.stderr.flush()
+            for descriptor, copy in zip((1, 2), saved):
+                os.dup2(copy, descriptor)
+                os.close(copy)

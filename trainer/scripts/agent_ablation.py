@@ -22,8 +22,13 @@ def parse_settings(argv=None):
     parser.add_argument("--targets", type=int, default=DEFAULTS.targets, help="random pointing targets per arm")
     parser.add_argument("--only", nargs="*", choices=sorted(ABLATIONS),
                         help="train and measure only these; the other rows stay as agent_ablation.json has them")
+    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
+                        help="a local Ray's training runs at a time (default: one per CPU)")
+    parser.add_argument("--address", default=DEFAULTS.address,
+                        help="join a Ray cluster: auto or ray://HOST:PORT (default: a local Ray)")
     args = parser.parse_args(script_args(argv))
-    return AblationSettings(runs=args.runs, results=args.results, targets=args.targets, only=tuple(args.only or ()))
+    return AblationSettings(runs=args.runs, results=args.results, targets=args.targets, only=tuple(args.only or ()),
+                            address=args.address, workers=args.workers)
 
 
 def main(argv=None):

@@ -2,11 +2,12 @@
 behaviour metrics, on the held-out and a harder split), Figure 3 and length flexibility.
 
     nice -n 10 python -m trainer.scripts.experiments [--preset default] [--epoch-scale 1.0] [--seeds 0 1 2]
-                                                    [--jobs 2] [--skip-training]
+                                                    [--workers 2 | --address auto] [--skip-training]
 
 Trains the four variants (RLAnimate and its three ablations) on each column (wave, point, both)
-for the paper's 50 / 100 epochs times --epoch-scale, for each seed, each run by `trainer.scripts.train`
-in its own process, --jobs at a time, into runs/experiments/<variant>_<column>/ (seed 0) and
+for the paper's 50 / 100 epochs times --epoch-scale, for each seed, each run a Ray task: on a local Ray,
+--workers at a time (default one per CPU), or on the cluster --address joins (docs/TRAINING.md), into
+runs/experiments/<variant>_<column>/ (seed 0) and
 runs/experiments_seed<N>/<variant>_<column>/. Runs that already finished are kept and interrupted ones
 resume from their checkpoints; --skip-training reports the finished runs only. Then every finished run's
 agent and the baselines (no motion, class mean, nearest clip, procedural IK) answer the library's held-out
@@ -43,7 +44,11 @@ def build_parser():
     parser.add_argument("--results", default=DEFAULTS.results)
     parser.add_argument("--eval-every", type=int, default=DEFAULTS.eval_every)
     parser.add_argument("--seeds", type=int, nargs="+", default=list(DEFAULTS.seeds))
-    parser.add_argument("--jobs", type=int, default=DEFAULTS.jobs, help="training runs at a time, one process each")
+    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
+                        help="a local Ray's training runs at a time (default: one per CPU)")
+    parser.add_argument("--address", default=DEFAULTS.address,
+                        help="join a Ray cluster: auto (started on this machine by ray start) or ray://HOST:PORT "
+                             "(default: a local Ray, no set-up)")
     parser.add_argument("--skip-training", action="store_true", help="report the runs that finished, train none")
     return parser
 
@@ -53,8 +58,8 @@ def parse_settings(argv=None):
     args = build_parser().parse_args(script_args(argv))
     return PaperSettings(preset=args.preset, epoch_scale=args.epoch_scale, variants=tuple(args.variants),
                          columns=tuple(args.columns), clips=args.clips, runs=args.runs, results=args.results,
-                         eval_every=args.eval_every, seeds=tuple(args.seeds), jobs=args.jobs,
-                         skip_training=args.skip_training)
+                         eval_every=args.eval_every, seeds=tuple(args.seeds), address=args.address,
+                         workers=args.workers, skip_training=args.skip_training)
 
 
 def main(argv=None):

@@ -30,6 +30,8 @@ def build_parser():
                              "agent when trained, else one trained here on the sample library)")
     parser.add_argument("--runs", default=DEFAULTS.runs)
     parser.add_argument("--results", default=DEFAULTS.results)
+    parser.add_argument("--import-workers", type=int, default=DEFAULTS.import_workers,
+                        help="import the takes the cache lacks with N Blenders at once (Ray tasks; default 1)")
     return parser
 
 
@@ -37,7 +39,8 @@ def parse_settings(argv=None):
     """RealMocapSettings from the command line."""
     args = build_parser().parse_args(script_args(argv))
     return RealMocapSettings(realmocap=args.realmocap, epochs=args.epochs, preset=args.preset, seeds=tuple(args.seeds),
-                             point_agent=args.point_agent, runs=args.runs, results=args.results)
+                             point_agent=args.point_agent, runs=args.runs, results=args.results,
+                             import_workers=args.import_workers)
 
 
 def main(argv=None):

@@ -46,6 +46,8 @@ def build_parser():
     parser.add_argument("--checkpoint-every", type=int, default=1)
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--verbose", action="store_true", help="show what Blender prints while loading the clips")
+    parser.add_argument("--import-workers", type=int, default=1,
+                        help="import the clips the cache lacks with N Blenders at once (Ray tasks; default 1)")
     return parser
 
 
@@ -67,7 +69,8 @@ def install(output):
 def main(argv=None):
     args = build_parser().parse_args(script_args(argv))
     settings = resolve(run_settings(args))
-    report, _ = train(settings, LibrarySession(settings.clips, verbose=args.verbose))
+    session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers)
+    report, _ = train(settings, session)
     scored, split = ((report["held_out"], "held-out") if report["held_out"] is not None
                      else (report["training"], "no held-out clips; training-clip"))
     print(f"trained: {report['epochs']} epochs, {report['episodes']} episodes, {report['train_seconds'] / 60:.1f} min; "

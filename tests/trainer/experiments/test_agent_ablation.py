@@ -15,7 +15,8 @@ def test_only_replaces_its_rows_and_keeps_the_others(tmp_path, monkeypatch):
     measured = dict(before["point_no_random_targets"], update_steps=7)
     trained = []
     monkeypatch.setattr(agent_ablation, "LibrarySession", lambda manifest: None)
-    monkeypatch.setattr(agent_ablation, "train", lambda settings, session: trained.append(settings.preset))
+    monkeypatch.setattr(agent_ablation, "train_runs",
+                        lambda runs, address, workers: trained.extend(run.preset for run in runs) or [])
     monkeypatch.setattr(agent_ablation, "measure", lambda path, behaviour, session, targets: measured)
     rerun = ["point_no_pointing_term", "point_random_targets"]
     argv = ["agent_ablation", "--only", *rerun, "--runs",

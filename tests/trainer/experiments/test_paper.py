@@ -18,8 +18,9 @@ def test_another_seed_never_reuses_seed_zero_runs(tmp_path):
     settings = experiments.parse_settings(["experiments", "--seeds", "0", "3", "--runs", str(tmp_path / "r")])
     assert harness.run_folder(settings, 3, "rlanimate", "wave") == tmp_path / "r_seed3" / "rlanimate_wave"
     assert harness.run_folder(settings, 0, "rlanimate", "wave") == tmp_path / "r" / "rlanimate_wave"
-    assert "--seed" in (command := harness.train_command(settings, 3, "rlanimate", "wave"))
-    assert command[command.index("--seed") + 1] == "3"
+    run = harness.run_settings(settings, 3, "rlanimate", "wave")
+    assert (run.seed, run.behaviour, run.resume) == (3, "wave", False)
+    assert run.output == str(tmp_path / "r_seed3" / "rlanimate_wave")
 
 
 def test_aggregate_gives_mean_sd_and_count_and_skips_undefined_ratios():

@@ -1,7 +1,6 @@
 """trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its
 outputs exist and load without torch."""
 import json
-import shutil
 import subprocess
 import sys
 
@@ -12,22 +11,8 @@ from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_import import load_clip_set
-from trainer.paths import CLIP_DIR, DEFAULT_MANIFEST, REPO_ROOT
+from trainer.paths import REPO_ROOT
 from trainer.scripts import cli, train
-
-
-@pytest.fixture(scope="module")
-def tiny_library(tmp_path_factory):
-    """Two training and one held-out clip per behaviour of the sample library: its FBX files and their
-    manifest entries, in a folder of their own (so they are imported afresh)."""
-    folder = tmp_path_factory.mktemp("clips")
-    entries = json.loads(DEFAULT_MANIFEST.read_text())["clips"]
-    chosen = [e for behaviour in ("POINT", "WAVE") for split, count in (("train", 2), ("test", 1))
-              for e in [f for f in entries if f["behaviour"] == behaviour and f["split"] == split][:count]]
-    for entry in chosen:
-        shutil.copyfile(CLIP_DIR / entry["file"], folder / entry["file"])
-    (folder / "manifest.json").write_text(json.dumps({"fps": 30, "clips": chosen}))
-    return folder / "manifest.json"
 
 
 def test_blender_style_arguments_are_parsed_after_the_double_dash():
