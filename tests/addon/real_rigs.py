@@ -9,9 +9,9 @@ import tempfile
 from pathlib import Path
 
 import addon_helpers as helpers
-import addon_utils
 import bpy
 import numpy as np
+import rig_variants
 import test_generate
 from test_rig_variants import _strokes
 
@@ -97,18 +97,9 @@ def rigify_rig(arm_mode="FK", export=False):
     generation and adds no bone a gesture keys), both arms in FK (IK_FK 1.0) or left as generated, in IK
     (0.0), the IK hand controls moved so the arms stand posed; a mesh skinned to its DEF- bones, or with
     `export` to a game export skeleton in the same armature copying them (Copy Transforms). Returns it."""
-    addon_utils.enable("rigify", default_set=True)
-    bpy.ops.object.armature_human_metarig_add()
-    metarig = bpy.context.active_object
-    bpy.ops.object.mode_set(mode="EDIT")
-    edit = metarig.data.edit_bones
-    for bone in [edit["face"], *edit["face"].children_recursive]:
-        edit.remove(bone)
-    bpy.ops.object.mode_set(mode="OBJECT")
-    bpy.ops.pose.rigify_generate()
-    rig = bpy.context.active_object
+    metarig, rig = rig_variants.generate_rigify()
     bpy.data.objects.remove(metarig)
-    for side, sign in (("L", 1.0), ("R", -1.0)):
+    for side in ("L", "R"):
         rig.pose.bones["upper_arm_parent." + side]["IK_FK"] = 1.0 if arm_mode == "FK" else 0.0
         rig.pose.bones["hand_ik." + side].location = (0.0, 0.25, -0.05)  # the IK hand lowered towards the hips
     deform = [b.name for b in rig.data.bones if b.use_deform]
