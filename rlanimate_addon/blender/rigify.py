@@ -1,6 +1,5 @@
 """Rigify at the Blender edge: telling a generated rig, reading an arm's IK-FK switch and the pose its
 arm plays, and the switch's keys (core/rigify.py says how an arm in IK is switched to FK)."""
-import bpy
 import numpy as np
 
 from ..core import rigify
@@ -9,10 +8,13 @@ from . import action_adapter
 
 
 def is_generated(obj):
-    """Whether Rigify generated the armature: its rig_id on the armature data, or a UI script naming it."""
+    """Whether Rigify generated the armature: its rig_id on the armature data (which its UI script names),
+    or, where that was lost, Rigify's own machinery: ORG- bones and an arm's IK-FK switch."""
     if "rig_id" in obj.data:
         return True
-    return any(text.name.startswith("rig_ui") and f'"{obj.data.name}"' in text.as_string() for text in bpy.data.texts)
+    switches = [obj.pose.bones.get(rigify.switch_bone(arm)) for arm in ("LEFT", "RIGHT")]
+    return any(s is not None and rigify.SWITCH in s for s in switches) and any(
+        b.name.startswith("ORG-") for b in obj.data.bones)
 
 
 def _switch_path(arm):

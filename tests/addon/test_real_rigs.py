@@ -96,6 +96,9 @@ def test_a_generated_rigify_rig_gestures_in_fk_and_ik(settings, arm_mode, export
     assert armature_io.rig_roles_of(rig)[0] == rig_roles.RIGIFY.name
     if export:
         assert rig_roles.detect(names)[0] is rig_roles.UNREAL, "by names alone the export skeleton wins"
+        rig_id = rig.data.pop("rig_id")
+        assert armature_io.rig_roles_of(rig)[0] == rig_roles.RIGIFY.name, "its ORG- bones and IK-FK switches"
+        rig.data["rig_id"] = rig_id
     _assert_gestures(rig, settings)
     if arm_mode == "IK":
         switch = rig.pose.bones["upper_arm_parent.R"]
