@@ -13,7 +13,7 @@ import numpy as np
 from ..core import key_reduction, rig_roles
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
-from . import action_adapter
+from . import action_adapter, rigify
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
 ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
@@ -46,7 +46,7 @@ def rig_roles_of(obj, bone_map_path=""):
             raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file "
                                  "saved from the panel, or clear the Bone Map field.") from None
         return rig_roles.read_bone_map(text, names)
-    family, roles = rig_roles.detect(names)
+    family, roles = rig_roles.detect(names, rigify=rigify.is_generated(obj))
     return family.name, roles
 
 
@@ -132,7 +132,7 @@ def _to_armature(obj, point):
     return (np.array(obj.matrix_world.inverted(), dtype=np.float64) @ np.append(point, 1.0))[:3]
 
 
-def write_gesture(obj, name, start_frame, keys, blend_type, played):
+def write_gesture(obj, name, start_frame, keys, blend_type, played, properties=None):
     """Key a gesture from start_frame into a new action called `name`; returns the new action.
 
     keys: {bone name: (rotation mode, (N, C) channel values per frame, kept frame indices or None)}:
@@ -141,7 +141,8 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
     becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
     Blender's Push Down does, playing as before over its keys and the `played` frames (first, last:
     the scene's range and the gesture's), and the gesture goes on a new NLA track above it with the
-    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames.
+    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames. properties: {data path: (N,)
+    values} of other channels to key on every frame (a Rigify arm's IK-FK switch).
     """
     target = action_adapter.new_action(name, obj)
     for bone, (mode, values, kept) in keys.items():
@@ -154,6 +155,9 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
                 action_adapter.write_keys(fcurve, frames, values[:, channel])
             else:
                 action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel])
+    for path, values in (properties or {}).items():
+        fcurve = target.new_fcurve(path, 0, path.split('"')[1])
+        action_adapter.write_keys(fcurve, start_frame + np.arange(len(values)), values)
     if action_adapter.is_animated(obj):
         action_adapter.push_down(obj, played)
         strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)

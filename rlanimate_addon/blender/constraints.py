@@ -25,6 +25,40 @@ _CHAIN_TYPES = {"IK", "SPLINE_IK"}
 _FRAME_CURVE = "frame"
 
 
+#: Constraints that hold a bone to another bone, whatever its parent does.
+_COPYING = {"COPY_TRANSFORMS", "COPY_ROTATION", "COPY_LOCATION", "CHILD_OF", "ARMATURE"}
+
+
+def held_below(obj, bone_names):
+    """[(pose bone name, constraint)] of working constraints that hold a deforming bone below the named
+    (keyed) bones, not itself keyed, to a bone outside them (a control rig's finger copying its DRV_ twin):
+    the mesh there would not follow the gesture's keys above it."""
+    keyed = set(bone_names)
+    found = []
+    for pose_bone in obj.pose.bones:
+        if not pose_bone.constraints or pose_bone.name in keyed or not pose_bone.bone.use_deform:
+            continue
+        if not any(parent.name in keyed for parent in pose_bone.parent_recursive):
+            continue
+        for constraint in pose_bone.constraints:
+            if constraint.mute or not constraint.is_valid or constraint.type not in _COPYING:
+                continue
+            if constraint.influence == 0.0 and influence_curve(obj, constraint) is None:
+                continue
+            target = getattr(constraint, "subtarget", "") if getattr(constraint, "target", None) == obj else ""
+            if target not in keyed and not (target and any(
+                    p.name in keyed for p in obj.pose.bones[target].parent_recursive)):
+                found.append((pose_bone.name, constraint))
+    return found
+
+
+def against_gesture(obj, bone_names):
+    """[(pose bone name, constraint)] of every constraint that keeps the gesture keyed on bone_names from
+    playing: those acting on the keyed bones (`overriding`) and those holding deforming bones below them
+    elsewhere (`held_below`)."""
+    return overriding(obj, bone_names) + held_below(obj, bone_names)
+
+
 def driven_bones(names, behaviour, arm):
     """The rig's names of the bones a gesture keys: the action joints, and for Point the pointing hand."""
     canonical = list(skeleton.ACTION_JOINTS)

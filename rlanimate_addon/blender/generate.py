@@ -3,8 +3,9 @@ import bpy
 import numpy as np
 
 from ..core import blas_threads, channels, gesture, key_reduction, rig_roles, rig_scale
+from ..core import rigify as rig_rigify
 from ..core.errors import RLAnimateError
-from . import armature_io, bake_check, constraints, preferences, properties
+from . import armature_io, bake_check, constraints, preferences, properties, rigify
 
 
 def _check_target(settings):
@@ -91,28 +92,20 @@ def selected_armatures(context, settings):
 class _Plan:
     """One armature's checked settings, and then its gesture, ready to write."""
 
-    def __init__(self, obj, family, roles, overriding):
+    def __init__(self, obj, family, roles, overriding, ik_share=None):
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
+        self.ik_share = ik_share  # a Rigify arm in IK: its IK_FK value, switched to FK over the gesture
+        self.properties = None
         self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.settings = None
         self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
         self.worst = 0.0
-
-
-def check_fk_arm(obj, family, arm):
-    """RLAnimateError when a Rigify arm follows its IK controls: the gesture keys its FK controls."""
-    side = ".L" if arm == "LEFT" else ".R"
-    switch = obj.pose.bones.get("upper_arm_parent" + side)
-    if family == rig_roles.RIGIFY.name and switch is not None and switch.get("IK_FK", 1.0) < 1.0:
-        raise RLAnimateError(f"The {arm.lower()} arm of {obj.name!r} follows its IK controls (IK_FK "
-                             f"{switch['IK_FK']:.2f} on {switch.name}), so keys on its FK controls would not move "
-                             "it: set the arm's IK-FK slider to 1.0 (FK) in Rigify's panel, then generate.")
 
 
 def _check(obj, settings, start, end, mute_constraints):
     """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
-    check_fk_arm(obj, family, settings.arm)
+    ik_share = rigify.ik_share(obj, settings.arm) if family == rig_roles.RIGIFY.name else None
     check_keepable(obj)
     check_nla(obj)
     check_inherited_rotation(obj, roles)
@@ -124,9 +117,9 @@ def _check(obj, settings, start, end, mute_constraints):
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
     driven = constraints.driven_bones(roles, settings.behaviour, settings.arm)
     constraints.check_drivers(obj, driven)
-    overriding = constraints.overriding(obj, driven)
+    overriding = constraints.against_gesture(obj, driven)
     constraints.check(obj, overriding, start, end, mute_constraints)
-    return _Plan(obj, family, roles, overriding)
+    return _Plan(obj, family, roles, overriding, ik_share)
 
 
 def _compute(context, plan, settings, agent, frames):
@@ -142,6 +135,9 @@ def _compute(context, plan, settings, agent, frames):
             with constraints.muted(context.view_layer, plan.overriding):
                 rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames,
                                                                     target, bone)
+            if plan.ik_share is not None:  # the FK controls start where the arm stands in IK
+                played, switch = rigify.played_arm(context, obj, settings.arm, frames, rig.animated)
+                rig = rig_rigify.snap_fk(rig, rig_rigify.fk_controls(settings.arm), played)
         finally:
             if scene.frame_current != original_frame:
                 scene.frame_set(original_frame)
@@ -154,6 +150,8 @@ def _compute(context, plan, settings, agent, frames):
         if target is not None:
             plan.target, plan.target_bone, plan.targets = target, bone, targets
         plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
+        if plan.ik_share is not None:
+            plan.properties = rigify.switch_keys(obj, settings.arm, switch, plan.blend_type, rig.animated)
         plan.keys = {}
         for column, bone in enumerate(plan.bones):
             mode = obj.pose.bones[bone].rotation_mode
@@ -195,7 +193,8 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
         start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
         _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
-    undo = [bake_check.BakeUndo(plan.obj, plan.overriding) for plan in plans]
+    undo = [bake_check.BakeUndo(plan.obj, plan.overriding, rigify.switches(plan.obj, plan.properties))
+            for plan in plans]
     scene = context.scene
     original_frame = scene.frame_current
     lines = [_write(plan, agent, scene) for plan in plans]
@@ -226,7 +225,9 @@ def _write(plan, agent, scene):
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                       (min(scene.frame_start, start), max(scene.frame_end, end)))
+                                       (min(scene.frame_start, start), max(scene.frame_end, end)), plan.properties)
+    if plan.ik_share is not None:
+        note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
     constraints.mute(plan.obj, plan.overriding, start, end)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""

@@ -25,8 +25,8 @@ def _overriding_constraints(context, settings):
     obj = context.active_object
     if obj is None or obj.type != "ARMATURE":
         return []
-    return constraints.overriding(obj, constraints.driven_bones(_rig_roles(obj, settings.bone_map_file),
-                                                                settings.behaviour, settings.arm))
+    return constraints.against_gesture(obj, constraints.driven_bones(_rig_roles(obj, settings.bone_map_file),
+                                                                     settings.behaviour, settings.arm))
 
 
 _roles = {}

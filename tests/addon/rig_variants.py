@@ -189,10 +189,8 @@ def blender_human_metarig(rig, tmp):
     return _blender_metarig()
 
 
-def rigify_generated(rig, tmp):
-    """A real Rigify rig (410 bones: DEF-, ORG-, MCH- and controls) generated from Blender's human metarig
-    without its face, its arms switched to FK. The face rig takes 6 s of the 6.2 s generation and adds no
-    bone a gesture keys or the role detector finds (Rigify's eyes sit behind its face controls)."""
+def generate_rigify():
+    """(metarig, generated rig): Rigify's generation of Blender's human metarig without its face."""
     metarig = _blender_metarig()
     bpy.ops.object.mode_set(mode="EDIT")
     edit_bones = metarig.data.edit_bones
@@ -200,7 +198,14 @@ def rigify_generated(rig, tmp):
         edit_bones.remove(bone)
     bpy.ops.object.mode_set(mode="OBJECT")
     bpy.ops.pose.rigify_generate()
-    generated = bpy.context.active_object
+    return metarig, bpy.context.active_object
+
+
+def rigify_generated(rig, tmp):
+    """A real Rigify rig (410 bones: DEF-, ORG-, MCH- and controls) generated from Blender's human metarig
+    without its face, its arms switched to FK. The face rig takes 6 s of the 6.2 s generation and adds no
+    bone a gesture keys or the role detector finds (Rigify's eyes sit behind its face controls)."""
+    generated = generate_rigify()[1]
     for side in ("L", "R"):
         generated.pose.bones["upper_arm_parent." + side]["IK_FK"] = 1.0
     return generated

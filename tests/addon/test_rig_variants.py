@@ -259,11 +259,3 @@ def test_the_agents_own_aim_on_a_rig_unlike_the_sample_misses_by_what_it_misses_
     misses = _own_aim_misses(rig_variants.load(variant_files[variant]), settings)
     print(f"{variant}: own aim {np.round(misses, 1)} deg, sample {np.round(sample_own_aim, 1)} deg")
     assert np.median(misses - sample_own_aim) <= 1.5 and np.median(misses) <= np.median(sample_own_aim) + 1.5
-
-
-def test_a_rigify_arm_in_ik_is_refused_by_name(settings, variant_files):
-    rig = rig_variants.load(variant_files["rigify_generated"])
-    rig.pose.bones["upper_arm_parent.R"]["IK_FK"] = 0.0
-    with pytest.raises(RuntimeError, match=r"right arm of 'Variant' follows its IK controls.*IK-FK slider to 1.0"):
-        helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
-    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT") == {"FINISHED"}

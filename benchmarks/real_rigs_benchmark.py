@@ -1,0 +1,139 @@
+"""Generate Gesture on every rig in ../shared/rigs and on the Rigify rigs the tests build (FK, IK, with a game
+export skeleton), measured on the bones the mesh deforms with, as Blender plays them (tests/addon/real_rigs.py).
+
+Per rig: whether it is accepted (as it comes, with 'Generate, Muting Constraints', or with a user bone map),
+Point's miss (degrees between the deformed index finger, base joint to tip joint, and the line from its base
+to the target; median over the pointing hold) over random unseen targets, both arms alternating, with Exact
+Aim on and off, a 150-frame wave's strokes, and the deformed wrist's least travel over those gestures in arm
+lengths. Writes the "Real rigs" section of docs/BENCHMARKS.md.
+
+Run: `nice -n 10 python benchmarks/real_rigs_benchmark.py [--targets 12] [--seed 5] [--no-write]`
+"""
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+for path in (ROOT, ROOT / "tests", ROOT / "tests" / "addon"):
+    sys.path.insert(0, str(path))
+
+import addon_helpers as helpers  # noqa: E402
+import bpy  # noqa: E402
+import real_rigs  # noqa: E402
+
+from benchmarks.report import write_section  # noqa: E402
+
+#: (name, family, source) of every rig: a ../shared/rigs file (real_rigs.FILES) or a Rigify build.
+RIGS = (
+    ("ue_control_rig", "UE4 names, deform bones copy DRV_ twins", "Mesh2Motion (real file)"),
+    ("ue_gltf", "UE4 names, glTF", "Mesh2Motion (real file)"),
+    ("seed_san", "metarig names, A-pose, twist bone", "UniVRM (real file)"),
+    ("kenney", "Mixamo-like, 3.7 units tall", "Mesh2Motion / Kenney (real file)"),
+    ("quaternius", "outside the families (Palm, no index)", "Quaternius (real file)"),
+    ("gdbot", "outside the families (_FK/_IK chains)", "GDQuest (real file)"),
+    ("vrm0_robot", "VRM 0.x", "UNAVI (real file)"),
+    ("rigify_fk", "Rigify, arms in FK", "built by Rigify (real tool)"),
+    ("rigify_ik", "Rigify, arms in IK", "built by Rigify (real tool)"),
+    ("rigify_export", "Rigify + game export skeleton", "built by Rigify (real tool)"),
+)
+
+
+def _load(name):
+    if name.startswith("rigify_"):
+        return real_rigs.rigify_rig("FK" if name == "rigify_fk" else "IK", export=name == "rigify_export")
+    return real_rigs.load_shared(name)
+
+
+def _accept(rig, settings, name, folder):
+    """(how it is accepted, mute constraints?) or (the refusal's first words, None)."""
+    for mute in (False, True):
+        try:
+            real_rigs.wave(rig, settings, "RIGHT", 5000, mute=mute)
+            return ("yes" if not mute else "with Generate, Muting Constraints"), mute
+        except RuntimeError as error:
+            refusal = str(error).removeprefix("Error: ")
+    if name in real_rigs.USER_BONE_MAPS:
+        settings.bone_map_file = real_rigs.write_bone_map(name, folder)
+        try:
+            real_rigs.wave(rig, settings, "RIGHT", 5000)
+            return "with a user bone map (refused before, naming the fix)", False
+        except RuntimeError as error:
+            refusal = str(error).removeprefix("Error: ")
+    return "refused: " + refusal[:150].replace("|", "/") + "...", None
+
+
+def measure(name, targets, seed, folder):
+    settings = helpers.enable_addon()
+    rig = _load(name)
+    accepted, mute = _accept(rig, settings, name, folder)
+    if mute is None:
+        helpers.disable_addon()
+        return accepted, None
+    rng = np.random.default_rng(seed)
+    exact, own, travel = [], [], []
+    for k in range(targets):
+        arm = ("RIGHT", "LEFT")[k % 2]
+        for aimed, misses in ((True, exact), (False, own)):
+            target = real_rigs.world_target(rig, settings, arm, rng)
+            result, miss, moved = real_rigs.point(rig, settings, arm, target, 1 + 150 * (2 * k + aimed),
+                                                  exact=aimed, mute=mute)
+            assert result == {"FINISHED"}, (name, result)
+            misses.append(miss)
+            travel.append(moved)
+    _, strokes, moved = real_rigs.wave(rig, settings, "RIGHT", 150 * (2 * targets + 2), mute=mute)
+    travel.append(moved)
+    helpers.disable_addon()
+    return accepted, (np.array(exact), np.array(own), strokes, min(travel))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--targets", type=int, default=12)
+    parser.add_argument("--seed", type=int, default=5)
+    parser.add_argument("--no-write", action="store_true")
+    args = parser.parse_args()
+    folder = Path(tempfile.mkdtemp())
+    rows, started = [], time.perf_counter()
+    for name, family, source in RIGS:
+        if not name.startswith("rigify_") and real_rigs.shared_file(name) is None:
+            rows.append(f"| {name} | {family} | {source} | absent (../shared/rigs) | | | | |")
+            continue
+        accepted, measured = measure(name, args.targets, args.seed, folder)
+        if measured is None:
+            rows.append(f"| {name} | {family} | {source} | {accepted} | - | - | - | - |")
+        else:
+            exact, own, strokes, travel = measured
+            rows.append(f"| {name} | {family} | {source} | {accepted} | {np.median(exact):.2f} / {exact.max():.2f} "
+                        f"| {np.median(own):.1f} / {own.max():.1f} | {strokes} | {travel:.2f} |")
+        print(rows[-1], flush=True)
+    text = "\n".join([
+        "## Real rigs",
+        "",
+        f"Generate Gesture on every rig in `../shared/rigs` (made by others, imported as they come) and on Rigify "
+        f"rigs generated by the Rigify add-on (tests/addon/real_rigs.py), measured on the bones the mesh deforms "
+        f"with, as Blender plays them: {args.targets} random unseen Point targets per rig and Exact Aim setting "
+        f"(both arms alternating, 120 frames, seed {args.seed}), miss in degrees of the deformed index finger "
+        "(base joint to tip joint) at the hold (median / worst over the targets), a 150-frame wave's strokes, "
+        "and the deformed wrist's least travel over those gestures, in arm lengths. Bundled agent.",
+        "",
+        "Regenerate: `nice -n 10 python benchmarks/real_rigs_benchmark.py`",
+        "",
+        f"Blender {bpy.app.version_string}, {time.perf_counter() - started:.0f} s. "
+        f"Date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.",
+        "",
+        "| rig | family | source | accepted | exact aim: median / worst deg | own aim: median / worst deg "
+        "| wave strokes | hand travel |",
+        "|---|---|---|---|---:|---:|---:|---:|",
+        *rows,
+    ])
+    print(text)
+    if not args.no_write:
+        write_section("## Real rigs", text)
+
+
+if __name__ == "__main__":
+    main()
