@@ -104,6 +104,18 @@ VRM_HUMANOID = _family(
                               for p in (_VRM_THUMB[k - 1] if f == "Thumb" else (_VRM_PHALANGES[k - 1],)))
      for f in _FINGERS for k in (1, 2, 3)})
 
+#: The VRM Add-on for Blender's humanoid armature names ('upper_arm.L', 'lower_arm.L', 'index.proximal.L'),
+#: which VRM files it exports keep as node names; thumbs as in VRM_HUMANOID.
+VRM_ADDON = _family(
+    "VRM Add-on armature", (".L", ".R"),
+    {"Hips": ("hips",), "Spine": ("spine",), "Spine1": ("chest",), "Spine2": ("upper_chest",), "Neck": ("neck",),
+     "Head": ("head",)},
+    {"LeftEye": ("eye{s}",), "LeftShoulder": ("shoulder{s}",), "LeftArm": ("upper_arm{s}",),
+     "LeftForeArm": ("lower_arm{s}",), "LeftHand": ("hand{s}",)},
+    {f"LeftHand{f}{k}": tuple(f"{_VRM_FINGERS[f].lower()}.{p.lower()}{{s}}"
+                              for p in (_VRM_THUMB[k - 1] if f == "Thumb" else (_VRM_PHALANGES[k - 1],)))
+     for f in _FINGERS for k in (1, 2, 3)})
+
 CHARACTER_CREATOR = _family(
     "Character Creator", ("L", "R"),
     {"Hips": ("CC_Base_Hip",), "Spine": ("CC_Base_Waist",), "Spine1": ("CC_Base_Spine01",),
@@ -129,8 +141,8 @@ BIPED = _family(
      for k in (1, 2, 3)})
 
 #: Every family, in the order that wins a tie.
-FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, CHARACTER_CREATOR, METARIG, RIGIFY_DEFORM,
-            BIPED)
+FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, VRM_ADDON, CHARACTER_CREATOR, METARIG,
+            RIGIFY_DEFORM, BIPED)
 
 #: Prefixes dropped before matching: Mixamo's ('mixamorig', 'mixamorig1_') and 3ds Max Biped's
 #: ('Bip01 ', 'Bip001 ').
