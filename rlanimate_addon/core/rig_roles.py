@@ -206,7 +206,8 @@ def check_roles(rig_name, roles, arm, family_name):
             f"Armature {rig_name!r} has no bone for the roles {', '.join(missing)} (closest bone naming: "
             f"{family_name}). Rename those bones to Mixamo names, or map them: in the RLAnimate panel, "
             "'Save Bone Map' writes the detected map as a JSON file; add the missing roles with your "
-            "bone names and pick the file as Bone Map.")
+            "bone names and pick the file as Bone Map. For a VRM character, 'Bone Map from VRM File' reads "
+            "the map its .vrm file carries.")
 
 
 def bone_map_json(family_name, roles):
