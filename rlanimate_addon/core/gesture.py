@@ -402,12 +402,10 @@ def finger_line_bones(roles, arm):
     the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index base; without an
     index finger, the forearm's head through the hand's head."""
     prefix = skeleton.ARM_PREFIX[arm]
+    if f"{prefix}HandIndex1" not in roles:
+        return roles[prefix + "ForeArm"], roles[prefix + "Hand"]
     index = [roles[f"{prefix}HandIndex{k}"] for k in (1, 2, 3, 4) if f"{prefix}HandIndex{k}" in roles]
-    if f"{prefix}HandIndex1" in roles and len(index) > 1:
-        return index[0], index[-1]
-    if f"{prefix}HandIndex1" in roles:
-        return roles[prefix + "Hand"], index[0]
-    return roles[prefix + "ForeArm"], roles[prefix + "Hand"]
+    return (index[0], index[-1]) if len(index) > 1 else (roles[prefix + "Hand"], index[0])
 
 
 def aim_rig(rig, basis, changed, arm, targets, weights):

@@ -10,7 +10,6 @@ import pytest
 import real_rigs
 from mathutils import Vector
 
-from rlanimate_addon.core import gesture
 
 EXACT_MEDIAN, EXACT_WORST, OWN_MEDIAN, OWN_WORST = 1.0, 3.0, 5.0, 12.0
 
@@ -61,10 +60,3 @@ def test_waves_on_real_rigs_make_strokes_and_move_the_hand(settings, tmp_path, k
     print(f"{kind}: {strokes} strokes, hand travel {travel:.2f} arm lengths")
     assert strokes >= 4 and travel >= 0.5
 
-
-def test_the_finger_line_is_joint_to_joint():
-    roles = {f"RightHandIndex{k}": f"i{k}" for k in (1, 2, 3)} | {"RightHand": "hand", "RightForeArm": "forearm"}
-    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3")
-    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip")
-    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1")
-    assert gesture.finger_line_bones({"RightHand": "hand", "RightForeArm": "forearm"}, "RIGHT") == ("forearm", "hand")

@@ -121,18 +121,38 @@ class _Vrm0(bpy.types.PropertyGroup):
     humanoid: bpy.props.PointerProperty(type=_Humanoid0)
 
 
+class _Vrm1HumanBone(bpy.types.PropertyGroup):
+    node: bpy.props.PointerProperty(type=_Node)
+
+
+#: VRM 1.0: one pointer per human bone, named in snake case (left_upper_arm, left_thumb_metacarpal, ...).
+_Vrm1HumanBones = type("_Vrm1HumanBones", (bpy.types.PropertyGroup,), {"__annotations__": {
+    vrm.snake_case(name): bpy.props.PointerProperty(type=_Vrm1HumanBone) for name in vrm.ROLE_OF["1"]}})
+
+
+class _Vrm1Humanoid(bpy.types.PropertyGroup):
+    human_bones: bpy.props.PointerProperty(type=_Vrm1HumanBones)
+
+
+class _Vrm1(bpy.types.PropertyGroup):
+    humanoid: bpy.props.PointerProperty(type=_Vrm1Humanoid)
+
+
 class _Extension(bpy.types.PropertyGroup):
     vrm0: bpy.props.PointerProperty(type=_Vrm0)
+    vrm1: bpy.props.PointerProperty(type=_Vrm1)
 
 
-_ADDON_LAYOUT = (_Node, _HumanBone0, _Humanoid0, _Vrm0, _Extension)
+_ADDON_LAYOUT = (_Node, _HumanBone0, _Humanoid0, _Vrm0, _Vrm1HumanBone, _Vrm1HumanBones, _Vrm1Humanoid, _Vrm1,
+                 _Extension)
 
 
 @pytest.fixture
 def vrm_addon_layout(settings):
-    """The VRM add-on's data layout on armatures (saturday06/VRM-Addon-for-Blender, editor/vrm0/
-    property_group.py: Armature.vrm_addon_extension.vrm0.humanoid.human_bones, each {bone, node.bone_name}),
-    registered as the add-on registers it, without the add-on."""
+    """The VRM add-on's data layout on armatures (saturday06/VRM-Addon-for-Blender, editor/vrm0 and vrm1
+    property_group.py: Armature.vrm_addon_extension.vrm0.humanoid.human_bones, a list of {bone,
+    node.bone_name}; .vrm1.humanoid.human_bones.<snake_case name>.node.bone_name), registered as the
+    add-on registers it, without the add-on."""
     for cls in _ADDON_LAYOUT:
         bpy.utils.register_class(cls)
     bpy.types.Armature.vrm_addon_extension = bpy.props.PointerProperty(type=_Extension)
@@ -142,19 +162,30 @@ def vrm_addon_layout(settings):
         bpy.utils.unregister_class(cls)
 
 
-def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addon_layout):
+@pytest.mark.parametrize("major", ["0", "1"])
+def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addon_layout, major):
     source = real_rigs.require(real_rigs.VRM0)
     rig = real_rigs.import_gltf(source, tmp_path)
     for bone in rig.data.bones:  # names no family knows: only the add-on's map can tell
         bone.name = "b_" + bone.name.replace(".", "_")
     gltf = vrm.read_gltf_json(str(source))
     names = vrm.imported_bone_names(gltf)
+    extension = rig.data.vrm_addon_extension
     for entry in gltf["extensions"]["VRM"]["humanoid"]["humanBones"]:
-        human_bone = rig.data.vrm_addon_extension.vrm0.humanoid.human_bones.add()
-        human_bone.bone = entry["bone"]
-        human_bone.node.bone_name = "b_" + names[entry["node"]].replace(".", "_")
+        bone_name = "b_" + names[entry["node"]].replace(".", "_")
+        if major == "0":
+            human_bone = extension.vrm0.humanoid.human_bones.add()
+            human_bone.bone = entry["bone"]
+        else:
+            vrm1_name = entry["bone"].replace("ThumbProximal", "ThumbMetacarpal").replace(
+                "ThumbIntermediate", "ThumbProximal")
+            human_bone = getattr(extension.vrm1.humanoid.human_bones, vrm.snake_case(vrm1_name), None)
+            if human_bone is None:  # legs: no role
+                continue
+        human_bone.node.bone_name = bone_name
     roles = real_rigs.roles(rig)
     assert roles["LeftForeArm"] == "b_lower_arm_L" and roles["RightHandIndex3"] == "b_index_distal_R"
+    assert roles["RightHandThumb1"] == "b_thumb_proximal_R" and len(roles) == 45
     target = helpers.add_empty("Target", real_rigs.world_target(rig, "RIGHT", np.random.default_rng(3)))
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, frame_count=120) == {"FINISHED"}
     angles, bases = real_rigs.finger_angles(rig, "RIGHT", np.array(target.location), np.arange(1, 121))

@@ -384,3 +384,11 @@ def test_a_nan_start_pose_is_refused_before_anything_is_returned():
     rig.under[rig.skeleton.index["RightForeArm"], :3, :3] = np.nan
     with pytest.raises(RLAnimateError, match="rotations of RightForeArm are not numbers"):
         gesture.gesture_rotations(ReplayAgent(np.full((60, 45), 0.5)), _request(behaviour="WAVE"), rig)
+
+
+def test_the_finger_line_runs_through_joints_index_base_to_its_farthest_joint():
+    roles = {f"RightHandIndex{k}": f"i{k}" for k in (1, 2, 3)} | {"RightHand": "hand", "RightForeArm": "forearm"}
+    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3")
+    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip")
+    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1")
+    assert gesture.finger_line_bones({"RightHand": "hand", "RightForeArm": "forearm"}, "RIGHT") == ("forearm", "hand")
