@@ -7,7 +7,7 @@ import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import real_rigs
+import deformed_measures as measures
 from mathutils import Vector
 
 
@@ -37,16 +37,16 @@ def _load(kind, tmp_path):
         rig = helpers.load_sample_rig()
         _turn_finger_tails(rig)
         return rig
-    path = {"UE4 glTF": real_rigs.UE_GLB, "Kenney glTF": real_rigs.KENNEY_GLB}[kind]
-    return real_rigs.import_gltf(real_rigs.require(path), tmp_path)
+    path = {"UE4 glTF": measures.UE_GLB, "Kenney glTF": measures.KENNEY_GLB}[kind]
+    return measures.import_gltf(measures.require(path), tmp_path)
 
 
 @pytest.mark.parametrize("kind", ["UE4 glTF", "Kenney glTF", "sample", "sample, tails turned"])
 def test_exact_aim_hits_through_the_finger_joints(settings, tmp_path, kind):
     rig = _load(kind, tmp_path)
-    assert real_rigs.measured_bones_deform(rig, "RIGHT") and real_rigs.measured_bones_deform(rig, "LEFT")
-    own, _ = real_rigs.point_misses(rig, settings, 4, False, 7)
-    exact, travel = real_rigs.point_misses(rig, settings, 4, True, 7)
+    assert measures.measured_bones_deform(rig, "RIGHT") and measures.measured_bones_deform(rig, "LEFT")
+    own, _ = measures.point_misses(rig, settings, 4, False, 7)
+    exact, travel = measures.point_misses(rig, settings, 4, True, 7)
     print(f"{kind}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)}")
     assert np.median(exact) <= EXACT_MEDIAN and exact.max() <= EXACT_WORST, f"{kind}: Exact Aim misses {exact}"
     assert np.median(own) <= OWN_MEDIAN and own.max() <= OWN_WORST, f"{kind}: own aim misses {own}"
@@ -56,7 +56,7 @@ def test_exact_aim_hits_through_the_finger_joints(settings, tmp_path, kind):
 @pytest.mark.parametrize("kind", ["UE4 glTF", "Kenney glTF"])
 def test_waves_on_real_rigs_make_strokes_and_move_the_hand(settings, tmp_path, kind):
     rig = _load(kind, tmp_path)
-    strokes, travel = real_rigs.wave(rig, settings, "LEFT")
+    strokes, travel = measures.wave(rig, settings, "LEFT")
     print(f"{kind}: {strokes} strokes, hand travel {travel:.2f} arm lengths")
     assert strokes >= 4 and travel >= 0.5
 

@@ -9,7 +9,7 @@ import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import real_rigs
+import deformed_measures as measures
 
 from rlanimate_addon.blender import armature_io
 from rlanimate_addon.core import vrm
@@ -46,17 +46,17 @@ def as_vrm1(gltf):
 
 @pytest.fixture
 def vrm1_file(tmp_path):
-    return rewrite_json(real_rigs.require(real_rigs.VRM0), tmp_path / "robot_vrm1.vrm", as_vrm1)
+    return rewrite_json(measures.require(measures.VRM0), tmp_path / "robot_vrm1.vrm", as_vrm1)
 
 
 def _check_gestures(rig, settings, family):
-    own, _ = real_rigs.point_misses(rig, settings, 4, False, 5)
-    exact, travel = real_rigs.point_misses(rig, settings, 4, True, 5)
-    strokes, wave_travel = real_rigs.wave(rig, settings, "RIGHT")
-    start = real_rigs.arm_drop(rig, "RIGHT", 1)
+    own, _ = measures.point_misses(rig, settings, 4, False, 5)
+    exact, travel = measures.point_misses(rig, settings, 4, True, 5)
+    strokes, wave_travel = measures.wave(rig, settings, "RIGHT")
+    start = measures.arm_drop(rig, "RIGHT", 1)
     print(f"{family}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)} arm "
           f"lengths, wave {strokes} strokes / {wave_travel:.2f}, start arm drop {start:.0f} deg")
-    assert real_rigs.measured_bones_deform(rig, "RIGHT") and real_rigs.measured_bones_deform(rig, "LEFT")
+    assert measures.measured_bones_deform(rig, "RIGHT") and measures.measured_bones_deform(rig, "LEFT")
     assert np.median(exact) <= EXACT_MEDIAN and exact.max() <= EXACT_WORST
     assert np.median(own) <= OWN_MEDIAN and own.max() <= OWN_WORST
     assert strokes >= 4 and min(travel.min(), wave_travel) >= 0.5
@@ -65,23 +65,23 @@ def _check_gestures(rig, settings, family):
 
 
 def test_a_vrm0_file_imported_with_the_gltf_importer_points_and_waves(settings, tmp_path):
-    source = real_rigs.require(real_rigs.VRM0)
-    rig = real_rigs.import_gltf(source, tmp_path)
+    source = measures.require(measures.VRM0)
+    rig = measures.import_gltf(source, tmp_path)
     assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(source)) == {"FINISHED"}
     assert rig.rlanimate.vrm_file == str(source)
-    roles = real_rigs.roles(rig)
+    roles = measures.roles(rig)
     assert roles["RightArm"] == "upper_arm.R" and roles["RightHandIndex1"] == "index.proximal.R"
     _check_gestures(rig, settings, vrm.FAMILY)
 
 
 def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_file):
-    rig = real_rigs.import_gltf(vrm1_file, tmp_path)
+    rig = measures.import_gltf(vrm1_file, tmp_path)
     target = helpers.add_empty("Target", (1.0, 3.0, 1.5))
     with pytest.raises(RuntimeError, match="has no bone for the roles"):
         helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target)
     assert not rig.animation_data or not rig.animation_data.action
     assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
-    roles = real_rigs.roles(rig)
+    roles = measures.roles(rig)
     gltf = vrm.read_gltf_json(str(vrm1_file))
     thumb = gltf["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]["rightThumbMetacarpal"]["node"]
     assert roles["RightHandThumb1"] == f"joint_{thumb:02d}" and len(roles) == 45
@@ -89,9 +89,9 @@ def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_f
 
 
 def test_a_wrong_or_damaged_vrm_file_is_refused_and_the_armature_keeps_its_map(settings, tmp_path, vrm1_file):
-    rig = real_rigs.import_gltf(vrm1_file, tmp_path)
+    rig = measures.import_gltf(vrm1_file, tmp_path)
     assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
-    other = real_rigs.require(real_rigs.VRM0)  # the 0.x file names its bones otherwise
+    other = measures.require(measures.VRM0)  # the 0.x file names its bones otherwise
     with pytest.raises(RuntimeError, match="names bones 'Armature' lacks"):
         bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(other))
     broken = tmp_path / "broken.vrm"
@@ -164,8 +164,8 @@ def vrm_addon_layout(settings):
 
 @pytest.mark.parametrize("major", ["0", "1"])
 def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addon_layout, major):
-    source = real_rigs.require(real_rigs.VRM0)
-    rig = real_rigs.import_gltf(source, tmp_path)
+    source = measures.require(measures.VRM0)
+    rig = measures.import_gltf(source, tmp_path)
     for bone in rig.data.bones:  # names no family knows: only the add-on's map can tell
         bone.name = "b_" + bone.name.replace(".", "_")
     gltf = vrm.read_gltf_json(str(source))
@@ -183,10 +183,10 @@ def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addo
             if human_bone is None:  # legs: no role
                 continue
         human_bone.node.bone_name = bone_name
-    roles = real_rigs.roles(rig)
+    roles = measures.roles(rig)
     assert roles["LeftForeArm"] == "b_lower_arm_L" and roles["RightHandIndex3"] == "b_index_distal_R"
     assert roles["RightHandThumb1"] == "b_thumb_proximal_R" and len(roles) == 45
-    target = helpers.add_empty("Target", real_rigs.world_target(rig, "RIGHT", np.random.default_rng(3)))
+    target = helpers.add_empty("Target", measures.world_target(rig, "RIGHT", np.random.default_rng(3)))
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, frame_count=120) == {"FINISHED"}
-    angles, bases = real_rigs.finger_angles(rig, "RIGHT", np.array(target.location), np.arange(1, 121))
-    assert real_rigs.hold_miss(rig, angles, bases) <= EXACT_WORST
+    angles, bases = measures.finger_angles(rig, "RIGHT", np.array(target.location), np.arange(1, 121))
+    assert measures.hold_miss(rig, angles, bases) <= EXACT_WORST
