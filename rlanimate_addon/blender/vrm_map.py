@@ -1,10 +1,11 @@
 """A VRM character's own humanoid map: from its .vrm file (core.vrm), or from the VRM add-on's data.
 
-An armature imported with Blender's glTF importer carries nothing of the VRM: "Bone Map from VRM File"
-reads the file's map, checks it against the armature's bones and keeps the file's path on the
-armature (`Object.rlanimate.vrm_file`), where Generate finds it. An armature the VRM add-on imported
-or set up carries the map itself (`Armature.vrm_addon_extension`), read here without importing the
-add-on.
+Blender's glTF importer keeps nothing of the VRM, so while this add-on is enabled each armature it
+imports from a file with a VRM humanoid keeps the file's path (`Object.rlanimate.vrm_file`, set by
+`remember_vrm_file` from the importer's hook), where Generate finds it; for an armature imported
+before, "Bone Map from VRM File" reads the file's map, checks it against the armature's bones and
+keeps its path. An armature the VRM add-on imported or set up carries the map itself
+(`Armature.vrm_addon_extension`), read here without importing the add-on.
 """
 import bpy
 from bpy_extras.io_utils import ImportHelper
@@ -14,12 +15,31 @@ from ..core.errors import RLAnimateError
 
 
 def roles_of(obj):
-    """{role: bone name} from the armature's VRM file or the VRM add-on's map, or None when it has neither."""
+    """{role: bone name} from the VRM add-on's map on the armature (kept up to date as bones are
+    renamed), else from its VRM file, or None when it has neither."""
     names = [bone.name for bone in obj.data.bones]
+    roles = addon_roles(obj.data, set(names))
     path = obj.rlanimate.vrm_file
-    if path:
+    if roles or not path:
+        return roles
+    try:
         return vrm.file_roles(bpy.path.abspath(path), names, repr(obj.name))
-    return addon_roles(obj.data, set(names))
+    except RLAnimateError as error:
+        raise RLAnimateError(f"{error} (Armature {obj.name!r} takes its bone map from that VRM file: pick the "
+                             "right one with 'Bone Map from VRM File', or clear its VRM File field in the RLAnimate "
+                             "panel to detect the bones by name.)") from None
+
+
+def remember_vrm_file(gltf):
+    """Keep the path of a VRM file on the armatures Blender's glTF importer made from it (`gltf`: the
+    importer's state, after its nodes are created); a glTF without a VRM humanoid is left alone."""
+    extensions = getattr(gltf.data, "extensions", None) or {}
+    if "VRMC_vrm" not in extensions and "VRM" not in extensions:
+        return
+    for vnode in getattr(gltf, "vnodes", {}).values():
+        obj = getattr(vnode, "blender_object", None)
+        if obj is not None and obj.type == "ARMATURE":
+            obj.rlanimate.vrm_file = gltf.filename
 
 
 def addon_roles(armature, bone_names):

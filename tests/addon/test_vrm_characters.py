@@ -67,8 +67,7 @@ def _check_gestures(rig, settings, family):
 def test_a_vrm0_file_imported_with_the_gltf_importer_points_and_waves(settings, tmp_path):
     source = measures.require(measures.VRM0)
     rig = measures.import_gltf(source, tmp_path)
-    assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(source)) == {"FINISHED"}
-    assert rig.rlanimate.vrm_file == str(source)
+    assert rig.rlanimate.vrm_file == str(tmp_path / "x.glb"), "the import keeps the VRM file's path"
     roles = measures.roles(rig)
     assert roles["RightArm"] == "upper_arm.R" and roles["RightHandIndex1"] == "index.proximal.R"
     _check_gestures(rig, settings, vrm.FAMILY)
@@ -76,16 +75,24 @@ def test_a_vrm0_file_imported_with_the_gltf_importer_points_and_waves(settings, 
 
 def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_file):
     rig = measures.import_gltf(vrm1_file, tmp_path)
-    target = helpers.add_empty("Target", (1.0, 3.0, 1.5))
-    with pytest.raises(RuntimeError, match="has no bone for the roles"):
-        helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target)
-    assert not rig.animation_data or not rig.animation_data.action
-    assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
+    assert rig.rlanimate.vrm_file == str(tmp_path / "x.glb"), "the import keeps the VRM file's path"
     roles = measures.roles(rig)
     gltf = vrm.read_gltf_json(str(vrm1_file))
     thumb = gltf["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]["rightThumbMetacarpal"]["node"]
     assert roles["RightHandThumb1"] == f"joint_{thumb:02d}" and len(roles) == 45
     _check_gestures(rig, settings, vrm.FAMILY)
+
+
+def test_an_armature_imported_without_its_vrm_path_is_mapped_from_the_file_it_is_given(settings, tmp_path, vrm1_file):
+    rig = measures.import_gltf(vrm1_file, tmp_path)
+    rig.rlanimate.vrm_file = ""  # imported before the add-on was enabled: nothing but bone names
+    target = helpers.add_empty("Target", (1.0, 3.0, 1.5))
+    with pytest.raises(RuntimeError, match="has no bone for the roles.*'Bone Map from VRM File' reads the map"):
+        helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target)
+    assert rig.animation_data is None or rig.animation_data.action is None
+    assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
+    assert rig.rlanimate.vrm_file == str(vrm1_file)
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target) == {"FINISHED"}
 
 
 def test_a_wrong_or_damaged_vrm_file_is_refused_and_the_armature_keeps_its_map(settings, tmp_path, vrm1_file):
@@ -100,7 +107,7 @@ def test_a_wrong_or_damaged_vrm_file_is_refused_and_the_armature_keeps_its_map(s
         bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(broken))
     assert rig.rlanimate.vrm_file == str(vrm1_file)
     rig.rlanimate.vrm_file = str(tmp_path / "moved.vrm")
-    with pytest.raises(RuntimeError, match="Cannot read the VRM file"):
+    with pytest.raises(RuntimeError, match="Cannot read the VRM file.*clear its VRM File field"):
         helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
 
 
@@ -166,7 +173,7 @@ def vrm_addon_layout(settings):
 def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addon_layout, major):
     source = measures.require(measures.VRM0)
     rig = measures.import_gltf(source, tmp_path)
-    for bone in rig.data.bones:  # names no family knows: only the add-on's map can tell
+    for bone in rig.data.bones:  # names no family, nor the file, knows: only the add-on's map can tell
         bone.name = "b_" + bone.name.replace(".", "_")
     gltf = vrm.read_gltf_json(str(source))
     names = vrm.imported_bone_names(gltf)
