@@ -2,6 +2,6 @@
 
 Everything is registered by the rlanimate_addon package; this file only delegates to it.
 """
-from .rlanimate_addon import register, unregister
+from .rlanimate_addon import glTF2ImportUserExtension, register, unregister
 
-__all__ = ("register", "unregister")
+__all__ = ("glTF2ImportUserExtension", "register", "unregister")

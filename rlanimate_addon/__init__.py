@@ -13,3 +13,12 @@ def register():
 def unregister():
     from .blender import registration
     registration.unregister()
+
+
+class glTF2ImportUserExtension:  # noqa: N801 (the name Blender's glTF importer looks for on enabled add-ons)
+    """Blender's glTF importer calls this on every import: an armature imported from a VRM file keeps
+    that file's path, so its own humanoid map names its bones (blender/vrm_map.py)."""
+
+    def gather_import_scene_after_nodes_hook(self, gltf_scene, blender_scene, gltf):
+        from .blender import vrm_map
+        vrm_map.remember_vrm_file(gltf)

@@ -10,10 +10,10 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..core import key_reduction, rig_roles
+from ..core import key_reduction, rig_roles, vrm
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
-from . import action_adapter, rigify
+from . import action_adapter, rigify, vrm_map
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
 ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
@@ -24,8 +24,9 @@ def rotation_path(mode):
 
 
 def rig_roles_of(obj, bone_map_path=""):
-    """(family name, {role: bone name}) of an armature: from the bone-map file when one is given,
-    else detected from its bone names. RLAnimateError when obj is not an armature."""
+    """(family name, {role: bone name}) of an armature: from the bone-map file when one is given, else
+    from its VRM humanoid map (its VRM file, or the VRM add-on's data; blender/vrm_map.py), else
+    detected from its bone names. RLAnimateError when obj is not an armature."""
     if obj is None or obj.type != "ARMATURE":
         raise RLAnimateError("The active object is not an armature: select the character's armature.")
     names = [bone.name for bone in obj.data.bones]
@@ -46,6 +47,9 @@ def rig_roles_of(obj, bone_map_path=""):
             raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file "
                                  "saved from the panel, or clear the Bone Map field.") from None
         return rig_roles.read_bone_map(text, names)
+    roles = vrm_map.roles_of(obj)
+    if roles:
+        return vrm.FAMILY, roles
     family, roles = rig_roles.detect(names, rigify=rigify.is_generated(obj))
     return family.name, roles
 

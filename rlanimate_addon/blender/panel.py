@@ -5,7 +5,7 @@ import bpy
 
 from ..core import gesture
 from ..core.errors import RLAnimateError
-from . import armature_io, constraints, preferences, properties
+from . import armature_io, constraints, preferences, properties, vrm_map
 
 
 def _agent_summary(context, behaviour):
@@ -34,13 +34,11 @@ _roles = {}
 
 def _rig_roles(obj, bone_map_file):
     """The armature's roles as Generate finds them ({} when it cannot: Generate names why), remembered per
-    bone names and bone-map file version: detecting them takes about 1 ms, too long for every redraw."""
-    path = bpy.path.abspath(bone_map_file) if bone_map_file else ""
-    try:
-        version = os.stat(path).st_mtime_ns if path else None
-    except OSError:
-        version = None
-    key = (tuple(bone.name for bone in obj.data.bones), path, version)
+    bone names, bone-map and VRM file versions and VRM add-on map: detecting them takes about 1 ms, too
+    long for every redraw."""
+    paths = tuple(bpy.path.abspath(p) if p else "" for p in (bone_map_file, obj.rlanimate.vrm_file))
+    key = (tuple(bone.name for bone in obj.data.bones), paths, tuple(_version(p) for p in paths),
+           _vrm_addon_map(obj))
     if key not in _roles:
         _roles.clear()
         try:
@@ -48,6 +46,20 @@ def _rig_roles(obj, bone_map_file):
         except RLAnimateError:
             _roles[key] = {}
     return _roles[key]
+
+
+def _version(path):
+    """A file's modification time (None when absent or unreadable), to notice an edited map."""
+    try:
+        return os.stat(path).st_mtime_ns if path else None
+    except OSError:
+        return None
+
+
+def _vrm_addon_map(obj):
+    """The VRM add-on's humanoid map on the armature, as a hashable value (None without the add-on)."""
+    roles = vrm_map.addon_roles(obj.data, set(obj.data.bones.keys()))
+    return tuple(sorted(roles.items())) if roles else None
 
 
 class VIEW3D_PT_rlanimate(bpy.types.Panel):
@@ -87,6 +99,11 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
         row = layout.row(align=True)
         row.prop(settings, "bone_map_file")
         row.operator("rlanimate.save_bone_map", text="", icon="FILE_TICK")
+        if obj is not None and obj.type == "ARMATURE":
+            row = layout.row(align=True)
+            row.operator("rlanimate.bone_map_from_vrm", icon="ARMATURE_DATA")
+            if obj.rlanimate.vrm_file:
+                row.prop(obj.rlanimate, "vrm_file", text="")
 
         label, error = _agent_summary(context, settings.behaviour)
         box = layout.box()

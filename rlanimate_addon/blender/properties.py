@@ -79,6 +79,10 @@ class RLANIMATE_PG_object(bpy.types.PropertyGroup):
         name="Own Settings", default=False,
         description="Generate this armature's gesture from its own settings instead of the scene's")
     settings: bpy.props.PointerProperty(type=RLANIMATE_PG_settings)
+    vrm_file: bpy.props.StringProperty(
+        name="VRM File", default="", subtype="FILE_PATH",
+        description="The VRM file this armature was imported from: its humanoid map names the bones "
+                    "(set by Bone Map from VRM File)")
 
 
 def settings_for(obj, shared):

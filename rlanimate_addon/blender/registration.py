@@ -1,7 +1,7 @@
 """Registration in one place: the ordered class list and the property namespaces (Scene and Object)."""
 import bpy
 
-from . import bone_map, export, generate, panel, preferences, properties
+from . import bone_map, export, generate, panel, preferences, properties, vrm_map
 
 #: Registered in this order, unregistered in reverse (property groups before what points at them).
 CLASSES = (
@@ -11,6 +11,7 @@ CLASSES = (
     generate.RLANIMATE_OT_generate_gesture,
     export.RLANIMATE_OT_export_fbx,
     bone_map.RLANIMATE_OT_save_bone_map,
+    vrm_map.RLANIMATE_OT_bone_map_from_vrm,
     panel.VIEW3D_PT_rlanimate,
 )
 

@@ -390,21 +390,28 @@ def _standing_pose():
 
 #: Canonical local rotation vectors (3,) of the standing pose, by bone (others stay at rest).
 STANDING_POSE = _standing_pose()
+#: A bone whose rotation underneath is within this of its rest (sin of half the angle: 0.06 degrees) is
+#: at rest: a rest pose read back from float32 bind matrices (FBX, glTF) is a few 1e-5 radians off.
+AT_REST = 5e-4
 
 
 def finger_line_bones(roles, arm):
-    """(start bone, start at head?, end bone) of the rig's pointing line: the index finger from
-    Index1's head to the tail of the last of Index1-3 the rig has, or the hand's own axis without one."""
-    prefix = skeleton.ARM_PREFIX[arm] + "Hand"
-    index = [roles[prefix + f"Index{k}"] for k in (1, 2, 3) if prefix + f"Index{k}" in roles]
-    if prefix + "Index1" in roles:
-        return index[0], index[-1]
-    return roles[prefix], roles[prefix]
+    """(start bone, end bone) of the rig's pointing line, which runs from the start bone's head through
+    the end bone's head: joint positions, as the mesh shows them, never a bone's tail (an imported
+    bone's tail may point anywhere). The index finger from its base (Index1) to the farthest index joint
+    the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index base; without an
+    index finger, the forearm's head through the hand's head."""
+    prefix = skeleton.ARM_PREFIX[arm]
+    if f"{prefix}HandIndex1" not in roles:
+        return roles[prefix + "ForeArm"], roles[prefix + "Hand"]
+    index = [roles[f"{prefix}HandIndex{k}"] for k in (1, 2, 3, 4) if f"{prefix}HandIndex{k}" in roles]
+    return (index[0], index[-1]) if len(index) > 1 else (roles[prefix + "Hand"], index[0])
 
 
 def aim_rig(rig, basis, changed, arm, targets, weights):
-    """(N, 4, 4) basis matrices of the pointing Arm bone turned so the rig's finger line passes
-    through targets (N, 3) by `weights` (N,) of the turn, solved against the posed rig.
+    """(N, 4, 4) basis matrices of the pointing Arm bone turned so the rig's finger line
+    (`finger_line_bones`) passes through targets (N, 3) by `weights` (N,) of the turn, solved against
+    the posed rig.
 
     basis: (N, B, 4, 4) every bone's basis as it will play: the gesture's on the bones at indices
     `changed`, over the pose underneath.
@@ -415,7 +422,7 @@ def aim_rig(rig, basis, changed, arm, targets, weights):
                                    only=(end, arm_bone))
     i = rig.skeleton.index[arm_bone]
     base = pose[:, rig.skeleton.index[start], :3, 3]
-    finger = rig.skeleton.tails(pose, end) - base
+    finger = pose[:, rig.skeleton.index[end], :3, 3] - base
     finger /= np.linalg.norm(finger, axis=1, keepdims=True)
     correction = aim.shoulder_corrections(pose[:, i, :3, 3], base, finger, targets)  # (N, 3)
     turn = rotvec_to_matrix(correction * np.asarray(weights)[:, None])
@@ -518,7 +525,7 @@ def gesture_rotations(agent, request, rig):
     if not rig.animated:  # bones at rest start from the standing pose, not the bind pose
         standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions,
                             parent_conversions)  # (D, 4)
-        at_rest = np.abs(under[..., 0]) > 1.0 - 1e-9
+        at_rest = np.linalg.norm(under[..., 1:], axis=-1) < AT_REST
         start = np.where(at_rest[..., None], standing, under)
     keyed = blend_from_pose(start, retarget(canonical, conversions, parent_conversions),
                             blend_weights(request.frame_count))

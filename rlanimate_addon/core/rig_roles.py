@@ -106,6 +106,18 @@ VRM_HUMANOID = _family(
                               for p in (_VRM_THUMB[k - 1] if f == "Thumb" else (_VRM_PHALANGES[k - 1],)))
      for f in _FINGERS for k in (1, 2, 3)})
 
+#: The VRM Add-on for Blender's humanoid armature names ('upper_arm.L', 'lower_arm.L', 'index.proximal.L'),
+#: which VRM files it exports keep as node names; thumbs as in VRM_HUMANOID.
+VRM_ADDON = _family(
+    "VRM Add-on armature", (".L", ".R"),
+    {"Hips": ("hips",), "Spine": ("spine",), "Spine1": ("chest",), "Spine2": ("upper_chest",), "Neck": ("neck",),
+     "Head": ("head",)},
+    {"LeftEye": ("eye{s}",), "LeftShoulder": ("shoulder{s}",), "LeftArm": ("upper_arm{s}",),
+     "LeftForeArm": ("lower_arm{s}",), "LeftHand": ("hand{s}",)},
+    {f"LeftHand{f}{k}": tuple(f"{_VRM_FINGERS[f].lower()}.{p.lower()}{{s}}"
+                              for p in (_VRM_THUMB[k - 1] if f == "Thumb" else (_VRM_PHALANGES[k - 1],)))
+     for f in _FINGERS for k in (1, 2, 3)})
+
 CHARACTER_CREATOR = _family(
     "Character Creator", ("L", "R"),
     {"Hips": ("CC_Base_Hip",), "Spine": ("CC_Base_Waist",), "Spine1": ("CC_Base_Spine01",),
@@ -131,8 +143,8 @@ BIPED = _family(
      for k in (1, 2, 3)})
 
 #: Every family, in the order that wins a tie.
-FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, CHARACTER_CREATOR, METARIG, RIGIFY_DEFORM,
-            BIPED)
+FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, VRM_ADDON, CHARACTER_CREATOR, METARIG,
+            RIGIFY_DEFORM, BIPED)
 
 #: Prefixes dropped before matching: Mixamo's ('mixamorig', 'mixamorig1_') and 3ds Max Biped's
 #: ('Bip01 ', 'Bip001 ').
@@ -205,7 +217,8 @@ def check_roles(rig_name, roles, arm, family_name):
             f"Armature {rig_name!r} has no bone for the roles {', '.join(missing)} (closest bone naming: "
             f"{family_name}). Rename those bones to Mixamo names, or map them: in the RLAnimate panel, "
             "'Save Bone Map' writes the detected map as a JSON file; add the missing roles with your "
-            "bone names and pick the file as Bone Map.")
+            "bone names and pick the file as Bone Map. For a VRM character, 'Bone Map from VRM File' reads "
+            "the map its .vrm file carries.")
 
 
 def bone_map_json(family_name, roles):

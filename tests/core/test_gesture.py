@@ -195,9 +195,14 @@ def test_point_asks_the_agent_for_the_direction_the_body_sees_over_hips_that_tur
     assert np.allclose(agent.calls[-1][0][:, spaces.OBJECTIVE_ATTRIBUTES], spaces.pointing_direction("RIGHT", target))
 
 
-def test_a_still_rig_at_rest_starts_and_ends_in_the_standing_pose_not_its_bind_pose():
+@pytest.mark.parametrize("noise", [0.0, 1e-4])
+def test_a_still_rig_at_rest_starts_and_ends_in_the_standing_pose_not_its_bind_pose(noise):
+    """noise: radians about each axis in every bone's basis underneath, as a rest pose read back from
+    float32 bind matrices leaves: still at rest, so still the standing pose."""
     agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(40, spaces.ACTION_SIZE)))
-    names, quats, _ = gesture.gesture_rotations(agent, _request(frames=40), gesture.canonical_rig())
+    rig = gesture.canonical_rig()
+    rig.under[:, :3, :3] = rotvec_to_matrix(np.tile([noise, -noise, noise], (len(rig.under), 1)))
+    names, quats, _ = gesture.gesture_rotations(agent, _request(frames=40), rig)
     hanging = {n: rotvec_to_quat(gesture.STANDING_POSE.get(n, np.zeros(3))) for n in names}
     for frame in (0, -1):
         assert np.allclose([abs(np.dot(quats[frame, k], hanging[n])) for k, n in enumerate(names)], 1.0)
@@ -224,7 +229,7 @@ def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underne
     start, end = gesture.finger_line_bones(rig.roles, arm)
     pose = rig.skeleton.pose_matrices(basis, only=(end,))
     base = pose[:, rig.skeleton.index[start], :3, 3]
-    finger, to_target = rig.skeleton.tails(pose, end) - base, target - base
+    finger, to_target = pose[:, rig.skeleton.index[end], :3, 3] - base, target - base
     cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(finger, axis=1) / np.linalg.norm(to_target, axis=1)
     angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
     phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm))
@@ -379,3 +384,11 @@ def test_a_nan_start_pose_is_refused_before_anything_is_returned():
     rig.under[rig.skeleton.index["RightForeArm"], :3, :3] = np.nan
     with pytest.raises(RLAnimateError, match="rotations of RightForeArm are not numbers"):
         gesture.gesture_rotations(ReplayAgent(np.full((60, 45), 0.5)), _request(behaviour="WAVE"), rig)
+
+
+def test_the_finger_line_runs_through_joints_index_base_to_its_farthest_joint():
+    roles = {f"RightHandIndex{k}": f"i{k}" for k in (1, 2, 3)} | {"RightHand": "hand", "RightForeArm": "forearm"}
+    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3")
+    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip")
+    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1")
+    assert gesture.finger_line_bones({"RightHand": "hand", "RightForeArm": "forearm"}, "RIGHT") == ("forearm", "hand")

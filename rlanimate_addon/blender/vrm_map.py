@@ -1,0 +1,93 @@
+"""A VRM character's own humanoid map: from its .vrm file (core.vrm), or from the VRM add-on's data.
+
+Blender's glTF importer keeps nothing of the VRM, so while this add-on is enabled each armature it
+imports from a file with a VRM humanoid keeps the file's path (`Object.rlanimate.vrm_file`, set by
+`remember_vrm_file` from the importer's hook), where Generate finds it; for an armature imported
+before, "Bone Map from VRM File" reads the file's map, checks it against the armature's bones and
+keeps its path. An armature the VRM add-on imported or set up carries the map itself
+(`Armature.vrm_addon_extension`), read here without importing the add-on.
+"""
+import bpy
+from bpy_extras.io_utils import ImportHelper
+
+from ..core import vrm
+from ..core.errors import RLAnimateError
+
+
+def roles_of(obj):
+    """{role: bone name} from the VRM add-on's map on the armature (kept up to date as bones are
+    renamed), else from its VRM file, or None when it has neither."""
+    names = [bone.name for bone in obj.data.bones]
+    roles = addon_roles(obj.data, set(names))
+    path = obj.rlanimate.vrm_file
+    if roles or not path:
+        return roles
+    try:
+        return vrm.file_roles(bpy.path.abspath(path), names, repr(obj.name))
+    except RLAnimateError as error:
+        raise RLAnimateError(f"{error} (Armature {obj.name!r} takes its bone map from that VRM file: pick the "
+                             "right one with 'Bone Map from VRM File', or clear its VRM File field in the RLAnimate "
+                             "panel to detect the bones by name.)") from None
+
+
+def remember_vrm_file(gltf):
+    """Keep the path of a VRM file on the armatures Blender's glTF importer made from it (`gltf`: the
+    importer's state, after its nodes are created); a glTF without a VRM humanoid is left alone."""
+    extensions = getattr(gltf.data, "extensions", None) or {}
+    if "VRMC_vrm" not in extensions and "VRM" not in extensions:
+        return
+    for vnode in getattr(gltf, "vnodes", {}).values():
+        obj = getattr(vnode, "blender_object", None)
+        if obj is not None and obj.type == "ARMATURE":
+            obj.rlanimate.vrm_file = gltf.filename
+
+
+def addon_roles(armature, bone_names):
+    """{role: bone name} of the VRM add-on's humanoid map on armature data (VRM 1.0 first, then 0.x), or
+    None when the add-on left no map (or is not installed): only bones the armature has count."""
+    extension = getattr(armature, "vrm_addon_extension", None)
+    if extension is None:
+        return None
+    found = {}
+    human_bones = getattr(getattr(getattr(extension, "vrm1", None), "humanoid", None), "human_bones", None)
+    if human_bones is not None:
+        found["1"] = {name: _bone_name(getattr(human_bones, vrm.snake_case(name), None))
+                      for name in vrm.ROLE_OF["1"]}
+    listed = getattr(getattr(getattr(extension, "vrm0", None), "humanoid", None), "human_bones", ())
+    found["0"] = {str(getattr(entry, "bone", "")): _bone_name(entry) for entry in listed}
+    for major in ("1", "0"):
+        roles = vrm.roles_from_map(major, {k: b for k, b in found.get(major, {}).items() if b in bone_names})
+        if roles:
+            return roles
+    return None
+
+
+def _bone_name(human_bone):
+    """The bone name a VRM add-on human bone points at ("" when unset)."""
+    node = getattr(human_bone, "node", None)
+    return str(getattr(node, "bone_name", "") or "")
+
+
+class RLANIMATE_OT_bone_map_from_vrm(bpy.types.Operator, ImportHelper):
+    """Map the active armature's bones from the humanoid map of the VRM file it was imported from"""
+    bl_idname = "rlanimate.bone_map_from_vrm"
+    bl_label = "Bone Map from VRM File"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ".vrm"
+    filter_glob: bpy.props.StringProperty(default="*.vrm;*.glb", options={"HIDDEN"})
+
+    def execute(self, context):
+        obj = context.active_object
+        if obj is None or obj.type != "ARMATURE":
+            self.report({"ERROR"}, "The active object is not an armature: select the character's armature.")
+            return {"CANCELLED"}
+        try:
+            roles = vrm.file_roles(bpy.path.abspath(self.filepath), [b.name for b in obj.data.bones],
+                                   repr(obj.name))
+        except RLAnimateError as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        obj.rlanimate.vrm_file = self.filepath
+        self.report({"INFO"}, f"{obj.name!r} now maps {len(roles)} roles from the VRM file {self.filepath}")
+        return {"FINISHED"}

@@ -1,0 +1,199 @@
+"""VRM characters from their own humanoid map, on a real VRM 0.x file (../shared/rigs) imported with
+Blender's glTF importer, on a VRM 1.0 file made from it by rewriting its JSON chunk, and from the VRM
+add-on's data on the armature: accepted with no bone-map file, pointing and waving as measured on the
+bones the mesh deforms with."""
+import json
+import struct
+
+import addon_helpers as helpers
+import bpy
+import numpy as np
+import pytest
+import deformed_measures as measures
+
+from rlanimate_addon.blender import armature_io
+from rlanimate_addon.core import vrm
+
+EXACT_MEDIAN, EXACT_WORST, OWN_MEDIAN, OWN_WORST = 1.0, 3.0, 5.0, 12.0
+
+
+def rewrite_json(source, target, change):
+    """Copy a binary glTF file with its JSON chunk passed through change(dict) -> dict; the BIN chunk kept."""
+    data = source.read_bytes()
+    length = struct.unpack("<I", data[12:16])[0]
+    gltf = change(json.loads(data[20:20 + length]))
+    text = json.dumps(gltf).encode()
+    text += b" " * (-len(text) % 4)
+    rest = data[20 + length:]
+    target.write_bytes(b"glTF" + struct.pack("<II", 2, 20 + len(text) + len(rest))
+                       + struct.pack("<I4s", len(text), b"JSON") + text + rest)
+    return target
+
+
+def as_vrm1(gltf):
+    """The VRM 0.x glTF as VRM 1.0 (VRMC_vrm, humanBones a dict, thumbs from the metacarpal), every joint
+    renamed 'joint_<index>' so that nothing but the file's map can tell which bone is which."""
+    bones = {}
+    for entry in gltf["extensions"].pop("VRM")["humanoid"]["humanBones"]:
+        name = entry["bone"].replace("ThumbProximal", "ThumbMetacarpal").replace("ThumbIntermediate", "ThumbProximal")
+        bones[name] = {"node": entry["node"]}
+    gltf["extensions"]["VRMC_vrm"] = {"specVersion": "1.0", "humanoid": {"humanBones": bones}}
+    gltf["extensionsUsed"] = ["VRMC_vrm"]
+    for index in gltf["skins"][0]["joints"]:
+        gltf["nodes"][index]["name"] = f"joint_{index:02d}"
+    return gltf
+
+
+@pytest.fixture
+def vrm1_file(tmp_path):
+    return rewrite_json(measures.require(measures.VRM0), tmp_path / "robot_vrm1.vrm", as_vrm1)
+
+
+def _check_gestures(rig, settings, family):
+    own, _ = measures.point_misses(rig, settings, 4, False, 5)
+    exact, travel = measures.point_misses(rig, settings, 4, True, 5)
+    strokes, wave_travel = measures.wave(rig, settings, "RIGHT")
+    start = measures.arm_drop(rig, "RIGHT", 1)
+    print(f"{family}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)} arm "
+          f"lengths, wave {strokes} strokes / {wave_travel:.2f}, start arm drop {start:.0f} deg")
+    assert measures.measured_bones_deform(rig, "RIGHT") and measures.measured_bones_deform(rig, "LEFT")
+    assert np.median(exact) <= EXACT_MEDIAN and exact.max() <= EXACT_WORST
+    assert np.median(own) <= OWN_MEDIAN and own.max() <= OWN_WORST
+    assert strokes >= 4 and min(travel.min(), wave_travel) >= 0.5
+    assert 60.0 < start < 85.0, "a T-pose rig with no animation starts in the standing pose, not its T-pose"
+    assert armature_io.rig_roles_of(rig)[0] == family
+
+
+def test_a_vrm0_file_imported_with_the_gltf_importer_points_and_waves(settings, tmp_path):
+    source = measures.require(measures.VRM0)
+    rig = measures.import_gltf(source, tmp_path)
+    assert rig.rlanimate.vrm_file == str(tmp_path / "x.glb"), "the import keeps the VRM file's path"
+    roles = measures.roles(rig)
+    assert roles["RightArm"] == "upper_arm.R" and roles["RightHandIndex1"] == "index.proximal.R"
+    _check_gestures(rig, settings, vrm.FAMILY)
+
+
+def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_file):
+    rig = measures.import_gltf(vrm1_file, tmp_path)
+    assert rig.rlanimate.vrm_file == str(tmp_path / "x.glb"), "the import keeps the VRM file's path"
+    roles = measures.roles(rig)
+    gltf = vrm.read_gltf_json(str(vrm1_file))
+    thumb = gltf["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]["rightThumbMetacarpal"]["node"]
+    assert roles["RightHandThumb1"] == f"joint_{thumb:02d}" and len(roles) == 45
+    _check_gestures(rig, settings, vrm.FAMILY)
+
+
+def test_an_armature_imported_without_its_vrm_path_is_mapped_from_the_file_it_is_given(settings, tmp_path, vrm1_file):
+    rig = measures.import_gltf(vrm1_file, tmp_path)
+    rig.rlanimate.vrm_file = ""  # imported before the add-on was enabled: nothing but bone names
+    target = helpers.add_empty("Target", (1.0, 3.0, 1.5))
+    with pytest.raises(RuntimeError, match="has no bone for the roles.*'Bone Map from VRM File' reads the map"):
+        helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target)
+    assert rig.animation_data is None or rig.animation_data.action is None
+    assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
+    assert rig.rlanimate.vrm_file == str(vrm1_file)
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target) == {"FINISHED"}
+
+
+def test_a_wrong_or_damaged_vrm_file_is_refused_and_the_armature_keeps_its_map(settings, tmp_path, vrm1_file):
+    rig = measures.import_gltf(vrm1_file, tmp_path)
+    assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
+    other = measures.require(measures.VRM0)  # the 0.x file names its bones otherwise
+    with pytest.raises(RuntimeError, match="names bones 'Armature' lacks"):
+        bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(other))
+    broken = tmp_path / "broken.vrm"
+    broken.write_bytes(vrm1_file.read_bytes()[:5000])
+    with pytest.raises(RuntimeError, match="truncated"):
+        bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(broken))
+    assert rig.rlanimate.vrm_file == str(vrm1_file)
+    rig.rlanimate.vrm_file = str(tmp_path / "moved.vrm")
+    with pytest.raises(RuntimeError, match="Cannot read the VRM file.*clear its VRM File field"):
+        helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
+
+
+class _Node(bpy.types.PropertyGroup):
+    bone_name: bpy.props.StringProperty()
+
+
+class _HumanBone0(bpy.types.PropertyGroup):
+    bone: bpy.props.StringProperty()
+    node: bpy.props.PointerProperty(type=_Node)
+
+
+class _Humanoid0(bpy.types.PropertyGroup):
+    human_bones: bpy.props.CollectionProperty(type=_HumanBone0)
+
+
+class _Vrm0(bpy.types.PropertyGroup):
+    humanoid: bpy.props.PointerProperty(type=_Humanoid0)
+
+
+class _Vrm1HumanBone(bpy.types.PropertyGroup):
+    node: bpy.props.PointerProperty(type=_Node)
+
+
+#: VRM 1.0: one pointer per human bone, named in snake case (left_upper_arm, left_thumb_metacarpal, ...).
+_Vrm1HumanBones = type("_Vrm1HumanBones", (bpy.types.PropertyGroup,), {"__annotations__": {
+    vrm.snake_case(name): bpy.props.PointerProperty(type=_Vrm1HumanBone) for name in vrm.ROLE_OF["1"]}})
+
+
+class _Vrm1Humanoid(bpy.types.PropertyGroup):
+    human_bones: bpy.props.PointerProperty(type=_Vrm1HumanBones)
+
+
+class _Vrm1(bpy.types.PropertyGroup):
+    humanoid: bpy.props.PointerProperty(type=_Vrm1Humanoid)
+
+
+class _Extension(bpy.types.PropertyGroup):
+    vrm0: bpy.props.PointerProperty(type=_Vrm0)
+    vrm1: bpy.props.PointerProperty(type=_Vrm1)
+
+
+_ADDON_LAYOUT = (_Node, _HumanBone0, _Humanoid0, _Vrm0, _Vrm1HumanBone, _Vrm1HumanBones, _Vrm1Humanoid, _Vrm1,
+                 _Extension)
+
+
+@pytest.fixture
+def vrm_addon_layout(settings):
+    """The VRM add-on's data layout on armatures (saturday06/VRM-Addon-for-Blender, editor/vrm0 and vrm1
+    property_group.py: Armature.vrm_addon_extension.vrm0.humanoid.human_bones, a list of {bone,
+    node.bone_name}; .vrm1.humanoid.human_bones.<snake_case name>.node.bone_name), registered as the
+    add-on registers it, without the add-on."""
+    for cls in _ADDON_LAYOUT:
+        bpy.utils.register_class(cls)
+    bpy.types.Armature.vrm_addon_extension = bpy.props.PointerProperty(type=_Extension)
+    yield
+    del bpy.types.Armature.vrm_addon_extension
+    for cls in reversed(_ADDON_LAYOUT):
+        bpy.utils.unregister_class(cls)
+
+
+@pytest.mark.parametrize("major", ["0", "1"])
+def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addon_layout, major):
+    source = measures.require(measures.VRM0)
+    rig = measures.import_gltf(source, tmp_path)
+    for bone in rig.data.bones:  # names no family, nor the file, knows: only the add-on's map can tell
+        bone.name = "b_" + bone.name.replace(".", "_")
+    gltf = vrm.read_gltf_json(str(source))
+    names = vrm.imported_bone_names(gltf)
+    extension = rig.data.vrm_addon_extension
+    for entry in gltf["extensions"]["VRM"]["humanoid"]["humanBones"]:
+        bone_name = "b_" + names[entry["node"]].replace(".", "_")
+        if major == "0":
+            human_bone = extension.vrm0.humanoid.human_bones.add()
+            human_bone.bone = entry["bone"]
+        else:
+            vrm1_name = entry["bone"].replace("ThumbProximal", "ThumbMetacarpal").replace(
+                "ThumbIntermediate", "ThumbProximal")
+            human_bone = getattr(extension.vrm1.humanoid.human_bones, vrm.snake_case(vrm1_name), None)
+            if human_bone is None:  # legs: no role
+                continue
+        human_bone.node.bone_name = bone_name
+    roles = measures.roles(rig)
+    assert roles["LeftForeArm"] == "b_lower_arm_L" and roles["RightHandIndex3"] == "b_index_distal_R"
+    assert roles["RightHandThumb1"] == "b_thumb_proximal_R" and len(roles) == 45
+    target = helpers.add_empty("Target", measures.world_target(rig, "RIGHT", np.random.default_rng(3)))
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, frame_count=120) == {"FINISHED"}
+    angles, bases = measures.finger_angles(rig, "RIGHT", np.array(target.location), np.arange(1, 121))
+    assert measures.hold_miss(rig, angles, bases) <= EXACT_WORST
