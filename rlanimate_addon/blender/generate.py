@@ -2,7 +2,7 @@
 import bpy
 import numpy as np
 
-from ..core import blas_threads, channels, gesture, key_reduction, rig_roles, rig_scale
+from ..core import blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
 from ..core.errors import RLAnimateError
 from . import armature_io, bake_check, constraints, preferences, properties
 
@@ -148,7 +148,7 @@ def _compute(context, plan, settings, agent, frames):
         request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
                                          targets=targets if settings.behaviour == "POINT" else None,
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
-                                         exact_aim=settings.exact_aim)
+                                         exact_aim=settings.exact_aim, fps=properties.scene_fps(scene))
         plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
         plan.keyed = keyed
         if target is not None:
@@ -219,8 +219,9 @@ def _write(plan, agent, scene):
     end = start + count - 1
     label = f"{settings.behaviour.title()} {settings.arm.title()}"
     note = ""
-    steps = gesture.rollout_length(count, agent.average_frames[settings.behaviour], settings.behaviour)
-    if steps != count:
+    span = frame_rate.agent_frames(count, properties.scene_fps(scene))
+    steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], settings.behaviour)
+    if steps != span:
         note += f" (time-scaled from the agent's {steps}-frame gesture)"
     note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
     if settings.behaviour == "POINT" and not settings.exact_aim:

@@ -25,7 +25,7 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
 """
 import numpy as np
 
-from . import aim, rig_roles, skeleton, spaces
+from . import aim, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, inverse
 from .rotations import matrix_to_quat, matrix_to_rotvec, quat_to_matrix, rotvec_to_matrix
@@ -180,14 +180,14 @@ def rollout_length(frame_count, average_frames, behaviour):
     return int(np.clip(frame_count, shortest, longest))
 
 
-def run_agent(agent, behaviour, objectives, seed=None):
-    """Canonical local rotation vectors (N, 15, 3) for the objectives (N, 7).
+def run_agent(agent, behaviour, objectives, seed=None, frame_count=None):
+    """Canonical local rotation vectors (N, 15, 3) for the objectives (M, 7) at the agent's rate.
 
-    The agent runs for `rollout_length` steps; when that is not N, its actions are resampled to N
-    frames (time-scaled).
+    The agent runs for `rollout_length(M)` steps; its actions are resampled to the N = frame_count
+    scene frames (M when None) when that differs (time-scaled, or played at the scene's rate).
     """
-    count = len(objectives)
-    steps = rollout_length(count, agent.average_frames[behaviour], behaviour)
+    count = len(objectives) if frame_count is None else int(frame_count)
+    steps = rollout_length(len(objectives), agent.average_frames[behaviour], behaviour)
     agent_objectives = resample(objectives, steps)
     agent_objectives[:, spaces.OBJECTIVE_TIME] = np.linspace(0.0, 1.0, steps)
     if behaviour == "POINT":
@@ -490,12 +490,15 @@ def gesture_rotations(agent, request, rig):
     rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
     rest_heads = rig.rest_heads
     check_length(request.frame_count)
-    rhythm = (agent.wave_rhythm(request.exaggeration, request.frame_count, request.seed)
+    span = request.agent_frames  # M: the gesture's seconds at the agent's rate
+    rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed)
               if request.behaviour == "WAVE" else None)
-    asked = None if request.targets is None else hips_relative_targets(rig, request.targets, request.frame_count)
-    objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=asked,
+    asked = None if request.targets is None else resample(
+        hips_relative_targets(rig, request.targets, request.frame_count), span)  # (M, 3)
+    objectives = build_objectives(request.behaviour, request.arm, span, targets=asked,
                                   rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
-    canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
+    canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed,
+                          frame_count=request.frame_count)  # (N, 15, 3)
     phase_base = played_finger_base(canonical, request.arm) if request.behaviour == "POINT" else None
     names, canonical = fold_spine(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
     if request.behaviour == "POINT":
@@ -552,14 +555,22 @@ def gesture_rotations(agent, request, rig):
 
 
 class GestureRequest:
-    """What the user asked for: behaviour, arm, length, seed, the behaviour's attribute, and whether
-    Point solves its aim exactly on the rig (else it keys the agent's own aim)."""
+    """What the user asked for: behaviour, arm, length in scene frames at the scene's `fps`, seed, the
+    behaviour's attribute, and whether Point solves its aim exactly on the rig (else it keys the
+    agent's own aim)."""
 
-    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True):
+    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True,
+                 fps=frame_rate.AGENT_FPS):
         self.behaviour, self.arm = behaviour, arm
         self.frame_count, self.seed = int(frame_count), seed
         self.targets, self.exaggeration = targets, float(exaggeration)
         self.exact_aim = bool(exact_aim)
+        self.fps = float(fps)
+
+    @property
+    def agent_frames(self):
+        """The gesture's length at the agent's rate (core/frame_rate.py)."""
+        return frame_rate.agent_frames(self.frame_count, self.fps)
 
 
 class RigState:
