@@ -42,6 +42,12 @@ class ActionTarget:
         fcurves = self._fcurves()
         return [] if fcurves is None else list(fcurves)
 
+    def clear_fcurves(self):
+        """Remove every F-curve of this target (the action and its slot stay)."""
+        fcurves = self._fcurves()
+        if fcurves is not None:
+            fcurves.clear()
+
 
 def _channelbag(action, slot, create):
     if slot is None:
@@ -100,6 +106,14 @@ def write_bezier_keys(fcurve, frames, values, tangents):
         points.foreach_set(name, np.full(count, value, dtype=np.int32))
 
 
+def all_fcurves(action):
+    """Every F-curve of the action, of every slot."""
+    if not LAYERED:
+        return list(action.fcurves)
+    return [fcurve for layer in action.layers for strip in layer.strips for bag in strip.channelbags
+            for fcurve in bag.fcurves]
+
+
 def active_target(obj):
     """The ActionTarget the object's active action plays through, or None without one."""
     data = obj.animation_data
@@ -108,13 +122,17 @@ def active_target(obj):
     return ActionTarget(data.action, data.action_slot if LAYERED else None)
 
 
+def strip_target(strip):
+    """The ActionTarget an NLA strip with an action plays."""
+    return ActionTarget(strip.action, getattr(strip, "action_slot", None) if LAYERED else None)
+
+
 def strip_targets(obj):
     """ActionTargets of every NLA strip of the object, bottom track first."""
     data = obj.animation_data
     if data is None:
         return []
-    return [ActionTarget(strip.action, getattr(strip, "action_slot", None) if LAYERED else None)
-            for track in data.nla_tracks for strip in track.strips if strip.action is not None]
+    return [strip_target(strip) for track in data.nla_tracks for strip in track.strips if strip.action is not None]
 
 
 def is_animated(obj):
@@ -162,6 +180,11 @@ def add_strip(obj, target, start_frame, name):
     data = obj.animation_data or obj.animation_data_create()
     track = data.nla_tracks.new()
     track.name = name
+    return fill_track(track, target, start_frame, name)
+
+
+def fill_track(track, target, start_frame, name):
+    """Put `target` on the track as a strip called `name` from start_frame, with no effect outside it."""
     strip = _new_strip(track, target, start_frame)
     strip.name = name
     strip.extrapolation = "NOTHING"

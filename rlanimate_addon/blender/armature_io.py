@@ -144,6 +144,18 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
     blend type ('REPLACE' or 'COMBINE') and no effect outside its frames.
     """
     target = action_adapter.new_action(name, obj)
+    key_action(target, start_frame, keys)
+    if action_adapter.is_animated(obj):
+        action_adapter.push_down(obj, played)
+        strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
+        strip.blend_type = blend_type
+    else:
+        action_adapter.assign(obj, target)
+    return target.action
+
+
+def key_action(target, start_frame, keys):
+    """Key a gesture from start_frame into an ActionTarget without F-curves (keys as `write_gesture`'s)."""
     for bone, (mode, values, kept) in keys.items():
         frames = start_frame + np.arange(len(values))
         path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
@@ -154,10 +166,3 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
                 action_adapter.write_keys(fcurve, frames, values[:, channel])
             else:
                 action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel])
-    if action_adapter.is_animated(obj):
-        action_adapter.push_down(obj, played)
-        strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
-        strip.blend_type = blend_type
-    else:
-        action_adapter.assign(obj, target)
-    return target.action

@@ -4,7 +4,7 @@ import numpy as np
 
 from ..core import blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
 from ..core.errors import RLAnimateError
-from . import armature_io, bake_check, constraints, preferences, properties
+from . import armature_io, bake_check, constraints, gestures, preferences, properties
 
 
 def _check_target(settings):
@@ -95,6 +95,8 @@ class _Plan:
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
         self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.settings = None
         self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
+        self.previous = None  # the gesture it replaces (blender/gestures.py)
+        self.under = {}  # {bone: channel values} of keyed bones that stand still underneath
         self.worst = 0.0
 
 
@@ -154,6 +156,7 @@ def _compute(context, plan, settings, agent, frames):
         if target is not None:
             plan.target, plan.target_bone, plan.targets = target, bone, targets
         plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
+        plan.under = {bone: below_values[bone][0] for bone in plan.bones if not np.ptp(below_values[bone], axis=0).any()}
         plan.keys = {}
         for column, bone in enumerate(plan.bones):
             mode = obj.pose.bones[bone].rotation_mode
@@ -176,14 +179,23 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
     as it was (the scene frame included). Constraints that would override the gesture are refused, or
     muted over its frames with mute_constraints (blender/constraints.py). After the writes each rig is
     played and its deformed hand measured (blender/bake_check.py): a bake that does not play is undone,
-    every armature's, and refused.
+    every armature's, and refused. A gesture on the same arm over overlapping frames is
+    replaced in place unless Keep Previous is on (blender/gestures.py).
     """
+    armatures = selected_armatures(context, settings)
+    return bake(context, [(obj, properties.settings_for(obj, settings)) for obj in armatures], progress,
+                mute_constraints)
+
+
+def bake(context, requests, progress=lambda step: None, mute_constraints=False):
+    """`generate` for [(armature, its settings)]; returns the summary."""
     plans = []
-    for obj in selected_armatures(context, settings):
-        own = properties.settings_for(obj, settings)
+    for obj, own in requests:
         start = int(own.start_frame)
-        plan = _check(obj, own, start, start + int(own.frame_count) - 1, mute_constraints)
+        end = start + int(own.frame_count) - 1
+        plan = _check(obj, own, start, end, mute_constraints)
         plan.settings = own
+        plan.previous = None if own.keep_previous else gestures.overlapping(obj, own.arm, start, end)
         plans.append(plan)
     agent = preferences.selected_agent(context)
     for plan in plans:
@@ -193,7 +205,8 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
     progress(1)
     for plan in plans:
         start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
-        _compute(context, plan, plan.settings, agent, start + np.arange(count))
+        with gestures.detached(plan.previous, context.view_layer):
+            _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
     undo = [bake_check.BakeUndo(plan.obj, plan.overriding) for plan in plans]
     scene = context.scene
@@ -226,8 +239,13 @@ def _write(plan, agent, scene):
     note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
-    action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                       (min(scene.frame_start, start), max(scene.frame_end, end)))
+    if plan.previous is not None:
+        action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type)
+        note += " (replaced the previous gesture)"
+    else:
+        action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
+                                           (min(scene.frame_start, start), max(scene.frame_end, end)))
+    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets)
     constraints.mute(plan.obj, plan.overriding, start, end)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""

@@ -86,6 +86,9 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
 
         layout.prop(settings, "blend_type", expand=True)
         row = layout.row(align=True)
+        row.prop(settings, "keep_previous")
+        row.prop(context.scene.rlanimate, "follow_target")
+        row = layout.row(align=True)
         row.prop(settings, "editable_keys")
         if settings.editable_keys:
             row.prop(settings, "key_tolerance")

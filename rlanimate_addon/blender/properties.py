@@ -100,6 +100,14 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     bone_map_file: bpy.props.StringProperty(
         name="Bone Map", default="", subtype="FILE_PATH",
         description="A bone-map file (JSON) naming the rig's bone for each role; empty detects the bones")
+    keep_previous: bpy.props.BoolProperty(
+        name="Keep Previous", default=False,
+        description="Layer the new gesture over an earlier one on the same arm and frames, on a new NLA track, "
+                    "instead of replacing it in place")
+    follow_target: bpy.props.BoolProperty(
+        name="Follow Target", default=False,
+        description="While on, moving the target of an armature's last Point gesture re-bakes that gesture "
+                    "(until its keys are edited by hand)")
     seed: bpy.props.IntProperty(
         name="Variation Seed", min=0, default=0,
         description="0 gives the agent's most likely gesture; other values give variations")

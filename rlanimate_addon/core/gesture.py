@@ -106,6 +106,15 @@ def character_frame(rest_heads):
 REACH_MARGIN = 1.1
 
 
+def check_finite_targets(targets):
+    """RLAnimateError when any target (N, 3) is not a number."""
+    broken = ~np.isfinite(np.atleast_2d(targets)).all(axis=1)
+    if np.any(broken):
+        raise RLAnimateError(f"The target's position is not a number (NaN or infinite) on {broken.sum()} of the "
+                             f"gesture's {len(broken)} frames: check the target's location, constraints, drivers "
+                             "and parents, and the armature's transform.")
+
+
 def pointing_directions(arm, targets, rest_heads):
     """(N, 3) unit vectors in the character frame from the rig's rest shoulder to each target.
 
@@ -115,11 +124,7 @@ def pointing_directions(arm, targets, rest_heads):
     offsets = np.atleast_2d(np.asarray(targets, dtype=np.float64)) - shoulder  # (N, 3)
     norms = np.linalg.norm(offsets, axis=1)
     scale = np.linalg.norm(np.subtract(rest_heads["Head"], shoulder))
-    broken = ~np.isfinite(norms)
-    if np.any(broken):
-        raise RLAnimateError(f"The target's position is not a number (NaN or infinite) on {broken.sum()} of the "
-                             f"gesture's {len(norms)} frames: check the target's location, constraints, drivers "
-                             "and parents, and the armature's transform.")
+    check_finite_targets(targets)
     if np.any(norms < 1e-3 * scale):
         raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
     reach = arm_reach(arm, rest_heads)
@@ -493,6 +498,8 @@ def gesture_rotations(agent, request, rig):
     span = request.agent_frames  # M: the gesture's seconds at the agent's rate
     rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed)
               if request.behaviour == "WAVE" else None)
+    if request.targets is not None:
+        check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))
     asked = None if request.targets is None else resample(
         hips_relative_targets(rig, request.targets, request.frame_count), span)  # (M, 3)
     objectives = build_objectives(request.behaviour, request.arm, span, targets=asked,

@@ -1,0 +1,152 @@
+"""An armature's RLAnimate gestures: found, replaced in place, and recorded for Follow Target.
+
+Each gesture's action carries a record (the custom property RECORD): its behaviour, arm and frames,
+the settings it was made from, the rotations underneath its bones where they do not move, where it
+aimed, and a hash of its keys. Generate finds the gesture it overlaps (same arm, overlapping frames;
+the topmost, the active action first) and bakes the new one into the same action and NLA track:
+the animation underneath is untouched, and the same settings give the same keys however many times
+Generate runs. Follow Target re-bakes the last Point gesture from its record while its keys still
+hash as they were written (`edited_by_hand`).
+"""
+import contextlib
+import hashlib
+
+import numpy as np
+
+from . import action_adapter, armature_io
+
+#: The custom property of a gesture's action that holds its record.
+RECORD = "rlanimate_gesture"
+
+
+class Placed:
+    """A gesture's action where it plays: the active action (track None) or the strip of an NLA track."""
+
+    def __init__(self, obj, target, track=None):
+        self.obj, self.target, self.track = obj, target, track
+
+    @property
+    def action(self):
+        return self.target.action
+
+    @property
+    def record(self):
+        return self.action[RECORD]
+
+
+def placed_gestures(obj):
+    """The armature's recorded gestures as Placed, topmost first (the active action, then the NLA
+    tracks from the top)."""
+    data = obj.animation_data
+    if data is None:
+        return []
+    found = []
+    active = action_adapter.active_target(obj)
+    if active is not None and RECORD in active.action:
+        found.append(Placed(obj, active))
+    for track in reversed(data.nla_tracks):
+        for strip in track.strips:
+            if strip.action is not None and RECORD in strip.action:
+                found.append(Placed(obj, action_adapter.strip_target(strip), track))
+    return found
+
+
+def overlapping(obj, arm, start, end):
+    """The topmost gesture of the armature on the same arm whose frames overlap start-end, or None."""
+    return next((g for g in placed_gestures(obj)
+                 if g.record["arm"] == arm and g.record["start"] <= end and start <= g.record["end"]), None)
+
+
+def last_point(obj):
+    """The armature's topmost Point gesture, or None."""
+    return next((g for g in placed_gestures(obj) if g.record["behaviour"] == "POINT"), None)
+
+
+@contextlib.contextmanager
+def detached(gesture, view_layer):
+    """While inside, the armature plays without `gesture` (None: nothing changes): an active action is
+    unassigned, or its NLA track muted, and the bones that stood still beneath it are put back where
+    they stood (and stay there: the gesture replacing it may key fewer bones). The gesture plays again
+    on leaving; after an error the pose is as it was, too."""
+    if gesture is None:
+        yield
+        return
+    data = gesture.obj.animation_data
+    muted = gesture.track.mute if gesture.track is not None else None
+    if gesture.track is None:
+        data.action = None
+    else:
+        gesture.track.mute = True
+    # A bone nothing else animates keeps the gesture's last pose once it stops playing.
+    standing = {}
+    for bone, values in gesture.record.get("under", {}).items():
+        pose_bone = gesture.obj.pose.bones.get(bone)
+        if pose_bone is not None:
+            path = armature_io.rotation_path(pose_bone.rotation_mode)
+            standing[pose_bone, path] = tuple(getattr(pose_bone, path))
+            setattr(pose_bone, path, list(values))
+    view_layer.update()
+    try:
+        yield
+    except BaseException:
+        for (pose_bone, path), values in standing.items():
+            setattr(pose_bone, path, values)
+        raise
+    finally:
+        if gesture.track is None:
+            action_adapter.assign(gesture.obj, gesture.target)
+        else:
+            gesture.track.mute = muted
+
+
+def replace(gesture, name, start_frame, keys, blend_type):
+    """Bake the keys into the gesture's own action, renamed `name`, where it plays: as the active
+    action, or as the one strip of its NLA track from start_frame (armature_io.key_action's keys)."""
+    gesture.target.clear_fcurves()
+    armature_io.key_action(gesture.target, start_frame, keys)
+    gesture.action.name = name
+    if gesture.track is None:
+        gesture.obj.animation_data.action_blend_type = blend_type
+        return gesture.action
+    for strip in list(gesture.track.strips):
+        gesture.track.strips.remove(strip)
+    gesture.track.name = name
+    action_adapter.fill_track(gesture.track, gesture.target, start_frame, name).blend_type = blend_type
+    return gesture.action
+
+
+def keys_hash(action):
+    """Hex digest of every key and handle of the action's F-curves: it changes when anyone edits them."""
+    digest = hashlib.sha1()
+    for fcurve in sorted(action_adapter.all_fcurves(action), key=lambda f: (f.data_path, f.array_index)):
+        digest.update(f"{fcurve.data_path}[{fcurve.array_index}]".encode())
+        points = fcurve.keyframe_points
+        for field in ("co", "handle_left", "handle_right"):
+            values = np.empty(2 * len(points), dtype=np.float32)
+            points.foreach_get(field, values)
+            digest.update(values.tobytes())
+    return digest.hexdigest()
+
+
+def record(action, settings, start, end, under, aimed_at):
+    """Write the action's record: settings (a mapping of Scene.rlanimate's names to values), under
+    ({bone: channel values} of bones that stand still underneath), aimed_at ((N, 3) armature-space
+    targets per frame, or None)."""
+    action[RECORD] = {
+        "behaviour": settings["behaviour"], "arm": settings["arm"], "start": int(start), "end": int(end),
+        "settings": settings, "under": {bone: list(map(float, values)) for bone, values in under.items()},
+        "aimed_at": [] if aimed_at is None else np.asarray(aimed_at, dtype=np.float64).ravel().tolist(),
+        "keys": keys_hash(action), "note": ""}
+
+
+def edited_by_hand(gesture):
+    """Whether the gesture's keys changed since Generate wrote them."""
+    return keys_hash(gesture.action) != gesture.record["keys"]
+
+
+def snapshot(settings):
+    """{name: value} of every setting of a Scene.rlanimate group that has one (the target as the object
+    itself; no target, none)."""
+    values = {p.identifier: getattr(settings, p.identifier) for p in settings.bl_rna.properties
+              if p.identifier != "rna_type"}
+    return {name: value for name, value in values.items() if value is not None}
