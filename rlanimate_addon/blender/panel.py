@@ -5,7 +5,7 @@ import bpy
 
 from ..core import frame_rate, gesture
 from ..core.errors import RLAnimateError
-from . import armature_io, constraints, preferences, properties
+from . import armature_io, constraints, follow_target, preferences, properties
 
 
 def _agent_summary(context, behaviour):
@@ -88,6 +88,9 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
         row = layout.row(align=True)
         row.prop(settings, "keep_previous")
         row.prop(context.scene.rlanimate, "follow_target")
+        stopped = follow_target.note(obj) if context.scene.rlanimate.follow_target else ""
+        if stopped:
+            layout.box().label(text=stopped, icon="INFO")
         row = layout.row(align=True)
         row.prop(settings, "editable_keys")
         if settings.editable_keys:
