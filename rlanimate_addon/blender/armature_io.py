@@ -13,7 +13,7 @@ import numpy as np
 from ..core import key_reduction, rig_roles
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
-from . import action_adapter
+from . import action_adapter, pose_underneath
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
 ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
@@ -66,16 +66,25 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
     """(RigState, {bone: (N, C) rotation channel values underneath}, targets (N, 3)).
 
     The bones playing roles are read (their basis and their evaluated pose, constraints included) at
-    every frame of an animated rig (scene.frame_set), as its action, NLA and drivers play it; a still
-    rig once. The target (an object, a bone of an armature when target_bone names one, or the
-    3D cursor when target is None) is read in the rig's armature space at each frame where anything
-    can move it. The caller restores the scene's frame.
+    every frame of an animated rig, as its action, NLA and drivers play it: from their keys in numpy
+    where only keys move them and the rig and target stand still (blender/pose_underneath.py), else
+    by scene.frame_set; a still rig once. The target (an object, a bone of an armature when
+    target_bone names one, or the 3D cursor when target is None) is read in the rig's armature space
+    at each frame where anything can move it. The caller restores the scene's frame.
     """
     scene = context.scene
     animated = action_adapter.is_animated(obj)
     target_moves = target is not None and (may_move(target) or (target_bone and action_adapter.is_animated(target)))
     moving = animated or may_move(obj) or target_moves
     skeleton = read_skeleton(obj, roles)
+    count = len(frames)
+    evaluated = None
+    if animated and not may_move(obj) and not target_moves:
+        evaluated = pose_underneath.sample(obj, skeleton.names, frames)
+    if evaluated is not None:
+        under, poses, values = evaluated
+        rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
+        return rig, values, np.broadcast_to(target_point(obj, target, target_bone, scene), (count, 3))
     pose_bones = [obj.pose.bones[name] for name in skeleton.names]
     under, poses, values, targets = [], [], {b: [] for b in skeleton.names}, []
     for frame in (frames if moving else frames[:1]):
@@ -87,7 +96,6 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
         for pb in pose_bones:
             values[pb.name].append(_rotation_values(pb))
         targets.append(target_point(obj, target, target_bone, scene))
-    count = len(frames)
     under, poses = (np.broadcast_to(np.array(m), (count,) + np.shape(m)[1:]) for m in (under, poses))
     values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
     rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
