@@ -140,7 +140,7 @@ def _to_armature(obj, point):
     return (np.array(obj.matrix_world.inverted(), dtype=np.float64) @ np.append(point, 1.0))[:3]
 
 
-def write_gesture(obj, name, start_frame, keys, blend_type, played):
+def write_gesture(obj, name, start_frame, keys, blend_type, played, digest=None):
     """Key a gesture from start_frame into a new action called `name`; returns the new action.
 
     keys: {bone name: (rotation mode, (N, C) channel values per frame, kept frame indices or None)}:
@@ -149,10 +149,11 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
     becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
     Blender's Push Down does, playing as before over its keys and the `played` frames (first, last:
     the scene's range and the gesture's), and the gesture goes on a new NLA track above it with the
-    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames.
+    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames. The keys feed the
+    action_adapter.KeyDigest given.
     """
     target = action_adapter.new_action(name, obj)
-    key_action(target, start_frame, keys)
+    key_action(target, start_frame, keys, digest)
     if action_adapter.is_animated(obj):
         action_adapter.push_down(obj, played)
         strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
@@ -162,8 +163,9 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played):
     return target.action
 
 
-def key_action(target, start_frame, keys):
-    """Key a gesture from start_frame into an ActionTarget without F-curves (keys as `write_gesture`'s)."""
+def key_action(target, start_frame, keys, digest=None):
+    """Key a gesture from start_frame into an ActionTarget without F-curves (keys and digest as
+    `write_gesture`'s)."""
     for bone, (mode, values, kept) in keys.items():
         frames = start_frame + np.arange(len(values))
         path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
@@ -171,6 +173,7 @@ def key_action(target, start_frame, keys):
         for channel in range(values.shape[1]):
             fcurve = target.new_fcurve(path, channel, bone)
             if kept is None:
-                action_adapter.write_keys(fcurve, frames, values[:, channel])
+                action_adapter.write_keys(fcurve, frames, values[:, channel], digest)
             else:
-                action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel])
+                action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel],
+                                                 digest)

@@ -4,7 +4,7 @@ import numpy as np
 
 from ..core import blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
 from ..core.errors import RLAnimateError
-from . import armature_io, bake_check, constraints, gestures, preferences, properties
+from . import action_adapter, armature_io, bake_check, constraints, gestures, preferences, properties
 
 
 def _check_target(settings):
@@ -239,13 +239,14 @@ def _write(plan, agent, scene):
     note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
+    digest = action_adapter.KeyDigest()
     if plan.previous is not None:
-        action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type)
+        action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type, digest)
         note += " (replaced the previous gesture)"
     else:
         action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                           (min(scene.frame_start, start), max(scene.frame_end, end)))
-    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets)
+                                           (min(scene.frame_start, start), max(scene.frame_end, end)), digest)
+    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets, digest.hexdigest())
     constraints.mute(plan.obj, plan.overriding, start, end)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""

@@ -9,7 +9,6 @@ Generate runs. Follow Target re-bakes the last Point gesture from its record whi
 hash as they were written (`edited_by_hand`).
 """
 import contextlib
-import hashlib
 
 import numpy as np
 
@@ -99,11 +98,12 @@ def detached(gesture, view_layer):
             gesture.track.mute = muted
 
 
-def replace(gesture, name, start_frame, keys, blend_type):
+def replace(gesture, name, start_frame, keys, blend_type, digest=None):
     """Bake the keys into the gesture's own action, renamed `name`, where it plays: as the active
-    action, or as the one strip of its NLA track from start_frame (armature_io.key_action's keys)."""
+    action, or as the one strip of its NLA track from start_frame (armature_io.key_action's keys and
+    digest)."""
     gesture.target.clear_fcurves()
-    armature_io.key_action(gesture.target, start_frame, keys)
+    armature_io.key_action(gesture.target, start_frame, keys, digest)
     gesture.action.name = name
     if gesture.track is None:
         gesture.obj.animation_data.action_blend_type = blend_type
@@ -115,33 +115,20 @@ def replace(gesture, name, start_frame, keys, blend_type):
     return gesture.action
 
 
-def keys_hash(action):
-    """Hex digest of every key and handle of the action's F-curves: it changes when anyone edits them."""
-    digest = hashlib.sha1()
-    for fcurve in sorted(action_adapter.all_fcurves(action), key=lambda f: (f.data_path, f.array_index)):
-        digest.update(f"{fcurve.data_path}[{fcurve.array_index}]".encode())
-        points = fcurve.keyframe_points
-        for field in ("co", "handle_left", "handle_right"):
-            values = np.empty(2 * len(points), dtype=np.float32)
-            points.foreach_get(field, values)
-            digest.update(values.tobytes())
-    return digest.hexdigest()
-
-
-def record(action, settings, start, end, under, aimed_at):
+def record(action, settings, start, end, under, aimed_at, keys):
     """Write the action's record: settings (a mapping of Scene.rlanimate's names to values), under
     ({bone: channel values} of bones that stand still underneath), aimed_at ((N, 3) armature-space
-    targets per frame, or None)."""
+    targets per frame, or None), keys (the hex KeyDigest of the keys written)."""
     action[RECORD] = {
         "behaviour": settings["behaviour"], "arm": settings["arm"], "start": int(start), "end": int(end),
         "settings": settings, "under": {bone: list(map(float, values)) for bone, values in under.items()},
         "aimed_at": [] if aimed_at is None else np.asarray(aimed_at, dtype=np.float64).ravel().tolist(),
-        "keys": keys_hash(action), "note": ""}
+        "keys": keys, "note": ""}
 
 
 def edited_by_hand(gesture):
     """Whether the gesture's keys changed since Generate wrote them."""
-    return keys_hash(gesture.action) != gesture.record["keys"]
+    return action_adapter.read_digest(action_adapter.all_fcurves(gesture.action)).hexdigest() != gesture.record["keys"]
 
 
 def snapshot(settings):

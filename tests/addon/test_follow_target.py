@@ -53,6 +53,7 @@ def test_moving_the_target_re_bakes_the_point_at_the_new_position(settings):
 
 def test_a_gesture_edited_by_hand_is_never_re_baked(settings):
     rig, target = _point(settings)
+    assert not gestures.edited_by_hand(gestures.last_point(rig)), "the keys as written hash as read back"
     action = rig.animation_data.action
     fcurve = action_adapter.all_fcurves(action)[0]
     fcurve.keyframe_points[10].co.y += 0.1  # the animator's own edit
@@ -73,3 +74,16 @@ def test_the_handler_comes_and_goes_with_the_add_on(settings):
     assert follow_target._on_update not in handlers
     helpers.enable_addon()
     assert handlers.count(follow_target._on_update) == 1
+
+
+def test_moving_a_handle_of_editable_keys_is_an_edit(settings):
+    rig = helpers.load_sample_rig()
+    target = helpers.add_empty("Target", OLD)
+    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, editable_keys=True) \
+        == {"FINISHED"}
+    gesture = gestures.last_point(rig)
+    assert not gestures.edited_by_hand(gesture)
+    point = next(p for f in action_adapter.all_fcurves(gesture.action) for p in f.keyframe_points
+                 if p.interpolation == "BEZIER")
+    point.handle_right.y += 0.05
+    assert gestures.edited_by_hand(gesture)
