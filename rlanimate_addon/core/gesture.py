@@ -28,7 +28,8 @@ import numpy as np
 from . import aim, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, inverse
-from .rotations import matrix_to_quat, matrix_to_rotvec, quat_to_matrix, rotvec_to_matrix
+from .rotations import (matrix_to_quat, matrix_to_rotvec, quat_to_matrix, quat_to_rotvec, rotvec_to_matrix,
+                        rotvec_to_quat)
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
 SUPPORTED_LENGTH = (0.4, 1.5)
@@ -479,9 +480,9 @@ def played_finger_base(canonical, arm):
     """(N, 3) index-base path of canonical rotations (N, 15, 3) blended from their first frame as the keys
     blend from the pose underneath (`blend_weights`): it comes back to its start even where the agent's
     own hand does not (a target behind the character), so the aim's pointing phase stays whole."""
-    quats = matrix_to_quat(rotvec_to_matrix(canonical))  # (N, 15, 4)
+    quats = rotvec_to_quat(canonical)  # (N, 15, 4)
     blended = blend_from_pose(quats[0], quats, blend_weights(len(canonical)))
-    return aim.finger_lines(matrix_to_rotvec(quat_to_matrix(blended)), arm)[1]
+    return aim.finger_lines(quat_to_rotvec(blended), arm)[1]
 
 
 def gesture_rotations(agent, request, rig):

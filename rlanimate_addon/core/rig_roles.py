@@ -171,6 +171,13 @@ def family_roles(bone_names, family):
 
 def detect(bone_names):
     """(family, {role: bone name}) of the family that recognises the most roles (ties: FAMILIES order)."""
+    family, roles = _detect(tuple(bone_names))
+    return family, dict(roles)
+
+
+@lru_cache(maxsize=16)
+def _detect(bone_names):
+    """`detect`, remembered per rig's bone names: matching every family takes a few milliseconds."""
     controlled = bool(family_roles(bone_names, RIGIFY))
     scored = [(len(family_roles(bone_names, f)), -i, f) for i, f in enumerate(FAMILIES)
               if not (f is RIGIFY_DEFORM and controlled)]
