@@ -12,6 +12,7 @@ import contextlib
 
 import numpy as np
 
+from ..core.behaviours import POINT
 from . import action_adapter, armature_io
 
 #: The custom property of a gesture's action that holds its record.
@@ -58,7 +59,7 @@ def overlapping(obj, arm, start, end):
 
 def last_point(obj):
     """The armature's topmost Point gesture, or None."""
-    return next((g for g in placed_gestures(obj) if g.record["behaviour"] == "POINT"), None)
+    return next((g for g in placed_gestures(obj) if g.record["behaviour"] == POINT), None)
 
 
 @contextlib.contextmanager
