@@ -8,7 +8,7 @@ Bezier keys and constant extrapolation (any other curve is evaluated by Blender'
 or their parents. `sample` returns None anywhere else, and the caller lets Blender evaluate.
 
 Blender's Bezier segments are cubic in both the frame and the value: each frame is solved for the
-curve parameter by bisection on the segment (each handle first shortened to the segment's length,
+curve parameter by Newton's method on the segment (each handle first shortened to the segment's length,
 as Blender's `BKE_fcurve_correct_bezpart` does), all curves' frames at once.
 """
 import re
@@ -16,6 +16,7 @@ import re
 import bpy
 import numpy as np
 
+from ..core.rig import inverse
 from ..core.rotations import euler_to_matrix, quat_to_matrix, rotvec_to_matrix
 from . import action_adapter
 
@@ -24,8 +25,8 @@ _PATH = re.compile(r'^pose\.bones\["((?:[^"\\]|\\.)*)"\]\.(location|rotation_qua
 _CHANNELS = ("location", "rotation_quaternion", "rotation_euler", "rotation_axis_angle", "scale")
 _INTERPOLATION = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items
 _CONSTANT, _LINEAR, _BEZIER = (_INTERPOLATION[name].value for name in ("CONSTANT", "LINEAR", "BEZIER"))
-#: Bisection steps solving a Bezier segment's frame: 2^-40 of a segment, far below float32's keys.
-_BISECTIONS = 40
+#: Newton steps solving a Bezier segment's frame for its curve parameter, from the linear guess.
+_NEWTON_STEPS = 8
 
 
 def _chain(obj, names):
@@ -108,7 +109,7 @@ def _fcurve_keys(fcurve):
 
 def _numpy_evaluable(fcurve, interpolation):
     return (not fcurve.modifiers and fcurve.extrapolation == "CONSTANT" and len(interpolation) > 0
-            and np.isin(interpolation, (_CONSTANT, _LINEAR, _BEZIER)).all())
+            and ((interpolation == _CONSTANT) | (interpolation == _LINEAR) | (interpolation == _BEZIER)).all())
 
 
 def evaluate_fcurves(fcurves, frames):
@@ -146,21 +147,29 @@ def _solve_bezier(out, frames, segments):
     p1 = p0 - np.minimum(1.0, length / np.maximum(np.abs(h1[:, :1]), 1e-12)) * h1
     p2 = p3 - np.minimum(1.0, length / np.maximum(np.abs(h2[:, :1]), 1e-12)) * h2
     wanted = np.concatenate([frames[s[1]] for s in segments])
-    low, high = np.zeros(len(wanted)), np.ones(len(wanted))
-
-    def cubic(t, axis):
-        s = 1.0 - t
-        return s * s * s * p0[:, axis] + 3 * s * s * t * p1[:, axis] + 3 * s * t * t * p2[:, axis] + t * t * t * p3[:, axis]
-    for _ in range(_BISECTIONS):
-        middle = 0.5 * (low + high)
-        below = cubic(middle, 0) < wanted
-        low, high = np.where(below, middle, low), np.where(below, high, middle)
-    values = cubic(0.5 * (low + high), 1)
+    # x(t) and y(t) as cubic polynomials in t: a t^3 + b t^2 + c t + p0.
+    c = 3.0 * (p1 - p0)
+    b = 3.0 * (p2 - p1) - c
+    a = p3 - p0 - c - b
+    t = (wanted - p0[:, 0]) / np.maximum(p3[:, 0] - p0[:, 0], 1e-12)  # the linear guess
+    for _ in range(_NEWTON_STEPS):  # x(t) rises monotonically once the handles are shortened
+        x = ((a[:, 0] * t + b[:, 0]) * t + c[:, 0]) * t + p0[:, 0]
+        slope = (3.0 * a[:, 0] * t + 2.0 * b[:, 0]) * t + c[:, 0]
+        t = np.clip(t - (x - wanted) / np.maximum(slope, 1e-9), 0.0, 1.0)
+    values = ((a[:, 1] * t + b[:, 1]) * t + c[:, 1]) * t + p0[:, 1]
     start = 0
     for row, mask, *_ in segments:
         count = int(mask.sum())
         out[row, mask] = values[start:start + count]
         start += count
+
+
+def _matrices(collection, field, names):
+    """(len(names), 4, 4) float64 matrices `field` of the named items of a bone collection, read at once."""
+    flat = np.empty(16 * len(collection), dtype=np.float32)
+    collection.foreach_get(field, flat)
+    order = {item.name: k for k, item in enumerate(collection)}
+    return flat.reshape(-1, 4, 4).transpose(0, 2, 1)[[order[name] for name in names]].astype(np.float64)
 
 
 def _rotation(mode, values):
@@ -192,16 +201,19 @@ def sample(obj, names, frames):
             return None
     frames = np.asarray(frames, dtype=np.float64)
     count = len(frames)
-    # Every channel of the chain starts at the bone's own value, then each layer replaces what it keys.
-    channels = {(name, path): np.tile(np.array(getattr(pose_bones[name], path), dtype=np.float64), (count, 1))
-                for name in chain for path in _CHANNELS}
-    covered = {}  # {channel: (N,) frames some layer plays it}
+    in_chain = set(chain)
+    channels, covered = {}, {}  # {(bone, channel path): (N, C) values, (N,) frames some layer plays it}
     for target, mapping in layers:
         curves = []
         for fcurve in target.fcurves():
             match = None if fcurve.mute else _PATH.match(fcurve.data_path)
             key = None if match is None else (bpy.utils.unescape_identifier(match.group(1)), match.group(2))
-            if key in channels and fcurve.array_index < channels[key].shape[1]:
+            if key is None or key[0] not in in_chain:
+                continue
+            if key not in channels:  # starts at the bone's own value; each layer replaces what it keys
+                channels[key] = np.tile(np.array(getattr(pose_bones[key[0]], key[1]), dtype=np.float64), (count, 1))
+                covered[key] = np.zeros(count, dtype=bool)
+            if fcurve.array_index < channels[key].shape[1]:
                 curves.append((fcurve, key))
         if not curves:
             continue
@@ -209,27 +221,37 @@ def sample(obj, names, frames):
         values = evaluate_fcurves([f for f, _ in curves], times)  # (F, N)
         for (fcurve, key), row in zip(curves, values):
             channels[key][played, fcurve.array_index] = row[played]
-            covered[key] = covered.get(key, np.zeros(count, dtype=bool)) | played
+            covered[key] |= played
     # A channel the NLA plays on some frames only, or a connected bone's location: Blender's call.
     if any(not played.all() for played in covered.values()) \
             or any(bones[name].use_connect for name, path in covered if path == "location"):
         return None
-    basis = np.tile(np.eye(4), (count, len(chain), 1, 1))  # (N, C, 4, 4)
-    for column, name in enumerate(chain):
-        mode = pose_bones[name].rotation_mode
-        rotation = _rotation(mode, channels[name, _rotation_path(mode)])
-        basis[:, column, :3, :3] = rotation * channels[name, "scale"][:, None, :]
-        basis[:, column, :3, 3] = channels[name, "location"]
+    keyed = {name for name, _ in channels}
     index = {name: k for k, name in enumerate(chain)}
-    rest = np.array([np.array(bones[name].matrix_local, dtype=np.float64) for name in chain])  # (C, 4, 4)
-    pose = np.empty_like(basis)
+    parents = np.array([index[bones[name].parent.name] if bones[name].parent else -1 for name in chain])
+    rest = _matrices(bones, "matrix_local", chain)  # (C, 4, 4)
+    offsets = np.where((parents < 0)[:, None, None], rest, inverse(rest[parents]) @ rest)  # parent rest -> rest
+    # Bones neither keyed nor below a keyed bone stand as Blender last evaluated them.
+    basis, pose = (np.tile(_matrices(pose_bones, field, chain), (count, 1, 1, 1))
+                   for field in ("matrix_basis", "matrix"))  # (N, C, 4, 4)
+    moving = np.zeros(len(chain), dtype=bool)
     for column, name in enumerate(chain):
-        parent = bones[name].parent
-        if parent is None:
-            pose[:, column] = rest[column] @ basis[:, column]
-        else:
-            offset = np.linalg.inv(rest[index[parent.name]]) @ rest[column]
-            pose[:, column] = pose[:, index[parent.name]] @ offset @ basis[:, column]
+        parent = parents[column]
+        moving[column] = name in keyed or (parent >= 0 and moving[parent])
+        if not moving[column]:
+            continue
+        if name in keyed:
+            pose_bone = pose_bones[name]
+            path = _rotation_path(pose_bone.rotation_mode)
+            value = {p: channels.get((name, p), np.tile(np.array(getattr(pose_bone, p)), (count, 1)))
+                     for p in ("location", "scale", path)}
+            basis[:, column, :3, :3] = _rotation(pose_bone.rotation_mode, value[path]) * value["scale"][:, None, :]
+            basis[:, column, :3, 3] = value["location"]
+        local = offsets[column] @ basis[:, column]
+        pose[:, column] = local if parent < 0 else pose[:, parent] @ local
     columns = [index[name] for name in names]
-    values = {name: channels[name, _rotation_path(pose_bones[name].rotation_mode)] for name in names}
+    values = {}
+    for name in names:
+        path = _rotation_path(pose_bones[name].rotation_mode)
+        values[name] = channels.get((name, path), np.tile(np.array(getattr(pose_bones[name], path)), (count, 1)))
     return basis[:, columns], pose[:, columns], values
