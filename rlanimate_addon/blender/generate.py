@@ -208,6 +208,7 @@ def bake(context, requests, progress=lambda step: None, mute_constraints=False):
         with gestures.detached(plan.previous, context.view_layer):
             _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
+    replaced = [gestures.Backup(plan.previous) for plan in plans if plan.previous is not None]
     undo = [bake_check.BakeUndo(plan.obj, plan.overriding) for plan in plans]
     scene = context.scene
     original_frame = scene.frame_current
@@ -218,9 +219,13 @@ def bake(context, requests, progress=lambda step: None, mute_constraints=False):
     except RLAnimateError:
         for record in reversed(undo):
             record.restore()
+        for backup in replaced:
+            backup.restore()
         raise
     finally:
         scene.frame_set(original_frame)
+    for backup in replaced:
+        backup.discard()
     progress(4)
     return "\n".join(lines)
 

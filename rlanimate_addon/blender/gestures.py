@@ -10,6 +10,7 @@ hash as they were written (`edited_by_hand`).
 """
 import contextlib
 
+import bpy
 import numpy as np
 
 from ..core.behaviours import POINT
@@ -114,6 +115,37 @@ def replace(gesture, name, start_frame, keys, blend_type, digest=None):
     gesture.track.name = name
     action_adapter.fill_track(gesture.track, gesture.target, start_frame, name).blend_type = blend_type
     return gesture.action
+
+
+class Backup:
+    """A gesture about to be replaced, as it is: a copy of its action and where its strip plays, put back
+    by `restore` when the bake replacing it is undone (blender/bake_check.py), else `discard`ed. Make
+    it before bake_check.BakeUndo records the file, so that undoing the bake keeps the copy."""
+
+    def __init__(self, gesture):
+        self.gesture, self.name = gesture, gesture.action.name
+        self.copy = gesture.action.copy()
+        strip = gesture.track.strips[0] if gesture.track is not None and len(gesture.track.strips) else None
+        self.strip = None if strip is None else (int(strip.frame_start), strip.blend_type, strip.extrapolation,
+                                                 strip.name, gesture.track.name)
+
+    def restore(self):
+        gesture = self.gesture
+        replaced = gesture.action
+        target = action_adapter.ActionTarget(self.copy, self.copy.slots[0] if action_adapter.LAYERED else None)
+        if gesture.track is None:
+            action_adapter.assign(gesture.obj, target)
+        else:
+            for strip in list(gesture.track.strips):
+                gesture.track.strips.remove(strip)
+            start, blend_type, extrapolation, strip_name, track_name = self.strip
+            strip = action_adapter.fill_track(gesture.track, target, start, strip_name)
+            strip.blend_type, strip.extrapolation, gesture.track.name = blend_type, extrapolation, track_name
+        bpy.data.actions.remove(replaced)
+        self.copy.name = self.name
+
+    def discard(self):
+        bpy.data.actions.remove(self.copy)
 
 
 def record(action, settings, start, end, under, aimed_at, keys):

@@ -93,3 +93,22 @@ def test_a_refused_regenerate_leaves_the_gesture_and_the_pose_as_they_were(setti
         helpers.generate(rig, settings, **options)
     assert rig.animation_data.action == action and _same(_keys(action), keys)
     assert [tuple(bone.rotation_quaternion) for bone in rig.pose.bones] == pose
+
+
+@pytest.mark.parametrize("animated", [False, True], ids=["active action", "NLA track"])
+def test_a_regenerate_the_bake_check_undoes_puts_the_previous_gesture_back(settings, animated):
+    rig = helpers.load_sample_rig()
+    if animated:
+        _key_idle(rig)
+    target = helpers.add_empty("Target", (-1.2, -2.5, 1.7))
+    options = dict(behaviour="POINT", arm="RIGHT", target=target, start_frame=1, frame_count=100)
+    assert helpers.generate(rig, settings, **options) == {"FINISHED"}
+    keys, tracks = _keys(_gesture_actions()[0]), [t.name for t in rig.animation_data.nla_tracks]
+    # Pointing at its own other hand: the gesture moves the target, so the bake check undoes it.
+    with pytest.raises(RuntimeError, match="moves with the gesture"):
+        helpers.generate(rig, settings, **{**options, "target": rig, "target_bone": helpers.rig_bone(rig, "LeftHand")})
+    actions = _gesture_actions()
+    assert [a.name for a in actions] == ["RLAnimate Point Right"] and _same(_keys(actions[0]), keys)
+    assert [t.name for t in rig.animation_data.nla_tracks] == tracks
+    playing = rig.animation_data.nla_tracks[-1].strips[0].action if animated else rig.animation_data.action
+    assert playing == actions[0]
