@@ -165,8 +165,11 @@ def edited_by_hand(gesture):
 
 
 def snapshot(settings):
-    """{name: value} of every setting of a Scene.rlanimate group that has one (the target as the object
-    itself; no target, none)."""
-    values = {p.identifier: getattr(settings, p.identifier) for p in settings.bl_rna.properties
-              if p.identifier != "rna_type"}
+    """{name: value} of every setting of a Scene.rlanimate group, or of a recorded one Follow Target bakes
+    again (a namespace), that has one (the target as the object itself; no target, none)."""
+    if not hasattr(settings, "bl_rna"):
+        values = vars(settings)
+    else:
+        values = {p.identifier: getattr(settings, p.identifier) for p in settings.bl_rna.properties
+                  if p.identifier != "rna_type"}
     return {name: value for name, value in values.items() if value is not None}

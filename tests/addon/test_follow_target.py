@@ -87,3 +87,14 @@ def test_moving_a_handle_of_editable_keys_is_an_edit(settings):
                  if p.interpolation == "BEZIER")
     point.handle_right.y += 0.05
     assert gestures.edited_by_hand(gesture)
+
+
+def test_a_re_bake_records_its_settings_and_follows_again(settings):
+    rig, target = _point(settings)
+    _move(target, NEW)
+    record = gestures.last_point(rig).record
+    assert record["note"] == "" and record["settings"]["target"] == target
+    assert np.allclose(np.reshape(record["aimed_at"], (-1, 3))[0], np.array(rig.matrix_world.inverted() @ target.location))
+    _move(target, OLD)
+    to_old, to_new = _apex_angles(rig)
+    assert to_old <= MAX_APEX_ANGLE_DEG < to_new, "a second move is followed too"
