@@ -127,6 +127,7 @@ def main():
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
 
+    load = os.getloadavg()[0]
     rig, settings = fresh_scene()
     idle = key_idle(rig)
     idle.use_fake_user = True
@@ -145,9 +146,10 @@ def main():
 
 Generate Gesture (Point, the whole operator, bake included) against Blender's own evaluation of the
 frames it baked (`scene.frame_set` per frame, the skinned mesh deformed), on the sample rig at its
-file's {render.fps / render.fps_base:g} fps: a fresh rig at 120 frames, the rig under an F-curve idle
-on {len(IDLE_BONES)} bones at 120 frames (its pose underneath evaluated in numpy), and a fresh rig at
-46 frames. Best and median of {args.repeats} interleaved rounds after a warm-up, in milliseconds, pinned
+file's {render.fps / render.fps_base:g} fps (so the agent plays 150 of its 30 fps frames for 120, and its
+average Point, 116, for 46): a fresh rig at 120 frames, the rig under an F-curve idle on
+{len(IDLE_BONES)} bones at 120 frames (its pose underneath evaluated in numpy), and a fresh rig at 46
+frames. Generate includes the bake check (3 frames played and measured). Best and median of {args.repeats} interleaved rounds after a warm-up, in milliseconds, pinned
 to one CPU core (the machine is shared, so the median carries other jobs' load). The ratio pairs each
 round's Generate with its playback (median over rounds; best to best beside it). "Again" is
 Generate clicked a second time with the same settings, replacing its own gesture in place. Agent:
@@ -155,7 +157,8 @@ the bundled default ({trained}).
 
 Regenerate: `nice -n 10 python benchmarks/generate_benchmark.py`
 
-Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python {platform.python_version()},
+Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at
+start), Python {platform.python_version()},
 bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
 
 | case | Generate best ms | median ms | playback best ms | median ms | ratio, paired median | best to best | again best ms | median ms |
