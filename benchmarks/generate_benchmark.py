@@ -1,14 +1,19 @@
-"""Generate Gesture speed: 120 frames on the sample rig, bake included, against Blender's own playback.
+"""Generate Gesture speed against Blender's own playback: paired ratios in one process.
 
-Times `bpy.ops.rlanimate.generate_gesture()` (the whole operator: reading the rig and target, the
-numpy agent, aim correction, retargeting, blending and the bulk F-curve writes), its numpy part
-alone, and `scene.frame_set` on each of the same 120 frames of the baked gesture (the sample rig
-with its skinned mesh), in interleaved rounds, and writes the section "Generate Gesture" of
-docs/BENCHMARKS.md (replacing only that section, appending it when absent).
+Three cases on the sample rig (armature and skinned mesh, at its file's 24 fps), each a Point at a
+fixed target: a fresh rig at 120 frames, the rig under an F-curve idle at 120 frames, and a fresh
+rig at 46 frames. Each round of each case times `bpy.ops.rlanimate.generate_gesture()` (the whole
+operator: checks, reading the rig and the pose underneath, the numpy agent, aim, retargeting, the
+bulk F-curve writes, replacing nothing: the gesture is removed between rounds), then
+`scene.frame_set` on each of the gesture's frames (Blender's evaluation of what it baked, the mesh
+deformed), and pairs the two: the ratio of each round, so both see the machine alike. The cases'
+rounds are interleaved. A last row times Generate clicked again over its own gesture (the replace).
+Writes the section "Generate Gesture" of docs/BENCHMARKS.md (replacing only that section).
 
 Run: `nice -n 10 python benchmarks/generate_benchmark.py [--repeats N] [--no-write]`
 """
 import argparse
+import math
 import os
 import platform
 import statistics
@@ -24,14 +29,17 @@ import bpy  # noqa: E402
 import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
 import numpy as np  # noqa: E402
 
-from rlanimate_addon.blender import armature_io, preferences  # noqa: E402
-from rlanimate_addon.core import gesture  # noqa: E402
+from rlanimate_addon.blender import action_adapter, gestures, preferences  # noqa: E402
 from trainer.blender_io import rig_session  # noqa: E402
 from trainer.paths import SAMPLE_RIG_BLEND  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
-FRAMES = 120
 SECTION = "## Generate Gesture"
+#: (label, the rig carries an idle, frames)
+CASES = (("fresh rig, 120 frames", False, 120), ("animated rig, 120 frames", True, 120),
+         ("fresh rig, 46 frames", False, 46))
+#: Bones the idle keys (F-curves only: the pose underneath is evaluated in numpy).
+IDLE_BONES = ("Hips", "Spine", "Spine1", "Neck", "LeftArm", "RightArm", "RightForeArm")
 
 
 def fresh_scene():
@@ -43,63 +51,67 @@ def fresh_scene():
     target.location = (-1.2, -2.5, 1.7)
     bpy.context.scene.collection.objects.link(target)
     settings = bpy.context.scene.rlanimate
-    settings.target, settings.frame_count, settings.start_frame, settings.arm = target, FRAMES, 1, "RIGHT"
+    settings.target, settings.start_frame, settings.arm, settings.behaviour = target, 1, "RIGHT", "POINT"
     return rig, settings
 
 
-def clear_animation(rig):
+def key_idle(rig):
+    """An idle on IDLE_BONES, a key every 10 frames over 1-130 (Bezier), as the rig's active action."""
+    for k, role in enumerate(IDLE_BONES):
+        bone = rig.pose.bones["mixamorig:" + role]
+        bone.rotation_mode = "QUATERNION"
+        for frame in range(1, 131, 10):
+            angle = 0.08 * math.sin(0.1 * frame + k)
+            bone.rotation_quaternion = (math.cos(angle / 2), math.sin(angle / 2), 0.0, 0.0)
+            bone.keyframe_insert("rotation_quaternion", frame=frame)
+        bone.rotation_quaternion = (1.0, 0.0, 0.0, 0.0)
+    return rig.animation_data.action
+
+
+def remove_gesture(rig, idle):
+    """Remove the baked gesture; the idle (None: no animation) active again, as before Generate."""
     data = rig.animation_data
-    for action in {data.action} | {s.action for t in data.nla_tracks for s in t.strips}:
-        if action is not None:
-            bpy.data.actions.remove(action)
-    rig.animation_data_clear()
+    for action in [a for a in bpy.data.actions if gestures.RECORD in a]:
+        bpy.data.actions.remove(action)
+    for track in list(data.nla_tracks):
+        data.nla_tracks.remove(track)
+    if idle is None:
+        rig.animation_data_clear()
+    else:
+        action_adapter.assign(rig, action_adapter.ActionTarget(idle, idle.slots[0] if action_adapter.LAYERED else None))
+    for bone in rig.pose.bones:
+        bone.rotation_quaternion, bone.rotation_euler = (1.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    bpy.context.scene.frame_set(1)
 
 
-def time_generate(rig, behaviour):
-    """Seconds for one Generate Gesture call on the unanimated rig."""
-    bpy.context.scene.rlanimate.behaviour = behaviour
+def time_generate():
     start = time.perf_counter()
     assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
     return time.perf_counter() - start
 
 
-def numpy_part(rig):
-    """A callable timing the bpy-free part alone: objectives, agent rollout, aim, retarget and blend."""
-    agent = preferences.selected_agent(bpy.context)
-    family, roles = armature_io.rig_roles_of(rig)
-    rig_pose = armature_io.sample_rig(bpy.context, rig, roles, family, np.arange(1, FRAMES + 1))[0]
-    request = gesture.GestureRequest("POINT", "RIGHT", FRAMES, targets=np.tile([-1.2, -2.5, 1.7], (FRAMES, 1)))
-
-    def timed():
-        start = time.perf_counter()
-        gesture.gesture_rotations(agent, request, rig_pose)
-        return time.perf_counter() - start
-    return timed
-
-
-def time_playback():
-    """Seconds for scene.frame_set on each of the 120 baked frames (Blender's own evaluation)."""
+def time_playback(frames):
+    """Seconds for scene.frame_set on each of the gesture's frames (Blender's own evaluation)."""
     scene = bpy.context.scene
     start = time.perf_counter()
-    for frame in range(1, FRAMES + 1):
+    for frame in range(1, frames + 1):
         scene.frame_set(frame)
     return time.perf_counter() - start
 
 
-def measure(rig, repeats):
-    """{what: [seconds]} over `repeats` interleaved rounds, so that every measurement sees the
-    machine in the same state; each round's playback evaluates the Point gesture it just baked."""
-    time_generate(rig, "POINT")  # warm-up: loads the agent file
-    clear_animation(rig)
-    timed_numpy_part = numpy_part(rig)
-    times = {"point": [], "playback": [], "wave": [], "numpy": []}
-    for _ in range(repeats):
-        times["point"].append(time_generate(rig, "POINT"))
-        times["playback"].append(time_playback())
-        clear_animation(rig)
-        times["wave"].append(time_generate(rig, "WAVE"))
-        clear_animation(rig)
-        times["numpy"].append(timed_numpy_part())
+def measure(rig, settings, idle, repeats):
+    """{label: {"generate", "playback", "again": [seconds]}} over interleaved rounds."""
+    times = {label: {"generate": [], "playback": [], "again": []} for label, _, _ in CASES}
+    for round_ in range(repeats + 1):  # the first round warms up (loads the agent file)
+        for label, animated, frames in CASES:
+            remove_gesture(rig, idle if animated else None)
+            settings.frame_count = frames
+            generate = time_generate()
+            playback = time_playback(frames)
+            again = time_generate()
+            if round_:
+                for key, value in (("generate", generate), ("playback", playback), ("again", again)):
+                    times[label][key].append(value)
     return times
 
 
@@ -109,42 +121,51 @@ def ms(values):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=25)
+    parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--no-write", action="store_true", help="print the section only")
     args = parser.parse_args()
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
 
-    rig, _ = fresh_scene()
-    times = measure(rig, args.repeats)
-    point, wave, numpy_seconds, playback = times["point"], times["wave"], times["numpy"], times["playback"]
-    paired = statistics.median(g / p for g, p in zip(point, playback))
+    load = os.getloadavg()[0]
+    rig, settings = fresh_scene()
+    idle = key_idle(rig)
+    idle.use_fake_user = True
+    times = measure(rig, settings, idle, args.repeats)
     agent = preferences.selected_agent(bpy.context)
     trained = "untrained" if agent.metadata.get("training", {}).get("untrained") else "trained"
-
+    render = bpy.context.scene.render
+    rows = []
+    for label, _, _ in CASES:
+        t = times[label]
+        paired = statistics.median(g / p for g, p in zip(t["generate"], t["playback"]))
+        rows.append(f"| {label} | {ms(t['generate'])} | {ms(t['playback'])} | **{paired:.2f}** | "
+                    f"{min(t['generate']) / min(t['playback']):.2f} | {ms(t['again'])} |")
+    table = "\n".join(rows)
     text = f"""{SECTION}
 
-Generate Gesture for {FRAMES} frames on the sample rig (armature and skinned mesh), bake included,
-against Blender's own playback evaluation of the same {FRAMES} frames (`scene.frame_set` per frame).
-Best and median of {args.repeats} interleaved rounds after a warm-up (Point, the playback of the gesture
-it baked, Wave, the numpy part), in milliseconds, pinned to one CPU core (the machine is shared, so
-the median carries other jobs' load; the best is the code's own cost); agent: the bundled default
-({trained}). The ratio pairs each round's Point with its playback, so both see the machine alike.
+Generate Gesture (Point, the whole operator, bake included) against Blender's own evaluation of the
+frames it baked (`scene.frame_set` per frame, the skinned mesh deformed), on the sample rig at its
+file's {render.fps / render.fps_base:g} fps (so the agent plays 150 of its 30 fps frames for 120, and its
+average Point, 116, for 46): a fresh rig at 120 frames, the rig under an F-curve idle on
+{len(IDLE_BONES)} bones at 120 frames (its pose underneath evaluated in numpy), and a fresh rig at 46
+frames. Generate includes the bake check (3 frames played and measured). Best and median of {args.repeats} interleaved rounds after a warm-up, in milliseconds, pinned
+to one CPU core (the machine is shared, so the median carries other jobs' load). The ratio pairs each
+round's Generate with its playback (median over rounds; best to best beside it). "Again" is
+Generate clicked a second time with the same settings, replacing its own gesture in place. Agent:
+the bundled default ({trained}).
 
 Regenerate: `nice -n 10 python benchmarks/generate_benchmark.py`
 
-Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python {platform.python_version()},
+Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at
+start), Python {platform.python_version()},
 bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
 
-| what | best ms | median ms |
-|---|---:|---:|
-| Generate Gesture, Point (operator, bake included) | {ms(point)} |
-| Generate Gesture, Wave (operator, bake included) | {ms(wave)} |
-| of which the numpy part (objectives, agent, aim, retarget, blend) | {ms(numpy_seconds)} |
-| `scene.frame_set` x {FRAMES} (Blender's playback evaluation) | {ms(playback)} |
+| case | Generate best ms | median ms | playback best ms | median ms | ratio, paired median | best to best | again best ms | median ms |
+|---|---:|---:|---:|---:|---:|---:|---:|---:|
+{table}
 
-Generate / playback ratio (Point): median {paired:.2f} over the rounds, {min(point) / min(playback):.2f} best to best.
-Budget: under 100 ms; aim: ratio below 1.
+Targets (issue 30): at most 0.5 on the fresh rig at 120 frames, 1.0 over the animated rig, 1.0 at 46 frames.
 """
     print(text)
     if not args.no_write:

@@ -5,6 +5,7 @@ Blender 4.2 keeps F-curves on the action (`action.fcurves`). Blender 4.4+ (and 5
 F-curves live in a channelbag of a keyframe strip of a layer, one channelbag per slot. Callers get
 an `ActionTarget` (the action and, where slots exist, the slot) and never touch either layout.
 """
+import hashlib
 import math
 
 import bpy
@@ -42,6 +43,12 @@ class ActionTarget:
         fcurves = self._fcurves()
         return [] if fcurves is None else list(fcurves)
 
+    def clear_fcurves(self):
+        """Remove every F-curve of this target (the action and its slot stay)."""
+        fcurves = self._fcurves()
+        if fcurves is not None:
+            fcurves.clear()
+
 
 def _channelbag(action, slot, create):
     if slot is None:
@@ -67,20 +74,62 @@ def new_action(name, obj):
     return ActionTarget(action)
 
 
-def write_keys(fcurve, frames, values):
-    """Bulk-write keys (frames (N,), values (N,)) into an empty F-curve, linear between frames.
+class KeyDigest:
+    """A hash of F-curves' keys, in F-curve order: each key's frame, value and interpolation, and a
+    Bezier curve's handles. Fed as keys are written (`write_keys`, `write_bezier_keys`) or read back
+    (`read_digest`), it comes out the same until anyone edits them."""
+
+    def __init__(self):
+        self._sha = hashlib.sha1()
+
+    def add(self, fcurve, co, interpolation, handles=()):
+        """co: (K, 2) float32; interpolation: (K,) int32; handles: the Bezier keys' left and right (K, 2) float32."""
+        self._sha.update(f"{fcurve.data_path}[{fcurve.array_index}]".encode())
+        for values in (co, interpolation, *handles):
+            self._sha.update(np.ascontiguousarray(values).tobytes())
+
+    def hexdigest(self):
+        return self._sha.hexdigest()
+
+
+def read_digest(fcurves):
+    """The KeyDigest of the F-curves' keys as they are now."""
+    digest = KeyDigest()
+    for fcurve in fcurves:
+        points = fcurve.keyframe_points
+        count = len(points)
+        co, interpolation = np.empty((count, 2), dtype=np.float32), np.empty(count, dtype=np.int32)
+        points.foreach_get("co", co.ravel())
+        points.foreach_get("interpolation", interpolation)
+        handles = ()
+        if (interpolation == _BEZIER).any():
+            handles = (np.empty((count, 2), dtype=np.float32), np.empty((count, 2), dtype=np.float32))
+            points.foreach_get("handle_left", handles[0].ravel())
+            points.foreach_get("handle_right", handles[1].ravel())
+        digest.add(fcurve, co, interpolation, handles)
+    return digest
+
+
+def write_keys(fcurve, frames, values, digest=None):
+    """Bulk-write keys (frames (N,), values (N,)) into an empty F-curve, linear between frames, fed to
+    the KeyDigest given.
 
     The keys arrive sorted, one per frame, with linear interpolation, so no handles need recomputing.
     """
     count = len(frames)
     points = fcurve.keyframe_points
     points.add(count)
-    points.foreach_set("co", np.column_stack([frames, values]).astype(np.float32).ravel())
-    points.foreach_set("interpolation", np.full(count, _LINEAR, dtype=np.int32))
+    co = np.column_stack([frames, values]).astype(np.float32)
+    interpolation = np.full(count, _LINEAR, dtype=np.int32)
+    points.foreach_set("co", co.ravel())
+    points.foreach_set("interpolation", interpolation)
+    if digest is not None:
+        digest.add(fcurve, co, interpolation)
 
 
-def write_bezier_keys(fcurve, frames, values, tangents):
-    """Bulk-write Bezier keys (frames (K,), values (K,), slopes per frame (K,)) into an empty F-curve.
+def write_bezier_keys(fcurve, frames, values, tangents, digest=None):
+    """Bulk-write Bezier keys (frames (K,), values (K,), slopes per frame (K,)) into an empty F-curve,
+    fed to the KeyDigest given.
 
     Each key's handles sit a third of the way to its neighbouring keys along its slope (free handles,
     so Blender keeps them): every segment then plays the cubic Hermite curve core.key_reduction predicts.
@@ -92,12 +141,25 @@ def write_bezier_keys(fcurve, frames, values, tangents):
     count = len(frames)
     points = fcurve.keyframe_points
     points.add(count)
-    for name, data in (("co", np.column_stack([frames, values])),
-                       ("handle_left", np.column_stack([frames - left, values - tangents * left])),
-                       ("handle_right", np.column_stack([frames + right, values + tangents * right]))):
-        points.foreach_set(name, data.astype(np.float32).ravel())
+    written = {name: data.astype(np.float32) for name, data in (
+        ("co", np.column_stack([frames, values])),
+        ("handle_left", np.column_stack([frames - left, values - tangents * left])),
+        ("handle_right", np.column_stack([frames + right, values + tangents * right])))}
+    for name, data in written.items():
+        points.foreach_set(name, data.ravel())
     for name, value in (("interpolation", _BEZIER), ("handle_left_type", _FREE), ("handle_right_type", _FREE)):
         points.foreach_set(name, np.full(count, value, dtype=np.int32))
+    if digest is not None:
+        digest.add(fcurve, written["co"], np.full(count, _BEZIER, dtype=np.int32),
+                   (written["handle_left"], written["handle_right"]))
+
+
+def all_fcurves(action):
+    """Every F-curve of the action, of every slot."""
+    if not LAYERED:
+        return list(action.fcurves)
+    return [fcurve for layer in action.layers for strip in layer.strips for bag in strip.channelbags
+            for fcurve in bag.fcurves]
 
 
 def active_target(obj):
@@ -108,13 +170,17 @@ def active_target(obj):
     return ActionTarget(data.action, data.action_slot if LAYERED else None)
 
 
+def strip_target(strip):
+    """The ActionTarget an NLA strip with an action plays."""
+    return ActionTarget(strip.action, getattr(strip, "action_slot", None) if LAYERED else None)
+
+
 def strip_targets(obj):
     """ActionTargets of every NLA strip of the object, bottom track first."""
     data = obj.animation_data
     if data is None:
         return []
-    return [ActionTarget(strip.action, getattr(strip, "action_slot", None) if LAYERED else None)
-            for track in data.nla_tracks for strip in track.strips if strip.action is not None]
+    return [strip_target(strip) for track in data.nla_tracks for strip in track.strips if strip.action is not None]
 
 
 def is_animated(obj):
@@ -162,6 +228,11 @@ def add_strip(obj, target, start_frame, name):
     data = obj.animation_data or obj.animation_data_create()
     track = data.nla_tracks.new()
     track.name = name
+    return fill_track(track, target, start_frame, name)
+
+
+def fill_track(track, target, start_frame, name):
+    """Put `target` on the track as a strip called `name` from start_frame, with no effect outside it."""
     strip = _new_strip(track, target, start_frame)
     strip.name = name
     strip.extrapolation = "NOTHING"

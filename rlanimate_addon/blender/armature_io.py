@@ -13,7 +13,7 @@ import numpy as np
 from ..core import key_reduction, rig_roles, vrm
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
-from . import action_adapter, rigify, vrm_map
+from . import action_adapter, pose_underneath, rigify, vrm_map
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
 ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
@@ -70,16 +70,25 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
     """(RigState, {bone: (N, C) rotation channel values underneath}, targets (N, 3)).
 
     The bones playing roles are read (their basis and their evaluated pose, constraints included) at
-    every frame of an animated rig (scene.frame_set), as its action, NLA and drivers play it; a still
-    rig once. The target (an object, a bone of an armature when target_bone names one, or the
-    3D cursor when target is None) is read in the rig's armature space at each frame where anything
-    can move it. The caller restores the scene's frame.
+    every frame of an animated rig, as its action, NLA and drivers play it: from their keys in numpy
+    where only keys move them and the rig and target stand still (blender/pose_underneath.py), else
+    by scene.frame_set; a still rig once. The target (an object, a bone of an armature when
+    target_bone names one, or the 3D cursor when target is None) is read in the rig's armature space
+    at each frame where anything can move it. The caller restores the scene's frame.
     """
     scene = context.scene
     animated = action_adapter.is_animated(obj)
     target_moves = target is not None and (may_move(target) or (target_bone and action_adapter.is_animated(target)))
     moving = animated or may_move(obj) or target_moves
     skeleton = read_skeleton(obj, roles)
+    count = len(frames)
+    evaluated = None
+    if animated and not may_move(obj) and not target_moves:
+        evaluated = pose_underneath.sample(obj, skeleton.names, frames)
+    if evaluated is not None:
+        under, poses, values = evaluated
+        rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
+        return rig, values, np.broadcast_to(target_point(obj, target, target_bone, scene), (count, 3))
     pose_bones = [obj.pose.bones[name] for name in skeleton.names]
     under, poses, values, targets = [], [], {b: [] for b in skeleton.names}, []
     for frame in (frames if moving else frames[:1]):
@@ -91,7 +100,6 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
         for pb in pose_bones:
             values[pb.name].append(_rotation_values(pb))
         targets.append(target_point(obj, target, target_bone, scene))
-    count = len(frames)
     under, poses = (np.broadcast_to(np.array(m), (count,) + np.shape(m)[1:]) for m in (under, poses))
     values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
     rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
@@ -136,7 +144,7 @@ def _to_armature(obj, point):
     return (np.array(obj.matrix_world.inverted(), dtype=np.float64) @ np.append(point, 1.0))[:3]
 
 
-def write_gesture(obj, name, start_frame, keys, blend_type, played, properties=None):
+def write_gesture(obj, name, start_frame, keys, blend_type, played, digest=None, properties=None):
     """Key a gesture from start_frame into a new action called `name`; returns the new action.
 
     keys: {bone name: (rotation mode, (N, C) channel values per frame, kept frame indices or None)}:
@@ -145,23 +153,12 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played, properties=N
     becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
     Blender's Push Down does, playing as before over its keys and the `played` frames (first, last:
     the scene's range and the gesture's), and the gesture goes on a new NLA track above it with the
-    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames. properties: {data path: (N,)
-    values} of other channels to key on every frame (a Rigify arm's IK-FK switch).
+    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames. The keys feed the
+    action_adapter.KeyDigest given. properties: {data path: (N,) values} of other channels to key on
+    every frame (a Rigify arm's IK-FK switch).
     """
     target = action_adapter.new_action(name, obj)
-    for bone, (mode, values, kept) in keys.items():
-        frames = start_frame + np.arange(len(values))
-        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
-        tangents = key_reduction.slopes(values)
-        for channel in range(values.shape[1]):
-            fcurve = target.new_fcurve(path, channel, bone)
-            if kept is None:
-                action_adapter.write_keys(fcurve, frames, values[:, channel])
-            else:
-                action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel])
-    for path, values in (properties or {}).items():
-        fcurve = target.new_fcurve(path, 0, path.split('"')[1])
-        action_adapter.write_keys(fcurve, start_frame + np.arange(len(values)), values)
+    key_action(target, start_frame, keys, digest, properties)
     if action_adapter.is_animated(obj):
         action_adapter.push_down(obj, played)
         strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
@@ -169,3 +166,22 @@ def write_gesture(obj, name, start_frame, keys, blend_type, played, properties=N
     else:
         action_adapter.assign(obj, target)
     return target.action
+
+
+def key_action(target, start_frame, keys, digest=None, properties=None):
+    """Key a gesture from start_frame into an ActionTarget without F-curves (keys, digest and properties
+    as `write_gesture`'s)."""
+    for bone, (mode, values, kept) in keys.items():
+        frames = start_frame + np.arange(len(values))
+        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
+        tangents = key_reduction.slopes(values)
+        for channel in range(values.shape[1]):
+            fcurve = target.new_fcurve(path, channel, bone)
+            if kept is None:
+                action_adapter.write_keys(fcurve, frames, values[:, channel], digest)
+            else:
+                action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel],
+                                                 digest)
+    for path, values in (properties or {}).items():
+        fcurve = target.new_fcurve(path, 0, path.split('"')[1])
+        action_adapter.write_keys(fcurve, start_frame + np.arange(len(values)), values, digest)

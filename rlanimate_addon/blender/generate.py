@@ -2,10 +2,10 @@
 import bpy
 import numpy as np
 
-from ..core import blas_threads, channels, gesture, key_reduction, rig_roles, rig_scale
+from ..core import blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
 from ..core import rigify as rig_rigify
 from ..core.errors import RLAnimateError
-from . import armature_io, bake_check, constraints, preferences, properties, rigify
+from . import action_adapter, armature_io, bake_check, constraints, gestures, preferences, properties, rigify
 
 
 def _check_target(settings):
@@ -98,6 +98,8 @@ class _Plan:
         self.properties = None
         self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.settings = None
         self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
+        self.previous = None  # the gesture it replaces (blender/gestures.py)
+        self.under = {}  # {bone: channel values} of keyed bones that stand still underneath
         self.worst = 0.0
 
 
@@ -144,7 +146,7 @@ def _compute(context, plan, settings, agent, frames):
         request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
                                          targets=targets if settings.behaviour == "POINT" else None,
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
-                                         exact_aim=settings.exact_aim)
+                                         exact_aim=settings.exact_aim, fps=properties.scene_fps(scene))
         plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
         plan.keyed = keyed
         if target is not None:
@@ -152,6 +154,7 @@ def _compute(context, plan, settings, agent, frames):
         plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
         if plan.ik_share is not None:
             plan.properties = rigify.switch_keys(obj, settings.arm, switch, plan.blend_type, rig.animated)
+        plan.under = {bone: below_values[bone][0] for bone in plan.bones if not np.ptp(below_values[bone], axis=0).any()}
         plan.keys = {}
         for column, bone in enumerate(plan.bones):
             mode = obj.pose.bones[bone].rotation_mode
@@ -174,14 +177,23 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
     as it was (the scene frame included). Constraints that would override the gesture are refused, or
     muted over its frames with mute_constraints (blender/constraints.py). After the writes each rig is
     played and its deformed hand measured (blender/bake_check.py): a bake that does not play is undone,
-    every armature's, and refused.
+    every armature's, and refused. A gesture on the same arm over overlapping frames is
+    replaced in place unless Keep Previous is on (blender/gestures.py).
     """
+    armatures = selected_armatures(context, settings)
+    return bake(context, [(obj, properties.settings_for(obj, settings)) for obj in armatures], progress,
+                mute_constraints)
+
+
+def bake(context, requests, progress=lambda step: None, mute_constraints=False):
+    """`generate` for [(armature, its settings)]; returns the summary."""
     plans = []
-    for obj in selected_armatures(context, settings):
-        own = properties.settings_for(obj, settings)
+    for obj, own in requests:
         start = int(own.start_frame)
-        plan = _check(obj, own, start, start + int(own.frame_count) - 1, mute_constraints)
+        end = start + int(own.frame_count) - 1
+        plan = _check(obj, own, start, end, mute_constraints)
         plan.settings = own
+        plan.previous = None if own.keep_previous else gestures.overlapping(obj, own.arm, start, end)
         plans.append(plan)
     agent = preferences.selected_agent(context)
     for plan in plans:
@@ -191,8 +203,10 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
     progress(1)
     for plan in plans:
         start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
-        _compute(context, plan, plan.settings, agent, start + np.arange(count))
+        with gestures.detached(plan.previous, context.view_layer):
+            _compute(context, plan, plan.settings, agent, start + np.arange(count))
     progress(3)
+    replaced = [gestures.Backup(plan.previous) for plan in plans if plan.previous is not None]
     undo = [bake_check.BakeUndo(plan.obj, plan.overriding, rigify.switches(plan.obj, plan.properties))
             for plan in plans]
     scene = context.scene
@@ -204,9 +218,13 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
     except RLAnimateError:
         for record in reversed(undo):
             record.restore()
+        for backup in replaced:
+            backup.restore()
         raise
     finally:
         scene.frame_set(original_frame)
+    for backup in replaced:
+        backup.discard()
     progress(4)
     return "\n".join(lines)
 
@@ -218,16 +236,25 @@ def _write(plan, agent, scene):
     end = start + count - 1
     label = f"{settings.behaviour.title()} {settings.arm.title()}"
     note = ""
-    steps = gesture.rollout_length(count, agent.average_frames[settings.behaviour], settings.behaviour)
-    if steps != count:
+    span = frame_rate.agent_frames(count, properties.scene_fps(scene))
+    steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], settings.behaviour)
+    if steps != span:
         note += f" (time-scaled from the agent's {steps}-frame gesture)"
     note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
-    action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                       (min(scene.frame_start, start), max(scene.frame_end, end)), plan.properties)
+    digest = action_adapter.KeyDigest()
+    if plan.previous is not None:
+        action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type, digest,
+                                  plan.properties)
+        note += " (replaced the previous gesture)"
+    else:
+        action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
+                                           (min(scene.frame_start, start), max(scene.frame_end, end)), digest,
+                                           plan.properties)
     if plan.ik_share is not None:
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
+    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets, digest.hexdigest())
     constraints.mute(plan.obj, plan.overriding, start, end)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""

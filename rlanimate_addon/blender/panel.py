@@ -3,21 +3,24 @@ import os
 
 import bpy
 
-from ..core import gesture
+from ..core import frame_rate, gesture
 from ..core.errors import RLAnimateError
-from . import armature_io, constraints, preferences, properties, vrm_map
+from . import armature_io, constraints, follow_target, preferences, properties, vrm_map
 
 
 def _agent_summary(context, behaviour):
-    """(label, error): the agent's name and its learned lengths for the behaviour, or why it won't load."""
+    """(label, error): the agent's name and its learned lengths for the behaviour in scene frames, or why
+    it won't load."""
     path = preferences.selected_agent_path(context)
     name = "Bundled default" if path == preferences.BUNDLED_AGENT else path.name
     try:
         average = preferences.selected_agent(context).average_frames[behaviour]
     except RLAnimateError as error:
         return name, str(error)
-    shortest, longest = gesture.supported_length_range(average)
-    return f"{name}: learned {int(round(average))} frames, supported {shortest}-{longest}", None
+    fps = properties.scene_fps(context.scene)
+    average, shortest, longest = (frame_rate.scene_frames(n, fps)
+                                  for n in (average, *gesture.supported_length_range(average)))
+    return f"{name}: learned {average} frames, supported {shortest}-{longest}", None
 
 
 def _overriding_constraints(context, settings):
@@ -87,11 +90,19 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             layout.prop(settings, "exaggeration", slider=True)
 
         column = layout.column(align=True)
-        column.prop(settings, "frame_count")
+        row = column.row(align=True)
+        row.prop(settings, "frame_count")
+        row.label(text=f"{frame_rate.seconds(settings.frame_count, properties.scene_fps(context.scene)):.2f} s")
         column.prop(settings, "start_frame")
         column.prop(settings, "seed")
 
         layout.prop(settings, "blend_type", expand=True)
+        row = layout.row(align=True)
+        row.prop(settings, "keep_previous")
+        row.prop(context.scene.rlanimate, "follow_target")
+        stopped = follow_target.note(obj) if context.scene.rlanimate.follow_target else ""
+        if stopped:
+            layout.box().label(text=stopped, icon="INFO")
         row = layout.row(align=True)
         row.prop(settings, "editable_keys")
         if settings.editable_keys:

@@ -5,6 +5,7 @@ contract that outside tools and checks use: keep them.
 """
 import bpy
 
+from ..core import frame_rate
 from ..core.behaviours import POINT, WAVE
 from ..core.errors import RLAnimateError
 from . import preferences
@@ -19,6 +20,36 @@ def learned_length(behaviour=POINT):
         return int(round(preferences.load_agent(preferences.BUNDLED_AGENT).average_frames[behaviour]))
     except (RLAnimateError, ImportError):
         return FALLBACK_LENGTH
+
+
+#: The bundled agent's average Point length at its 30 fps, read once at start-up.
+DEFAULT_LENGTH = learned_length()
+
+
+def scene_fps(scene):
+    """The scene's frame rate in frames per second (fps / fps_base: 29.97 for NTSC)."""
+    return scene.render.fps / scene.render.fps_base
+
+
+def _owning_scene(settings):
+    """The scene whose rate a settings group's length follows: its own, or the current one for an
+    armature's own settings (None in a context without one)."""
+    owner = settings.id_data
+    return owner if isinstance(owner, bpy.types.Scene) else bpy.context.scene
+
+
+def _get_frame_count(settings):
+    """The length set, else the agent's learned seconds at the scene's rate (core/frame_rate.py)."""
+    stored = settings.get("frame_count")
+    if stored is not None:
+        return int(stored)
+    scene = _owning_scene(settings)
+    return DEFAULT_LENGTH if scene is None else frame_rate.scene_frames(DEFAULT_LENGTH, scene_fps(scene))
+
+
+def _set_frame_count(settings, value):
+    length = RLANIMATE_PG_settings.bl_rna.properties["frame_count"]
+    settings["frame_count"] = min(max(int(value), length.hard_min), length.hard_max)
 
 
 class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
@@ -39,8 +70,10 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
         name="Exaggeration", min=0.0, max=1.0, default=0.5, subtype="FACTOR",
         description="How big and high the wave is, from a small wave (0) to a whole-arm wave (1)")
     frame_count: bpy.props.IntProperty(
-        name="Length", min=0, soft_min=2, max=100000, default=learned_length(),
-        description="Length of the gesture in frames; the agent learned its average from the clips")
+        name="Length", min=0, soft_min=2, max=100000, default=DEFAULT_LENGTH,
+        get=_get_frame_count, set=_set_frame_count,
+        description="Length of the gesture in frames; until set, the agent's average length from the clips "
+                    "in seconds, at the scene's frame rate")
     start_frame: bpy.props.IntProperty(
         name="Start Frame", default=1, description="First frame of the gesture")
     target_bone: bpy.props.StringProperty(
@@ -67,6 +100,14 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     bone_map_file: bpy.props.StringProperty(
         name="Bone Map", default="", subtype="FILE_PATH",
         description="A bone-map file (JSON) naming the rig's bone for each role; empty detects the bones")
+    keep_previous: bpy.props.BoolProperty(
+        name="Keep Previous", default=False,
+        description="Layer the new gesture over an earlier one on the same arm and frames, on a new NLA track, "
+                    "instead of replacing it in place")
+    follow_target: bpy.props.BoolProperty(
+        name="Follow Target", default=False,
+        description="While on, moving the target of an armature's last Point gesture re-bakes that gesture "
+                    "(until its keys are edited by hand)")
     seed: bpy.props.IntProperty(
         name="Variation Seed", min=0, default=0,
         description="0 gives the agent's most likely gesture; other values give variations")

@@ -1,7 +1,7 @@
 """Registration in one place: the ordered class list and the property namespaces (Scene and Object)."""
 import bpy
 
-from . import bone_map, export, generate, panel, preferences, properties, vrm_map
+from . import bone_map, export, follow_target, generate, panel, preferences, properties, vrm_map
 
 #: Registered in this order, unregistered in reverse (property groups before what points at them).
 CLASSES = (
@@ -21,9 +21,11 @@ def register():
         bpy.utils.register_class(cls)
     bpy.types.Scene.rlanimate = bpy.props.PointerProperty(type=properties.RLANIMATE_PG_settings)
     bpy.types.Object.rlanimate = bpy.props.PointerProperty(type=properties.RLANIMATE_PG_object)
+    follow_target.register()
 
 
 def unregister():
+    follow_target.unregister()
     del bpy.types.Object.rlanimate
     del bpy.types.Scene.rlanimate
     for cls in reversed(CLASSES):

@@ -25,10 +25,11 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
 """
 import numpy as np
 
-from . import aim, rig_roles, skeleton, spaces
+from . import aim, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, inverse
-from .rotations import matrix_to_quat, matrix_to_rotvec, quat_to_matrix, rotvec_to_matrix
+from .rotations import (matrix_to_quat, matrix_to_rotvec, quat_to_matrix, quat_to_rotvec, rotvec_to_matrix,
+                        rotvec_to_quat)
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
 SUPPORTED_LENGTH = (0.4, 1.5)
@@ -106,6 +107,15 @@ def character_frame(rest_heads):
 REACH_MARGIN = 1.1
 
 
+def check_finite_targets(targets):
+    """RLAnimateError when any target (N, 3) is not a number."""
+    broken = ~np.isfinite(np.atleast_2d(targets)).all(axis=1)
+    if np.any(broken):
+        raise RLAnimateError(f"The target's position is not a number (NaN or infinite) on {broken.sum()} of the "
+                             f"gesture's {len(broken)} frames: check the target's location, constraints, drivers "
+                             "and parents, and the armature's transform.")
+
+
 def pointing_directions(arm, targets, rest_heads):
     """(N, 3) unit vectors in the character frame from the rig's rest shoulder to each target.
 
@@ -115,11 +125,7 @@ def pointing_directions(arm, targets, rest_heads):
     offsets = np.atleast_2d(np.asarray(targets, dtype=np.float64)) - shoulder  # (N, 3)
     norms = np.linalg.norm(offsets, axis=1)
     scale = np.linalg.norm(np.subtract(rest_heads["Head"], shoulder))
-    broken = ~np.isfinite(norms)
-    if np.any(broken):
-        raise RLAnimateError(f"The target's position is not a number (NaN or infinite) on {broken.sum()} of the "
-                             f"gesture's {len(norms)} frames: check the target's location, constraints, drivers "
-                             "and parents, and the armature's transform.")
+    check_finite_targets(targets)
     if np.any(norms < 1e-3 * scale):
         raise RLAnimateError("The target sits on the pointing shoulder: move it away from the character.")
     reach = arm_reach(arm, rest_heads)
@@ -180,14 +186,14 @@ def rollout_length(frame_count, average_frames, behaviour):
     return int(np.clip(frame_count, shortest, longest))
 
 
-def run_agent(agent, behaviour, objectives, seed=None):
-    """Canonical local rotation vectors (N, 15, 3) for the objectives (N, 7).
+def run_agent(agent, behaviour, objectives, seed=None, frame_count=None):
+    """Canonical local rotation vectors (N, 15, 3) for the objectives (M, 7) at the agent's rate.
 
-    The agent runs for `rollout_length` steps; when that is not N, its actions are resampled to N
-    frames (time-scaled).
+    The agent runs for `rollout_length(M)` steps; its actions are resampled to the N = frame_count
+    scene frames (M when None) when that differs (time-scaled, or played at the scene's rate).
     """
-    count = len(objectives)
-    steps = rollout_length(count, agent.average_frames[behaviour], behaviour)
+    count = len(objectives) if frame_count is None else int(frame_count)
+    steps = rollout_length(len(objectives), agent.average_frames[behaviour], behaviour)
     agent_objectives = resample(objectives, steps)
     agent_objectives[:, spaces.OBJECTIVE_TIME] = np.linspace(0.0, 1.0, steps)
     if behaviour == "POINT":
@@ -481,9 +487,9 @@ def played_finger_base(canonical, arm):
     """(N, 3) index-base path of canonical rotations (N, 15, 3) blended from their first frame as the keys
     blend from the pose underneath (`blend_weights`): it comes back to its start even where the agent's
     own hand does not (a target behind the character), so the aim's pointing phase stays whole."""
-    quats = matrix_to_quat(rotvec_to_matrix(canonical))  # (N, 15, 4)
+    quats = rotvec_to_quat(canonical)  # (N, 15, 4)
     blended = blend_from_pose(quats[0], quats, blend_weights(len(canonical)))
-    return aim.finger_lines(matrix_to_rotvec(quat_to_matrix(blended)), arm)[1]
+    return aim.finger_lines(quat_to_rotvec(blended), arm)[1]
 
 
 def gesture_rotations(agent, request, rig):
@@ -497,12 +503,17 @@ def gesture_rotations(agent, request, rig):
     rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
     rest_heads = rig.rest_heads
     check_length(request.frame_count)
-    rhythm = (agent.wave_rhythm(request.exaggeration, request.frame_count, request.seed)
+    span = request.agent_frames  # M: the gesture's seconds at the agent's rate
+    rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed)
               if request.behaviour == "WAVE" else None)
-    asked = None if request.targets is None else hips_relative_targets(rig, request.targets, request.frame_count)
-    objectives = build_objectives(request.behaviour, request.arm, request.frame_count, targets=asked,
+    if request.targets is not None:
+        check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))
+    asked = None if request.targets is None else resample(
+        hips_relative_targets(rig, request.targets, request.frame_count), span)  # (M, 3)
+    objectives = build_objectives(request.behaviour, request.arm, span, targets=asked,
                                   rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
-    canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed)  # (N, 15, 3)
+    canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed,
+                          frame_count=request.frame_count)  # (N, 15, 3)
     phase_base = played_finger_base(canonical, request.arm) if request.behaviour == "POINT" else None
     names, canonical = fold_spine(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
     if request.behaviour == "POINT":
@@ -559,14 +570,22 @@ def gesture_rotations(agent, request, rig):
 
 
 class GestureRequest:
-    """What the user asked for: behaviour, arm, length, seed, the behaviour's attribute, and whether
-    Point solves its aim exactly on the rig (else it keys the agent's own aim)."""
+    """What the user asked for: behaviour, arm, length in scene frames at the scene's `fps`, seed, the
+    behaviour's attribute, and whether Point solves its aim exactly on the rig (else it keys the
+    agent's own aim)."""
 
-    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True):
+    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True,
+                 fps=frame_rate.AGENT_FPS):
         self.behaviour, self.arm = behaviour, arm
         self.frame_count, self.seed = int(frame_count), seed
         self.targets, self.exaggeration = targets, float(exaggeration)
         self.exact_aim = bool(exact_aim)
+        self.fps = float(fps)
+
+    @property
+    def agent_frames(self):
+        """The gesture's length at the agent's rate (core/frame_rate.py)."""
+        return frame_rate.agent_frames(self.frame_count, self.fps)
 
 
 class RigState:

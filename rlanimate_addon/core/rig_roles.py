@@ -191,6 +191,13 @@ def detect(bone_names, rigify=False):
     export skeleton copying its DEF- bones may match more roles). Otherwise Rigify is only a candidate
     when its arm FK controls are there: names like hand_fk.L alone (a custom rig's FK chain) are not Rigify.
     """
+    family, roles = _detect(tuple(bone_names), rigify)
+    return family, dict(roles)
+
+
+@lru_cache(maxsize=16)
+def _detect(bone_names, rigify):
+    """`detect`, remembered per rig's bone names: matching every family takes a few milliseconds."""
     if rigify:
         return RIGIFY, family_roles(bone_names, RIGIFY)
     rigify_roles = family_roles(bone_names, RIGIFY)
