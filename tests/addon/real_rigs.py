@@ -171,8 +171,8 @@ def deformed_joints(rig, settings, arm):
         last = rig.data.bones[index[-1]]
         tip_bone, tip_at = (last.children[0].name, "head") if last.children else (index[-1], "head")
         base_bone = index[0]
-    else:  # no index finger: the hand's own axis
-        base_bone, tip_bone, tip_at = hand, hand, "tail"
+    else:  # no index finger: the forearm's head through the hand's head (gesture.finger_line_bones)
+        base_bone, tip_bone, tip_at = roles[prefix + "ForeArm"], hand, "head"
     joints = [(hand, "head"), (base_bone, "head"), (tip_bone, tip_at), (roles[prefix + "Arm"], "head")]
     deformed = bake_check.deformed_bones(rig)
     carriers = [bake_check.stand_in(rig, bone, deformed) for bone, _ in joints]

@@ -51,9 +51,9 @@ def vrm1_file(tmp_path):
 
 def _check_gestures(rig, settings, family):
     own, _ = measures.point_misses(rig, settings, 4, False, 5)
+    start = measures.arm_drop(rig, "RIGHT", 1)  # the first gesture, baked on the still rig
     exact, travel = measures.point_misses(rig, settings, 4, True, 5)
     strokes, wave_travel = measures.wave(rig, settings, "RIGHT")
-    start = measures.arm_drop(rig, "RIGHT", 1)
     print(f"{family}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)} arm "
           f"lengths, wave {strokes} strokes / {wave_travel:.2f}, start arm drop {start:.0f} deg")
     assert measures.measured_bones_deform(rig, "RIGHT") and measures.measured_bones_deform(rig, "LEFT")
