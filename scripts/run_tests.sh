@@ -9,7 +9,11 @@ PARALLEL=(-n "${PYTEST_WORKERS:-auto}" --dist loadfile)
 python -m pytest -q "${PARALLEL[@]}" "$@"
 if [ -x .venv-bpy42/bin/python ]; then
     echo "== Blender 4.2 LTS: extension tests =="
-    .venv-bpy42/bin/python -m pytest -q "${PARALLEL[@]}" tests/addon -p no:cacheprovider
+    # Blender 4.2 as a module can crash in its glTF importer once the rig-variant tests have run in the
+    # same process, so those run in a process of their own.
+    .venv-bpy42/bin/python -m pytest -q "${PARALLEL[@]}" tests/addon -p no:cacheprovider \
+        --ignore=tests/addon/test_rig_variants.py
+    .venv-bpy42/bin/python -m pytest -q tests/addon/test_rig_variants.py -p no:cacheprovider
 else
     echo "scripts/run_tests.sh: .venv-bpy42 is missing; run scripts/setup.sh to test Blender 4.2 too" >&2
     exit 1
