@@ -11,7 +11,7 @@ needs no assumption about which deformed bone sits where, only that it moves wit
 import numpy as np
 
 from . import skeleton
-from .gesture import blend_weights
+from .gesture import blend_weights, finger_line_bones
 from .rig import inverse
 from .rotations import quat_to_matrix
 
@@ -21,26 +21,18 @@ HAND_TOLERANCE = 0.02
 FINGER_TOLERANCE_DEG = 3.0
 
 
-def line_bones(roles, arm):
-    """(hand bone, finger bones): the rig's bones whose joints the check measures. The finger runs from
-    the first index bone's head to the last one's tail (the hand's own head and tail without index bones)."""
-    prefix = skeleton.ARM_PREFIX[arm] + "Hand"
-    index = [roles[prefix + f"Index{k}"] for k in (1, 2, 3) if prefix + f"Index{k}" in roles]
-    return roles[prefix], (index[0], index[-1]) if index else (roles[prefix], roles[prefix])
-
-
 def measured_bones(roles, arm):
-    """The role bones carrying the wrist, the finger base and the finger tip (`line_bones`)."""
-    hand, (start, end) = line_bones(roles, arm)
-    return hand, start, end
+    """The role bones carrying the wrist (the hand), the finger base and the finger tip: the finger line
+    Exact Aim solves on (gesture.finger_line_bones, from one joint's head through another's)."""
+    start, end = finger_line_bones(roles, arm)
+    return roles[skeleton.ARM_PREFIX[arm] + "Hand"], start, end
 
 
 def rest_points(rig, arm):
-    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist (the hand's head),
-    the finger base (a head) and the finger tip (a tail). rig: a gesture.RigState."""
-    hand, start, end = measured_bones(rig.roles, arm)
-    return np.stack([rig.skeleton.rest_head(hand), rig.skeleton.rest_head(start),
-                     rig.skeleton.tails(rig.skeleton.rest, end)])
+    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist, the finger base and the
+    finger tip, each its bone's head (joint positions; an imported bone's tail may point anywhere).
+    rig: a gesture.RigState."""
+    return np.stack([rig.skeleton.rest_head(bone) for bone in measured_bones(rig.roles, arm)])
 
 
 def planned_pose(rig, arm, bones, keyed):
