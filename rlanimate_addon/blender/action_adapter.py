@@ -119,7 +119,8 @@ def write_keys(fcurve, frames, values, digest=None):
     count = len(frames)
     points = fcurve.keyframe_points
     points.add(count)
-    co = np.column_stack([frames, values]).astype(np.float32)
+    co = np.empty((count, 2), dtype=np.float32)
+    co[:, 0], co[:, 1] = frames, values
     interpolation = np.full(count, _LINEAR, dtype=np.int32)
     points.foreach_set("co", co.ravel())
     points.foreach_set("interpolation", interpolation)

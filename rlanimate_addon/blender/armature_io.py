@@ -174,7 +174,7 @@ def key_action(target, start_frame, keys, digest=None, properties=None):
     for bone, (mode, values, kept) in keys.items():
         frames = start_frame + np.arange(len(values))
         path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
-        tangents = key_reduction.slopes(values)
+        tangents = None if kept is None else key_reduction.slopes(values)
         for channel in range(values.shape[1]):
             fcurve = target.new_fcurve(path, channel, bone)
             if kept is None:

@@ -105,15 +105,15 @@ def stand_in(obj, bone, deformed):
     resting nearest it (heads and tails within half its length), else the bone itself."""
     if bone in deformed:
         return bone
-    rest = obj.data.bones[bone]
-    head, tail = np.array(rest.head_local), np.array(rest.tail_local)
-    best, distance = bone, 0.5 * rest.length
-    for name in deformed:
-        other = obj.data.bones[name]
-        gap = np.linalg.norm(np.array(other.head_local) - head) + np.linalg.norm(np.array(other.tail_local) - tail)
-        if gap < distance:
-            best, distance = name, gap
-    return best
+    bones = obj.data.bones
+    rest, names = bones[bone], list(deformed)
+    if not names:
+        return bone
+    heads, tails = (np.array([getattr(bones[n], end) for n in names]) for end in ("head_local", "tail_local"))
+    gaps = (np.linalg.norm(heads - np.array(rest.head_local), axis=1)
+            + np.linalg.norm(tails - np.array(rest.tail_local), axis=1))  # (D,)
+    nearest = int(np.argmin(gaps))
+    return names[nearest] if gaps[nearest] < 0.5 * rest.length else bone
 
 
 def _armature_matrices(obj, names):

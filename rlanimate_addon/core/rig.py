@@ -22,6 +22,14 @@ def inverse(matrices):
     return out
 
 
+def _frames_inverse(matrices, bones):
+    """(N, len(bones), 4, 4) `inverse` of (N, B, 4, 4) matrices' bones at indices `bones`, frame by frame;
+    taken once and repeated when the frames are one frame broadcast (a rig standing still)."""
+    if matrices.strides[0] == 0:
+        return np.repeat(inverse(matrices[:1, bones]), len(matrices), axis=0)
+    return inverse(matrices[:, bones])
+
+
 class RigSkeleton:
     """Bone names, parent names (None for a root), (B, 4, 4) rest matrices and (B,) rest lengths."""
 
@@ -68,7 +76,7 @@ class RigSkeleton:
         changed = set(changed)
         bones = self._evaluation_order(only)
         slot = {i: k for k, i in enumerate(bones)}
-        pose_inverse, basis_inverse = inverse(pose[:, bones]), inverse(basis[:, bones])  # (N, len(bones), 4, 4)
+        pose_inverse, basis_inverse = _frames_inverse(pose, bones), _frames_inverse(basis, bones)  # (N, len(bones), 4, 4)
         out = np.array(pose, dtype=np.float64)
         moved = np.zeros(len(self.names), dtype=bool)
         for i in bones:

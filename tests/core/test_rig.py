@@ -63,3 +63,21 @@ def test_inverse_of_rigid_and_scaled_affine_matrices():
     scaled = rigid.copy()
     scaled[..., :3, :3] *= 0.01
     assert np.allclose(inverse(scaled) @ scaled, np.eye(4), atol=1e-9)
+
+
+
+def test_inverses_of_a_still_rig_are_taken_once_with_the_same_bits_as_frame_by_frame():
+    """A rig standing still hands pose_after one frame broadcast over the gesture's frames (stride 0): its
+    inverses are taken once and repeated, and must be the frame-by-frame ones bit for bit, for rigid bones
+    (by transposition) and with a scaled bone (np.linalg.inv)."""
+    from rlanimate_addon.core.rig import _frames_inverse, inverse
+    for scale in (1.0, 1.2):
+        still = _random_basis(1, 12, 0.5)
+        still[0, 3, :3, :3] *= scale
+        frames = np.broadcast_to(still, (120, 12, 4, 4))
+        bones = [0, 3, 5, 11]
+        assert frames.strides[0] == 0
+        once = _frames_inverse(frames, bones)
+        assert once.shape == (120, 4, 4, 4) and once.flags.c_contiguous
+        assert np.array_equal(once, inverse(np.array(frames)[:, bones]))
+        assert np.allclose(once @ frames[:, bones], np.eye(4), atol=1e-12)
