@@ -81,3 +81,16 @@ def test_inverses_of_a_still_rig_are_taken_once_with_the_same_bits_as_frame_by_f
         assert once.shape == (120, 4, 4, 4) and once.flags.c_contiguous
         assert np.array_equal(once, inverse(np.array(frames)[:, bones]))
         assert np.allclose(once @ frames[:, bones], np.eye(4), atol=1e-12)
+
+
+def test_inverse_takes_the_transpose_exactly_where_the_rotation_parts_are_orthonormal_to_1e6():
+    """The orthonormality test behind `inverse` decides as np.allclose(R^T R, I, atol=1e-6) does."""
+    from rlanimate_addon.core.rig import _orthonormal
+    rigid = _random_basis(40, 7, 1.0)[..., :3, :3]
+    assert _orthonormal(rigid) and _orthonormal(np.broadcast_to(rigid[:1], rigid.shape))
+    for row, column, offset in ((0, 0, 4e-6), (2, 1, 4e-7), (1, 2, 8e-7), (0, 0, np.nan)):
+        bent = rigid.copy()
+        bent[17, 3, row, column] += offset
+        expected = bool(np.allclose(np.swapaxes(bent, -1, -2) @ bent, np.eye(3), atol=1e-6))
+        assert _orthonormal(bent) == expected
+    assert not _orthonormal(rigid * 1.01)
