@@ -200,9 +200,11 @@ def _is_frame_curve(curve):
 
 
 def mute(obj, found, start, end):
-    """Mute each constraint found over frames start-end, faded with the gesture's blend (see the module)."""
+    """Mute each constraint found over frames start-end, faded with the gesture's blend (see the module).
+    Returns {influence path: [its influence at each of the frames before the mute]}, for `unmute`."""
     frames = np.arange(start, end + 1)
     keep = 1.0 - gesture.blend_weights(len(frames))  # (N,) the influence's share left on each frame
+    before = {}
     for _, constraint in found:
         curve = influence_curve(obj, constraint)
         if curve is None:
@@ -215,8 +217,26 @@ def mute(obj, found, start, end):
             kept, evaluate = {}, (lambda frame, value=value: value)
         else:
             kept, evaluate = {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}, curve.evaluate
-        keys = {f: v for f, v in kept.items() if not start <= f <= end}
-        keys.update({int(f): evaluate(float(f)) * k for f, k in zip(frames, keep)})
-        ordered = sorted(keys)
-        curve.keyframe_points.clear()
-        action_adapter.write_keys(curve, np.array(ordered, dtype=np.float64), np.array([keys[f] for f in ordered]))
+        values = before[constraint.path_from_id("influence")] = [float(evaluate(float(f))) for f in frames]
+        _key_frames(curve, kept, start, [v * k for v, k in zip(values, keep)])
+    return before
+
+
+def unmute(obj, before, start):
+    """Undo a replaced gesture's `mute` from frame start on: before is what that mute returned. A curve
+    no longer Generate's (removed, or made something else by hand) is left alone."""
+    data = obj.animation_data
+    for path, values in before.items():
+        curve = None if data is None else data.drivers.find(path)
+        if curve is not None and _is_frame_curve(curve):
+            _key_frames(curve, {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}, start, values)
+
+
+def _key_frames(curve, kept, start, values):
+    """Key the frame curve with `values` on the frames from start on, and the kept {frame: value} keys elsewhere."""
+    end = start + len(values) - 1
+    keys = {f: v for f, v in kept.items() if not start <= f <= end}
+    keys.update({start + k: v for k, v in enumerate(values)})
+    ordered = sorted(keys)
+    curve.keyframe_points.clear()
+    action_adapter.write_keys(curve, np.array(ordered, dtype=np.float64), np.array([keys[f] for f in ordered]))

@@ -244,7 +244,8 @@ def _write(plan, agent, scene):
     if settings.behaviour == "POINT" and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     digest = action_adapter.KeyDigest()
-    if plan.previous is not None:
+    if plan.previous is not None:  # its constraints' fade undone first, so the new one applies once
+        constraints.unmute(plan.obj, gestures.influence_before(plan.previous), plan.previous.record["start"])
         action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type, digest,
                                   plan.properties)
         note += " (replaced the previous gesture)"
@@ -254,8 +255,9 @@ def _write(plan, agent, scene):
                                            plan.properties)
     if plan.ik_share is not None:
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
-    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets, digest.hexdigest())
-    constraints.mute(plan.obj, plan.overriding, start, end)
+    influence_before = constraints.mute(plan.obj, plan.overriding, start, end)
+    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets, digest.hexdigest(),
+                    influence_before)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
     editable = ""

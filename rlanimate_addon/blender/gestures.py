@@ -148,15 +148,24 @@ class Backup:
         bpy.data.actions.remove(self.copy)
 
 
-def record(action, settings, start, end, under, aimed_at, keys):
+def record(action, settings, start, end, under, aimed_at, keys, influence_before=None):
     """Write the action's record: settings (a mapping of Scene.rlanimate's names to values), under
     ({bone: channel values} of bones that stand still underneath), aimed_at ((N, 3) armature-space
-    targets per frame, or None), keys (the hex KeyDigest of the keys written)."""
+    targets per frame, or None), keys (the hex KeyDigest of the keys written), influence_before
+    ({influence path: values per frame} of the constraints it muted, before it muted them:
+    constraints.mute)."""
     action[RECORD] = {
         "behaviour": settings["behaviour"], "arm": settings["arm"], "start": int(start), "end": int(end),
         "settings": settings, "under": {bone: list(map(float, values)) for bone, values in under.items()},
         "aimed_at": [] if aimed_at is None else np.asarray(aimed_at, dtype=np.float64).ravel().tolist(),
-        "keys": keys, "note": ""}
+        "keys": keys, "note": "", "influence_before": [{"path": path, "values": list(map(float, values))}
+                                                       for path, values in (influence_before or {}).items()]}
+
+
+def influence_before(gesture):
+    """{influence path: values per frame} the gesture's mute faded (`record`; none in a record made before
+    Generate kept them)."""
+    return {item["path"]: list(item["values"]) for item in gesture.record.get("influence_before", [])}
 
 
 def edited_by_hand(gesture):

@@ -84,3 +84,33 @@ def test_muted_disabled_and_unrelated_constraints_are_left_alone(settings):
     assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"}
     assert not rig.animation_data.drivers
 
+
+
+def test_generate_again_over_a_muted_constraint_fades_it_once_as_the_first_click_did(settings):
+    """Regenerating replaces the gesture and its mute: the constraint's influence is faded by the new
+    gesture's blend once, not by the old fade times the new one (0.7 (1 - w)^2 in the ramps)."""
+    rig, _, ik = _ik_rig()
+    settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
+    path = ik.path_from_id("influence")
+
+    def influence_keys():
+        points = rig.animation_data.drivers.find(path).keyframe_points
+        return np.array([tuple(p.co) for p in points])
+
+    assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    first = influence_keys()
+    ramp = START + np.flatnonzero((gesture.blend_weights(COUNT) > 0.2) & (gesture.blend_weights(COUNT) < 0.8))
+    expected = 0.7 * (1.0 - gesture.blend_weights(COUNT))
+    assert np.allclose(first[:, 1], expected, atol=1e-6) and len(ramp) > 2
+    for _ in range(2):
+        assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+        assert np.array_equal(influence_keys(), first), "the fade of the replaced gesture is undone first"
+    for frame in ramp[:3]:
+        bpy.context.scene.frame_set(int(frame))
+        assert ik.influence == pytest.approx(expected[frame - START], abs=1e-6)
+    # A replacing gesture at other frames gives back the old frames' influence and fades its own.
+    settings.start_frame = START + 10
+    assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    for frame, value in ((START + 2, 0.7), (START + 10 + COUNT // 2, 0.0), (START + 10 + COUNT - 1, 0.7)):
+        bpy.context.scene.frame_set(frame)
+        assert ik.influence == pytest.approx(value, abs=1e-6)
