@@ -137,6 +137,10 @@ def _compute(context, plan, settings, agent, frames):
             with constraints.muted(context.view_layer, plan.overriding):
                 rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames,
                                                                     target, bone)
+            if plan.previous is not None and not plan.previous.record.get("animated", True):
+                # It replaces a gesture made on a still rig: with nothing else moving these frames (other
+                # gestures elsewhere make the rig animated), it plays as that first one did.
+                rig, below_values = rig.standing_still(below_values) or (rig, below_values)
             if plan.ik_share is not None:  # the FK controls start where the arm stands in IK
                 played, switch = rigify.played_arm(context, obj, settings.arm, frames, rig.animated)
                 rig = rig_rigify.snap_fk(rig, rig_rigify.fk_controls(settings.arm), played)
@@ -257,7 +261,7 @@ def _write(plan, agent, scene):
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
     influence_before = constraints.mute(plan.obj, plan.overriding, start, end)
     gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets, digest.hexdigest(),
-                    influence_before)
+                    influence_before, plan.rig.animated)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
     editable = ""

@@ -148,17 +148,17 @@ class Backup:
         bpy.data.actions.remove(self.copy)
 
 
-def record(action, settings, start, end, under, aimed_at, keys, influence_before=None):
+def record(action, settings, start, end, under, aimed_at, keys, influence_before=None, animated=True):
     """Write the action's record: settings (a mapping of Scene.rlanimate's names to values), under
     ({bone: channel values} of bones that stand still underneath), aimed_at ((N, 3) armature-space
     targets per frame, or None), keys (the hex KeyDigest of the keys written), influence_before
     ({influence path: values per frame} of the constraints it muted, before it muted them:
-    constraints.mute)."""
+    constraints.mute), animated (whether it was baked over animation, not on a still rig)."""
     action[RECORD] = {
         "behaviour": settings["behaviour"], "arm": settings["arm"], "start": int(start), "end": int(end),
         "settings": settings, "under": {bone: list(map(float, values)) for bone, values in under.items()},
         "aimed_at": [] if aimed_at is None else np.asarray(aimed_at, dtype=np.float64).ravel().tolist(),
-        "keys": keys, "note": "", "influence_before": [{"path": path, "values": list(map(float, values))}
+        "keys": keys, "note": "", "animated": bool(animated), "influence_before": [{"path": path, "values": list(map(float, values))}
                                                        for path, values in (influence_before or {}).items()]}
 
 

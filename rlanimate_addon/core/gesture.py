@@ -607,6 +607,20 @@ class RigState:
             under_pose = skeleton_.pose_matrices(self.under, only=every)
         self.under_pose = np.asarray(under_pose, dtype=np.float64)
 
+    def standing_still(self, values):
+        """(this rig as a still one, its rotation channel values {bone: (N, C)}) from the first frame
+        underneath, each broadcast over the frames, as a rig without animation is read; None when the pose
+        underneath moves over the frames. values: {bone: (N, C)} the channel values underneath."""
+        if self.under.ndim == 4 and (np.ptp(self.under, axis=0).any() or np.ptp(self.under_pose, axis=0).any()):
+            return None
+        if any(np.ptp(v, axis=0).any() for v in values.values()):
+            return None
+        count = len(next(iter(values.values())))
+        frame = (lambda m: np.broadcast_to(m[:1], m.shape)) if self.under.ndim == 4 else (lambda m: m)
+        still = RigState(self.name, self.skeleton, self.roles, self.family, frame(self.under), False,
+                         under_pose=frame(self.under_pose))
+        return still, {bone: np.broadcast_to(np.asarray(v)[:1], (count, np.shape(v)[1])) for bone, v in values.items()}
+
     def under_at(self, count):
         """(N, B, 4, 4) basis matrices underneath at each of `count` frames."""
         return np.broadcast_to(self.under, (count,) + self.under.shape[-3:])

@@ -392,3 +392,19 @@ def test_the_finger_line_runs_through_joints_index_base_to_its_farthest_joint():
     assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip")
     assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1")
     assert gesture.finger_line_bones({"RightHand": "hand", "RightForeArm": "forearm"}, "RIGHT") == ("forearm", "hand")
+
+
+def test_a_rig_whose_pose_underneath_stands_still_reads_as_still_and_one_that_moves_does_not():
+    rig = gesture.canonical_rig()
+    count = 5
+    under = np.broadcast_to(rig.under, (count,) + rig.under.shape).copy()
+    values = {"RightArm": np.tile([1.0, 0.0, 0.0, 0.0], (count, 1))}
+    animated = gesture.RigState("Rig", rig.skeleton, rig.roles, rig.family, under, True)
+    still, still_values = animated.standing_still(values)
+    assert not still.animated and still.under.strides[0] == 0 and np.array_equal(still.under_at(count), under)
+    assert still_values["RightArm"].strides[0] == 0 and np.array_equal(still_values["RightArm"], values["RightArm"])
+    under[3, 4, 0, 3] += 1e-3  # one bone moves at one frame
+    moving = gesture.RigState("Rig", rig.skeleton, rig.roles, rig.family, under, True)
+    assert moving.standing_still(values) is None
+    turning = dict(values, RightArm=values["RightArm"] + np.array([[0.0, 0.0, 1e-4, 0.0]]) * np.arange(count)[:, None])
+    assert animated.standing_still(turning) is None
