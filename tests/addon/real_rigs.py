@@ -20,8 +20,7 @@ from rlanimate_addon.core import behaviour_metrics, gesture, skeleton
 
 SHARED_RIGS = helpers.ROOT.parent / "shared" / "rigs"
 
-#: The files of ../shared/rigs, by a short name: (path under it, bone-map file's bones or None).
-#: Quaternius' 2019 naming is outside the claimed families: its user bone map maps the hand to Palm.
+#: The files of ../shared/rigs, by a short name: their paths under it.
 FILES = {
     "ue_control_rig": "unreal/mesh2motion_rig-human.blend",
     "ue_gltf": "unreal/mesh2motion_human-male.glb",
@@ -32,11 +31,18 @@ FILES = {
     "vrm0_robot": "vrm/unavi_robot_vrm0.vrm",
 }
 
+_QUATERNIUS_BODY = {"Hips": "Hips", "Spine": "Abdomen", "Spine1": "Torso", "Neck": "Neck", "Head": "Head",
+                    **{f"{side}{role}": f"{bone}.{side[0]}" for side in ("Left", "Right") for role, bone in
+                       (("Shoulder", "Shoulder"), ("Arm", "UpperArm"), ("ForeArm", "LowerArm"), ("Hand", "Palm"))}}
+
 #: User bone maps for the rigs outside the claimed families (what a user writes after Save Bone Map).
+#: Quaternius' hand is Palm, and its four fingers are one bone, Fingers, with an end bone: mapped as the
+#: index finger, it points as an index finger does ('quaternius_palm_only' maps no finger, so the arm
+#: points along its forearm, gesture.finger_line_bones).
 USER_BONE_MAPS = {
-    "quaternius": {"Hips": "Hips", "Spine": "Abdomen", "Spine1": "Torso", "Neck": "Neck", "Head": "Head",
-                   **{f"{side}{role}": f"{bone}.{side[0]}" for side in ("Left", "Right") for role, bone in
-                      (("Shoulder", "Shoulder"), ("Arm", "UpperArm"), ("ForeArm", "LowerArm"), ("Hand", "Palm"))}},
+    "quaternius": {**_QUATERNIUS_BODY, **{f"{side}HandIndex{k}": f"Fingers.{side[0]}{end}"
+                                          for side in ("Left", "Right") for k, end in ((1, ""), (2, "_end"))}},
+    "quaternius_palm_only": _QUATERNIUS_BODY,
     "gdbot": {"Hips": "hips", "Spine": "torso", "Neck": "neck", "Head": "head",
               **{f"{side}{role}": f"{bone}.{side[0]}" for side in ("Left", "Right") for role, bone in
                  (("Shoulder", "fake_shoulder"), ("Arm", "upperarm"), ("ForeArm", "lowerarm"), ("Hand", "hand"))}},
