@@ -35,17 +35,20 @@ RIGS = (
     ("kenney", "Mixamo-like, 3.7 units tall", "Mesh2Motion / Kenney (real file)"),
     ("quaternius", "outside the families (Palm, no index)", "Quaternius (real file)"),
     ("gdbot", "outside the families (_FK/_IK chains)", "GDQuest (real file)"),
-    ("vrm0_robot", "VRM 0.x", "UNAVI (real file)"),
+    ("vrm0_robot", "VRM 0.x, from the file's own humanoid map", "UNAVI (real file)"),
+    ("vrm1_robot", "VRM 1.0 rewritten from it, every joint renamed", "built from the real file"),
     ("rigify_fk", "Rigify, arms in FK", "built by Rigify (real tool)"),
     ("rigify_ik", "Rigify, arms in IK", "built by Rigify (real tool)"),
     ("rigify_export", "Rigify + game export skeleton", "built by Rigify (real tool)"),
 )
 
 
-def _load(name):
+def _load(name, folder):
     if name.startswith("rigify_"):
         return real_rigs.rigify_rig("FK" if name == "rigify_fk" else "IK", export=name == "rigify_export")
-    return real_rigs.load_shared(name)
+    if name == "vrm1_robot":
+        return real_rigs.import_gltf(real_rigs.vrm1_file(folder), folder)
+    return real_rigs.load_shared(name, folder)
 
 
 def _accept(rig, settings, name, folder):
@@ -68,7 +71,9 @@ def _accept(rig, settings, name, folder):
 
 def measure(name, targets, seed, folder):
     settings = helpers.enable_addon()
-    rig = _load(name)
+    folder = folder / name
+    folder.mkdir()
+    rig = _load(name, folder)
     accepted, mute = _accept(rig, settings, name, folder)
     if mute is None:
         helpers.disable_addon()
@@ -99,7 +104,7 @@ def main():
     folder = Path(tempfile.mkdtemp())
     rows, started = [], time.perf_counter()
     for name, family, source in RIGS:
-        if not name.startswith("rigify_") and real_rigs.shared_file(name) is None:
+        if not name.startswith("rigify_") and real_rigs.shared_file(name if name in real_rigs.FILES else "vrm0_robot") is None:
             rows.append(f"| {name} | {family} | {source} | absent (../shared/rigs) | | | | |")
             continue
         accepted, measured = measure(name, args.targets, args.seed, folder)

@@ -5,12 +5,13 @@ and the target, writing keys):
 
     targets (N, 3) in the rig's armature space --pointing_directions--> objectives (N, 7)
     --agent.rollout--> actions (M, 45) --decode, time_scale--> canonical rotations (N, 15, 3)
-    --fold_spine, retarget--> rig quaternions (N, D, 4) --blend with the pose underneath-->
+    --fold_missing, retarget--> rig quaternions (N, D, 4) --blend with the pose underneath-->
     --aim_rig (POINT, exact aim)--> keys
 
 A rig may differ from the canonical skeleton in many ways, all handled here:
   * bone names: core.rig_roles maps roles (canonical names) to its bones; a role it lacks is left
-    out (the other arm, fingers, eyes), or, for the spine, folded into the spine bones it has;
+    out (the other arm, fingers, eyes), or, for the spine and a collar, folded into the spine bones and
+    the upper arm it has;
   * scale and units (a Mixamo FBX in centimetres): only directions and rotations are used;
   * the orientation of its armature space (an FBX whose armature space is Y-up): `character_frame`
     finds the rotation from the rig's armature space to the character frame (+X left, -Y forward,
@@ -298,26 +299,36 @@ def _parent_role(name, present):
     return parent
 
 
-def fold_spine(rotvecs, joints, present):
-    """Canonical rotations (N, J, 3) of `joints` with each spine joint the rig lacks folded into one it has.
+#: Chains of action joints, parents first, in which a joint the rig lacks is folded into one it has: the
+#: spine, and each collar into its upper arm (an arm hanging from the spine with no collar bone).
+FOLDED_CHAINS = (rig_roles.SPINE, ("LeftShoulder", "LeftArm"), ("RightShoulder", "RightArm"))
 
-    A missing spine joint goes to the nearest present one below it (above it when none is below); a
-    present joint then turns by the product of its group's armature-space turns, so the neck and
-    everything above it end up turned as on the canonical skeleton. Returns (joints kept, rotations).
+
+def fold_missing(rotvecs, joints, present):
+    """Canonical rotations (N, J, 3) of `joints` with each joint of a FOLDED_CHAINS chain the rig lacks
+    folded into one of that chain it has.
+
+    A missing joint goes to the nearest present one below it (above it when none is below); a present
+    joint then turns by the product of its group's armature-space turns, so everything above the chain
+    ends up turned as on the canonical skeleton (the neck for the spine, the upper arm for a collar).
+    Returns (joints kept, rotations).
     """
-    spine = [j for j in rig_roles.SPINE if j in present]
-    groups = {j: [] for j in spine}
-    for j in rig_roles.SPINE:
-        below = [p for p in spine if rig_roles.SPINE.index(p) <= rig_roles.SPINE.index(j)]
-        groups[below[-1] if below else spine[0]].append(j)
     out = rotvecs.copy()
-    for keeper, members in groups.items():
-        turn = np.eye(3)
-        for j in members:  # SPINE order: parents first
-            frame = _CANONICAL_FRAMES[j]
-            turn = turn @ frame @ rotvec_to_matrix(rotvecs[:, joints.index(j)]) @ frame.T
-        frame = _CANONICAL_FRAMES[keeper]
-        out[:, joints.index(keeper)] = matrix_to_rotvec(frame.T @ turn @ frame)
+    for chain in FOLDED_CHAINS:
+        kept = [j for j in chain if j in present]
+        if not kept:  # an arm the rig lacks
+            continue
+        groups = {j: [] for j in kept}
+        for j in chain:
+            below = [p for p in kept if chain.index(p) <= chain.index(j)]
+            groups[below[-1] if below else kept[0]].append(j)
+        for keeper, members in groups.items():
+            turn = np.eye(3)
+            for j in members:  # chain order: parents first
+                frame = _CANONICAL_FRAMES[j]
+                turn = turn @ frame @ rotvec_to_matrix(rotvecs[:, joints.index(j)]) @ frame.T
+            frame = _CANONICAL_FRAMES[keeper]
+            out[:, joints.index(keeper)] = matrix_to_rotvec(frame.T @ turn @ frame)
     kept = [i for i, j in enumerate(joints) if j in present]
     return [joints[i] for i in kept], out[:, kept]
 
@@ -515,7 +526,7 @@ def gesture_rotations(agent, request, rig):
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed,
                           frame_count=request.frame_count)  # (N, 15, 3)
     phase_base = played_finger_base(canonical, request.arm) if request.behaviour == "POINT" else None
-    names, canonical = fold_spine(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
+    names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
     if request.behaviour == "POINT":
         hand_names, hand = pointing_hand_rotations(request.arm, request.frame_count)
         present = [i for i, name in enumerate(hand_names) if name in rig.roles]

@@ -209,9 +209,10 @@ def _detect(bone_names, rigify):
 
 
 def required_roles(arm):
-    """Roles a gesture of `arm` cannot do without: a spine bone, the neck, the head and that arm."""
+    """Roles a gesture of `arm` cannot do without: a spine bone, the neck, the head and that arm (a collar
+    bone it may lack: its turn goes to the upper arm, gesture.fold_missing)."""
     side = "Left" if arm == "LEFT" else "Right"
-    return ("Neck", "Head") + tuple(side + part for part in ("Shoulder", "Arm", "ForeArm", "Hand"))
+    return ("Neck", "Head") + tuple(side + part for part in ("Arm", "ForeArm", "Hand"))
 
 
 def check_roles(rig_name, roles, arm, family_name):

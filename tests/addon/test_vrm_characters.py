@@ -2,14 +2,12 @@
 Blender's glTF importer, on a VRM 1.0 file made from it by rewriting its JSON chunk, and from the VRM
 add-on's data on the armature: accepted with no bone-map file, pointing and waving as measured on the
 bones the mesh deforms with."""
-import json
-import struct
-
 import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
 import deformed_measures as measures
+import real_rigs
 
 from rlanimate_addon.blender import armature_io
 from rlanimate_addon.core import vrm
@@ -17,36 +15,10 @@ from rlanimate_addon.core import vrm
 EXACT_MEDIAN, EXACT_WORST, OWN_MEDIAN, OWN_WORST = 1.0, 3.0, 5.0, 12.0
 
 
-def rewrite_json(source, target, change):
-    """Copy a binary glTF file with its JSON chunk passed through change(dict) -> dict; the BIN chunk kept."""
-    data = source.read_bytes()
-    length = struct.unpack("<I", data[12:16])[0]
-    gltf = change(json.loads(data[20:20 + length]))
-    text = json.dumps(gltf).encode()
-    text += b" " * (-len(text) % 4)
-    rest = data[20 + length:]
-    target.write_bytes(b"glTF" + struct.pack("<II", 2, 20 + len(text) + len(rest))
-                       + struct.pack("<I4s", len(text), b"JSON") + text + rest)
-    return target
-
-
-def as_vrm1(gltf):
-    """The VRM 0.x glTF as VRM 1.0 (VRMC_vrm, humanBones a dict, thumbs from the metacarpal), every joint
-    renamed 'joint_<index>' so that nothing but the file's map can tell which bone is which."""
-    bones = {}
-    for entry in gltf["extensions"].pop("VRM")["humanoid"]["humanBones"]:
-        name = entry["bone"].replace("ThumbProximal", "ThumbMetacarpal").replace("ThumbIntermediate", "ThumbProximal")
-        bones[name] = {"node": entry["node"]}
-    gltf["extensions"]["VRMC_vrm"] = {"specVersion": "1.0", "humanoid": {"humanBones": bones}}
-    gltf["extensionsUsed"] = ["VRMC_vrm"]
-    for index in gltf["skins"][0]["joints"]:
-        gltf["nodes"][index]["name"] = f"joint_{index:02d}"
-    return gltf
-
-
 @pytest.fixture
 def vrm1_file(tmp_path):
-    return rewrite_json(measures.require(measures.VRM0), tmp_path / "robot_vrm1.vrm", as_vrm1)
+    measures.require(measures.VRM0)
+    return real_rigs.vrm1_file(tmp_path)
 
 
 def _check_gestures(rig, settings, family):

@@ -258,18 +258,21 @@ def test_the_eyes_look_at_the_target_while_pointing(animated):
         assert angles[0] > 5.0, "and only then: at the start it looks ahead"
 
 
-def test_a_missing_spine_bone_is_folded_into_the_one_below_and_the_neck_turns_the_same():
+@pytest.mark.parametrize("missing, above", [("Spine2", "Neck"), ("RightShoulder", "RightArm")])
+def test_a_missing_spine_or_collar_bone_is_folded_and_the_bone_above_turns_the_same(missing, above):
+    """A missing spine joint folds into the one below; a missing collar into its upper arm, which then
+    points where the canonical upper arm points (an arm hanging from the spine, GDQuest's robot)."""
     rotvecs = RNG.normal(scale=0.2, size=(5, len(skeleton.ACTION_JOINTS), 3))
     joints = list(skeleton.ACTION_JOINTS)
-    present = set(joints) - {"Spine2"}
-    kept, folded = gesture.fold_spine(rotvecs, joints, present)
-    assert "Spine2" not in kept and len(kept) == len(joints) - 1
+    present = set(joints) - {missing}
+    kept, folded = gesture.fold_missing(rotvecs, joints, present)
+    assert missing not in kept and len(kept) == len(joints) - 1
     from rlanimate_addon.core import kinematics
 
     full = kinematics.pose_matrices(dict(zip(joints, np.moveaxis(rotvecs, 1, 0))))
     merged = kinematics.pose_matrices(dict(zip(kept, np.moveaxis(folded, 1, 0))))
-    neck = kinematics.bone_index("Neck")
-    assert np.allclose(full[:, neck, :3, :3], merged[:, neck, :3, :3], atol=1e-9)
+    bone = kinematics.bone_index(above)
+    assert np.allclose(full[:, bone, :3, :3], merged[:, bone, :3, :3], atol=1e-9)
 
 
 def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
