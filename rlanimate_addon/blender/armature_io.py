@@ -54,6 +54,20 @@ def rig_roles_of(obj, bone_map_path=""):
     return family.name, roles
 
 
+def check_hips(obj, roles):
+    """RLAnimateError when the bone playing Hips hangs below a spine bone (GDQuest's robot: its torso carries
+    its hips): the gesture keys the spine, and reads where a target is from the hips' motion underneath."""
+    hips = roles.get("Hips")
+    above = set() if hips is None else {bone.name for bone in obj.data.bones[hips].parent_recursive}
+    spine = [roles[role] for role in rig_roles.SPINE if roles.get(role) in above]
+    if spine:
+        parent = obj.data.bones[spine[0]].parent
+        raise RLAnimateError(
+            f"The Hips bone {hips!r} of {obj.name!r} hangs below the Spine bone {spine[0]!r}, but the gesture keys "
+            "the spine from the hips up: in the bone-map file, map Hips to "
+            + (f"the bone the spine hangs from, {parent.name!r}." if parent else "a bone above the spine."))
+
+
 def read_skeleton(obj, roles):
     """The bones playing roles as a RigSkeleton (gesture.role_skeleton; rest matrices in armature space,
     the rig's units)."""

@@ -111,6 +111,7 @@ def _check(obj, settings, start, end, mute_constraints):
     check_keepable(obj)
     check_nla(obj)
     check_inherited_rotation(obj, roles)
+    armature_io.check_hips(obj, roles)
     rig_scale.check_nonzero_scale(obj.name, obj.matrix_world, {  # the gesture's bones and their parents
         p.name: tuple(p.scale) for b in constraints.driven_bones(roles, settings.behaviour, settings.arm)
         for p in (obj.pose.bones[b], *obj.pose.bones[b].parent_recursive)})

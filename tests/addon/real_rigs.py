@@ -12,6 +12,7 @@ from pathlib import Path
 import addon_helpers as helpers
 import bpy
 import numpy as np
+import pytest
 import rig_variants
 import test_generate
 from test_rig_variants import _strokes
@@ -55,6 +56,7 @@ USER_BONE_MAPS = {
     "quaternius_palm_only": _QUATERNIUS_BODY,
     "gdbot": _GDBOT,
     "gdbot_shoulder_pad": {**_GDBOT, **{f"{side}Shoulder": f"fake_shoulder.{side[0]}" for side in ("Left", "Right")}},
+    "gdbot_hips_below_torso": {**_GDBOT, "Hips": "hips"},
 }
 
 
@@ -69,12 +71,25 @@ def shared_file(name):
     return path if path.is_file() else None
 
 
+def require(name):
+    """Path of a ../shared/rigs file; skips the test, with a message, when it is absent."""
+    path = shared_file(name)
+    if path is None:
+        pytest.skip(f"{SHARED_RIGS / FILES[name]} is absent: the real-rig tests read ../shared/rigs (see its README.md)")
+    return path
+
+
+def roles(rig, settings):
+    """{role: bone} as Generate finds them (bone-map file, VRM map or detection)."""
+    return armature_io.rig_roles_of(rig, settings.bone_map_file)[1]
+
+
 def load_shared(name, folder):
     """Bring a ../shared/rigs file into the current scene as a user would (Blender's importer with its
     defaults; a .blend's objects appended); returns its armature. A .vrm is imported by glTF's importer,
     which takes it under a .glb name only: copied into `folder`, which the armature's VRM file path then
-    names (kept, for Generate to read the VRM map from)."""
-    path = shared_file(name)
+    names (kept, for Generate to read the VRM map from). Skips the test when the file is absent."""
+    path = require(name)
     before = set(bpy.data.objects)
     if path.suffix == ".blend":
         with bpy.data.libraries.load(str(path), link=False) as (source, target):
@@ -230,24 +245,23 @@ def deformed_joints(rig, settings, arm):
     and the shoulder, as the mesh's bones play them; and the arm's rest length (shoulder to elbow to
     wrist, world units). The index tip is the head of the bone after the last index bone (its end
     bone), else that bone's own head: joint positions, not imported bone tails."""
-    _, roles = armature_io.rig_roles_of(rig, settings.bone_map_file)
+    found = roles(rig, settings)
     prefix = skeleton.ARM_PREFIX[arm]
-    index = [roles[prefix + f"HandIndex{k}"] for k in (1, 2, 3) if prefix + f"HandIndex{k}" in roles]
-    hand = roles[prefix + "Hand"]
+    index = [found[prefix + f"HandIndex{k}"] for k in (1, 2, 3) if prefix + f"HandIndex{k}" in found]
+    hand = found[prefix + "Hand"]
     if index:
         last = rig.data.bones[index[-1]]
-        tip_bone, tip_at = (last.children[0].name, "head") if last.children else (index[-1], "head")
-        base_bone = index[0]
+        base_bone, tip_bone = index[0], last.children[0].name if last.children else index[-1]
     else:  # no index finger: the forearm's head through the hand's head (gesture.finger_line_bones)
-        base_bone, tip_bone, tip_at = roles[prefix + "ForeArm"], hand, "head"
-    joints = [(hand, "head"), (base_bone, "head"), (tip_bone, tip_at), (roles[prefix + "Arm"], "head")]
+        base_bone, tip_bone = found[prefix + "ForeArm"], hand
+    joints = [hand, base_bone, tip_bone, found[prefix + "Arm"]]  # their heads
     deformed = bake_check.deformed_bones(rig)
-    carriers = [bake_check.stand_in(rig, bone, deformed) for bone, _ in joints]
+    carriers = [bake_check.stand_in(rig, bone, deformed) for bone in joints]
     rests = [np.array(rig.data.bones[c].matrix_local) for c in carriers]
-    points = [np.append(np.array(getattr(rig.data.bones[b], at + "_local")), 1.0) for b, at in joints]
+    points = [np.append(np.array(rig.data.bones[b].head_local), 1.0) for b in joints]
     local = [np.linalg.inv(r) @ p for r, p in zip(rests, points)]
     world = np.array(rig.matrix_world)
-    heads = {r: world @ np.append(np.array(rig.data.bones[roles[prefix + r]].head_local), 1.0)
+    heads = {r: world @ np.append(np.array(rig.data.bones[found[prefix + r]].head_local), 1.0)
              for r in ("Arm", "ForeArm", "Hand")}
     arm_length = float(np.linalg.norm(heads["ForeArm"] - heads["Arm"])
                        + np.linalg.norm(heads["Hand"] - heads["ForeArm"]))
@@ -260,9 +274,16 @@ def deformed_joints(rig, settings, arm):
     return at, arm_length
 
 
+def measured_bones_deform(rig, settings, arm):
+    """The wrist and the finger base the measures read are bones the mesh deforms with (no stand-in)."""
+    found = roles(rig, settings)
+    prefix = skeleton.ARM_PREFIX[arm]
+    base = found.get(prefix + "HandIndex1", found[prefix + "ForeArm"])
+    return {found[prefix + "Hand"], base} <= bake_check.deformed_bones(rig)
+
+
 def _character_frame(rig, settings):
-    _, roles = armature_io.rig_roles_of(rig, settings.bone_map_file)
-    heads = {r: np.array(rig.data.bones[b].head_local) for r, b in roles.items()}
+    heads = {r: np.array(rig.data.bones[b].head_local) for r, b in roles(rig, settings).items()}
     return gesture.character_frame(heads), heads
 
 
@@ -303,19 +324,32 @@ def point(rig, settings, arm, target, start, frames=120, exact=True, mute=False)
     joints = np.array([at(f) for f in range(start, start + frames)])  # (F, 4, 3)
     base, finger = joints[:, 1], joints[:, 2] - joints[:, 1]
     angles = behaviour_metrics.pointing_angles(base, finger, np.asarray(target))
-    width = _shoulder_width(rig, settings)
     render = bpy.context.scene.render
-    hold = behaviour_metrics.hold_frames(base, width, render.fps / render.fps_base)
+    hold = behaviour_metrics.hold_frames(base, _shoulder_width(rig, settings), render.fps / render.fps_base)
     miss = (np.median(angles[hold[0]:hold[1] + 1]) if hold is not None
             else angles[int(np.argmax(np.linalg.norm(base - base[0], axis=1)))])
     travel = np.linalg.norm(joints[:, 0] - joints[0, 0], axis=1).max() / arm_length
     return result, float(miss), float(travel)
 
 
+def point_misses(rig, settings, count, exact, seed):
+    """(misses in degrees, wrist travels in arm lengths), each (count,), of `count` Points 200 frames apart,
+    arms alternating, at unseen targets drawn with seed."""
+    rng = np.random.default_rng(seed)
+    measured = []
+    for k in range(count):
+        arm = ("RIGHT", "LEFT")[k % 2]
+        result, miss, travel = point(rig, settings, arm, world_target(rig, settings, arm, rng), 1 + 200 * k,
+                                     exact=exact)
+        assert result == {"FINISHED"}, result
+        measured.append((miss, travel))
+    return tuple(np.array(m) for m in zip(*measured))
+
+
 def _shoulder_width(rig, settings):
-    _, roles = armature_io.rig_roles_of(rig, settings.bone_map_file)
+    found = roles(rig, settings)
     world = np.array(rig.matrix_world)
-    left, right = (world @ np.append(np.array(rig.data.bones[roles[s + "Arm"]].head_local), 1.0)
+    left, right = (world @ np.append(np.array(rig.data.bones[found[s + "Arm"]].head_local), 1.0)
                    for s in ("Left", "Right"))
     return float(np.linalg.norm(left - right))
 
@@ -334,3 +368,16 @@ def wave(rig, settings, arm, start, frames=150, exaggeration=0.8, mute=False):
     lateral = (joints[:, 0] - joints[:, 3]) @ to_character.T[:, 0] / arm_length
     travel = np.linalg.norm(joints[:, 0] - joints[0, 0], axis=1).max() / arm_length
     return result, _strokes(lateral), float(travel)
+
+
+def arm_drop(rig, settings, arm, frame):
+    """Degrees the deformed upper arm (shoulder to elbow joint) points below the character's horizontal at a
+    frame: about 0 in a T-pose, 75 in the standing pose a still rig starts and ends in."""
+    found = roles(rig, settings)
+    prefix = skeleton.ARM_PREFIX[arm]
+    frame_rotation, _ = _character_frame(rig, settings)
+    bpy.context.scene.frame_set(int(frame))
+    evaluated = rig.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    shoulder, elbow = (np.array(evaluated.pose.bones[found[prefix + n]].head) for n in ("Arm", "ForeArm"))
+    direction = frame_rotation @ (elbow - shoulder)
+    return float(np.degrees(np.arcsin(-direction[2] / np.linalg.norm(direction))))

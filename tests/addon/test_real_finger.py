@@ -7,7 +7,7 @@ import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import deformed_measures as measures
+import real_rigs
 from mathutils import Vector
 
 
@@ -37,16 +37,17 @@ def _load(kind, tmp_path):
         rig = helpers.load_sample_rig()
         _turn_finger_tails(rig)
         return rig
-    path = {"UE4 glTF": measures.UE_GLB, "Kenney glTF": measures.KENNEY_GLB}[kind]
-    return measures.import_gltf(measures.require(path), tmp_path)
+    name = {"UE4 glTF": "ue_gltf", "Kenney glTF": "kenney"}[kind]
+    real_rigs.require(name)
+    return real_rigs.load_shared(name, tmp_path)
 
 
 @pytest.mark.parametrize("kind", ["UE4 glTF", "Kenney glTF", "sample", "sample, tails turned"])
 def test_exact_aim_hits_through_the_finger_joints(settings, tmp_path, kind):
     rig = _load(kind, tmp_path)
-    assert measures.measured_bones_deform(rig, "RIGHT") and measures.measured_bones_deform(rig, "LEFT")
-    own, _ = measures.point_misses(rig, settings, 4, False, 7)
-    exact, travel = measures.point_misses(rig, settings, 4, True, 7)
+    assert real_rigs.measured_bones_deform(rig, settings, "RIGHT") and real_rigs.measured_bones_deform(rig, settings, "LEFT")
+    own, _ = real_rigs.point_misses(rig, settings, 4, False, 7)
+    exact, travel = real_rigs.point_misses(rig, settings, 4, True, 7)
     print(f"{kind}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)}")
     assert np.median(exact) <= EXACT_MEDIAN and exact.max() <= EXACT_WORST, f"{kind}: Exact Aim misses {exact}"
     assert np.median(own) <= OWN_MEDIAN and own.max() <= OWN_WORST, f"{kind}: own aim misses {own}"
@@ -56,7 +57,8 @@ def test_exact_aim_hits_through_the_finger_joints(settings, tmp_path, kind):
 @pytest.mark.parametrize("kind", ["UE4 glTF", "Kenney glTF"])
 def test_waves_on_real_rigs_make_strokes_and_move_the_hand(settings, tmp_path, kind):
     rig = _load(kind, tmp_path)
-    strokes, travel = measures.wave(rig, settings, "LEFT")
+    result, strokes, travel = real_rigs.wave(rig, settings, "LEFT", 1001)
+    assert result == {"FINISHED"}
     print(f"{kind}: {strokes} strokes, hand travel {travel:.2f} arm lengths")
     assert strokes >= 4 and travel >= 0.5
 

@@ -18,9 +18,6 @@ CLAIMED = {"ue_control_rig": True, "ue_gltf": False, "seed_san": False, "kenney"
 
 
 def _shared(name, folder):
-    if real_rigs.shared_file(name) is None:
-        pytest.skip(f"{real_rigs.SHARED_RIGS / real_rigs.FILES[name]} is absent: the real-rig tests read "
-                    "../shared/rigs (see its README.md)")
     if real_rigs.FILES[name].endswith(".blend") and bpy.app.version < (5, 0, 0):
         pytest.skip("the .blend was saved by Blender 5.0, which Blender 4.2 cannot read")
     return real_rigs.load_shared(name, folder)
@@ -83,8 +80,9 @@ def test_fk_and_ik_duplicate_chains_are_not_called_rigify_and_gesture_with_the_b
     chain hanging from the torso, with no collar bone (a fake shoulder pad sits beside it), measured over its
     Idle (real_rigs.ACTIONS). Refused naming
     the bone-map fix; with a map naming that chain (no Shoulder: the collar's turn goes to the upper arm)
-    it gestures on its deformed bones. A map giving the shoulder pad the Shoulder role bakes keys the arm
-    does not follow: the bake check undoes it."""
+    and root as Hips: its hips hang below its torso) it gestures on its deformed bones. A map giving the
+    shoulder pad the Shoulder role bakes keys the arm does not follow: the bake check undoes it; one giving
+    Hips to the bone named hips is refused naming root."""
     rig = _shared("gdbot", tmp_path)
     family, _ = armature_io.rig_roles_of(rig)
     assert family != rig_roles.RIGIFY.name
@@ -95,6 +93,10 @@ def test_fk_and_ik_duplicate_chains_are_not_called_rigify_and_gesture_with_the_b
     with pytest.raises(RuntimeError, match=r"would not play, so it was undone"):
         helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
     assert rig.animation_data.action == action and [t.name for t in rig.animation_data.nla_tracks] == tracks
+    settings.bone_map_file = real_rigs.write_bone_map("gdbot_hips_below_torso", tmp_path)
+    with pytest.raises(RuntimeError, match=r"The Hips bone 'hips' of 'Armature' hangs below the Spine bone 'torso'.*"
+                                           r"map Hips to the bone the spine hangs from, 'root'"):
+        helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
     settings.bone_map_file = real_rigs.write_bone_map("gdbot", tmp_path)
     # Over its Idle, whose arms hang 51 degrees down (the standing pose: 75), a point at a low target
     # turns the arm 27 degrees: the wrist moves 0.47 arm lengths, short of the issue's 0.5.

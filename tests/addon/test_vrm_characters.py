@@ -6,7 +6,6 @@ import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import deformed_measures as measures
 import real_rigs
 
 from rlanimate_addon.blender import armature_io
@@ -17,38 +16,37 @@ EXACT_MEDIAN, EXACT_WORST, OWN_MEDIAN, OWN_WORST = 1.0, 3.0, 5.0, 12.0
 
 @pytest.fixture
 def vrm1_file(tmp_path):
-    measures.require(measures.VRM0)
+    real_rigs.require("vrm0_robot")
     return real_rigs.vrm1_file(tmp_path)
 
 
 def _check_gestures(rig, settings, family):
-    own, _ = measures.point_misses(rig, settings, 4, False, 5)
-    start = measures.arm_drop(rig, "RIGHT", 1)  # the first gesture, baked on the still rig
-    exact, travel = measures.point_misses(rig, settings, 4, True, 5)
-    strokes, wave_travel = measures.wave(rig, settings, "RIGHT")
+    own, _ = real_rigs.point_misses(rig, settings, 4, False, 5)
+    start = real_rigs.arm_drop(rig, settings, "RIGHT", 1)  # the first gesture, baked on the still rig
+    exact, travel = real_rigs.point_misses(rig, settings, 4, True, 5)
+    result, strokes, wave_travel = real_rigs.wave(rig, settings, "RIGHT", 1001)
     print(f"{family}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)} arm "
           f"lengths, wave {strokes} strokes / {wave_travel:.2f}, start arm drop {start:.0f} deg")
-    assert measures.measured_bones_deform(rig, "RIGHT") and measures.measured_bones_deform(rig, "LEFT")
+    assert real_rigs.measured_bones_deform(rig, settings, "RIGHT") and real_rigs.measured_bones_deform(rig, settings, "LEFT")
     assert np.median(exact) <= EXACT_MEDIAN and exact.max() <= EXACT_WORST
     assert np.median(own) <= OWN_MEDIAN and own.max() <= OWN_WORST
-    assert strokes >= 4 and min(travel.min(), wave_travel) >= 0.5
+    assert result == {"FINISHED"} and strokes >= 4 and min(travel.min(), wave_travel) >= 0.5
     assert 60.0 < start < 85.0, "a T-pose rig with no animation starts in the standing pose, not its T-pose"
     assert armature_io.rig_roles_of(rig)[0] == family
 
 
 def test_a_vrm0_file_imported_with_the_gltf_importer_points_and_waves(settings, tmp_path):
-    source = measures.require(measures.VRM0)
-    rig = measures.import_gltf(source, tmp_path)
+    rig = real_rigs.load_shared("vrm0_robot", tmp_path)
     assert rig.rlanimate.vrm_file == str(tmp_path / "x.glb"), "the import keeps the VRM file's path"
-    roles = measures.roles(rig)
+    roles = real_rigs.roles(rig, settings)
     assert roles["RightArm"] == "upper_arm.R" and roles["RightHandIndex1"] == "index.proximal.R"
     _check_gestures(rig, settings, vrm.FAMILY)
 
 
 def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_file):
-    rig = measures.import_gltf(vrm1_file, tmp_path)
+    rig = real_rigs.import_gltf(vrm1_file, tmp_path)
     assert rig.rlanimate.vrm_file == str(tmp_path / "x.glb"), "the import keeps the VRM file's path"
-    roles = measures.roles(rig)
+    roles = real_rigs.roles(rig, settings)
     gltf = vrm.read_gltf_json(str(vrm1_file))
     thumb = gltf["extensions"]["VRMC_vrm"]["humanoid"]["humanBones"]["rightThumbMetacarpal"]["node"]
     assert roles["RightHandThumb1"] == f"joint_{thumb:02d}" and len(roles) == 45
@@ -56,7 +54,7 @@ def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_f
 
 
 def test_an_armature_imported_without_its_vrm_path_is_mapped_from_the_file_it_is_given(settings, tmp_path, vrm1_file):
-    rig = measures.import_gltf(vrm1_file, tmp_path)
+    rig = real_rigs.import_gltf(vrm1_file, tmp_path)
     rig.rlanimate.vrm_file = ""  # imported before the add-on was enabled: nothing but bone names
     target = helpers.add_empty("Target", (1.0, 3.0, 1.5))
     with pytest.raises(RuntimeError, match="has no bone for the roles.*'Bone Map from VRM File' reads the map"):
@@ -68,9 +66,9 @@ def test_an_armature_imported_without_its_vrm_path_is_mapped_from_the_file_it_is
 
 
 def test_a_wrong_or_damaged_vrm_file_is_refused_and_the_armature_keeps_its_map(settings, tmp_path, vrm1_file):
-    rig = measures.import_gltf(vrm1_file, tmp_path)
+    rig = real_rigs.import_gltf(vrm1_file, tmp_path)
     assert bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(vrm1_file)) == {"FINISHED"}
-    other = measures.require(measures.VRM0)  # the 0.x file names its bones otherwise
+    other = real_rigs.require("vrm0_robot")  # the 0.x file names its bones otherwise
     with pytest.raises(RuntimeError, match="names bones 'Armature' lacks"):
         bpy.ops.rlanimate.bone_map_from_vrm(filepath=str(other))
     broken = tmp_path / "broken.vrm"
@@ -83,44 +81,26 @@ def test_a_wrong_or_damaged_vrm_file_is_refused_and_the_armature_keeps_its_map(s
         helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
 
 
-class _Node(bpy.types.PropertyGroup):
-    bone_name: bpy.props.StringProperty()
+def _group(name, **properties):
+    """A PropertyGroup class with the given properties (annotations), as the VRM add-on declares them."""
+    return type(name, (bpy.types.PropertyGroup,), {"__annotations__": properties})
 
 
-class _HumanBone0(bpy.types.PropertyGroup):
-    bone: bpy.props.StringProperty()
-    node: bpy.props.PointerProperty(type=_Node)
+def _pointer(group):
+    return bpy.props.PointerProperty(type=group)
 
 
-class _Humanoid0(bpy.types.PropertyGroup):
-    human_bones: bpy.props.CollectionProperty(type=_HumanBone0)
-
-
-class _Vrm0(bpy.types.PropertyGroup):
-    humanoid: bpy.props.PointerProperty(type=_Humanoid0)
-
-
-class _Vrm1HumanBone(bpy.types.PropertyGroup):
-    node: bpy.props.PointerProperty(type=_Node)
-
-
+_Node = _group("_Node", bone_name=bpy.props.StringProperty())
+_HumanBone0 = _group("_HumanBone0", bone=bpy.props.StringProperty(), node=_pointer(_Node))
+_Humanoid0 = _group("_Humanoid0", human_bones=bpy.props.CollectionProperty(type=_HumanBone0))
+_Vrm1HumanBone = _group("_Vrm1HumanBone", node=_pointer(_Node))
 #: VRM 1.0: one pointer per human bone, named in snake case (left_upper_arm, left_thumb_metacarpal, ...).
-_Vrm1HumanBones = type("_Vrm1HumanBones", (bpy.types.PropertyGroup,), {"__annotations__": {
-    vrm.snake_case(name): bpy.props.PointerProperty(type=_Vrm1HumanBone) for name in vrm.ROLE_OF["1"]}})
-
-
-class _Vrm1Humanoid(bpy.types.PropertyGroup):
-    human_bones: bpy.props.PointerProperty(type=_Vrm1HumanBones)
-
-
-class _Vrm1(bpy.types.PropertyGroup):
-    humanoid: bpy.props.PointerProperty(type=_Vrm1Humanoid)
-
-
-class _Extension(bpy.types.PropertyGroup):
-    vrm0: bpy.props.PointerProperty(type=_Vrm0)
-    vrm1: bpy.props.PointerProperty(type=_Vrm1)
-
+_Vrm1HumanBones = _group("_Vrm1HumanBones", **{vrm.snake_case(name): _pointer(_Vrm1HumanBone)
+                                               for name in vrm.ROLE_OF["1"]})
+_Vrm1Humanoid = _group("_Vrm1Humanoid", human_bones=_pointer(_Vrm1HumanBones))
+_Vrm0, _Vrm1 = (_group(name, humanoid=_pointer(humanoid))
+                for name, humanoid in (("_Vrm0", _Humanoid0), ("_Vrm1", _Vrm1Humanoid)))
+_Extension = _group("_Extension", vrm0=_pointer(_Vrm0), vrm1=_pointer(_Vrm1))
 
 _ADDON_LAYOUT = (_Node, _HumanBone0, _Humanoid0, _Vrm0, _Vrm1HumanBone, _Vrm1HumanBones, _Vrm1Humanoid, _Vrm1,
                  _Extension)
@@ -143,8 +123,8 @@ def vrm_addon_layout(settings):
 
 @pytest.mark.parametrize("major", ["0", "1"])
 def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addon_layout, major):
-    source = measures.require(measures.VRM0)
-    rig = measures.import_gltf(source, tmp_path)
+    source = real_rigs.require("vrm0_robot")
+    rig = real_rigs.load_shared("vrm0_robot", tmp_path)
     for bone in rig.data.bones:  # names no family, nor the file, knows: only the add-on's map can tell
         bone.name = "b_" + bone.name.replace(".", "_")
     gltf = vrm.read_gltf_json(str(source))
@@ -162,10 +142,9 @@ def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addo
             if human_bone is None:  # legs: no role
                 continue
         human_bone.node.bone_name = bone_name
-    roles = measures.roles(rig)
+    roles = real_rigs.roles(rig, settings)
     assert roles["LeftForeArm"] == "b_lower_arm_L" and roles["RightHandIndex3"] == "b_index_distal_R"
     assert roles["RightHandThumb1"] == "b_thumb_proximal_R" and len(roles) == 45
-    target = helpers.add_empty("Target", measures.world_target(rig, "RIGHT", np.random.default_rng(3)))
-    assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, frame_count=120) == {"FINISHED"}
-    angles, bases = measures.finger_angles(rig, "RIGHT", np.array(target.location), np.arange(1, 121))
-    assert measures.hold_miss(rig, angles, bases) <= EXACT_WORST
+    target = real_rigs.world_target(rig, settings, "RIGHT", np.random.default_rng(3))
+    result, miss, _ = real_rigs.point(rig, settings, "RIGHT", target, 1)
+    assert result == {"FINISHED"} and miss <= EXACT_WORST
