@@ -102,8 +102,9 @@ def load_shared(name, folder):
     else:
         import_gltf(path, folder)
     armature = next(o for o in bpy.data.objects if o not in before and o.type == "ARMATURE")
-    if name in ACTIONS:
-        armature.animation_data.action = bpy.data.actions[ACTIONS[name]]
+    if name in ACTIONS:  # Blender 4.2's glTF importer names an action after its armature too: Idle_Armature
+        armature.animation_data.action = next(action for action in bpy.data.actions
+                                              if action.name in (ACTIONS[name], f"{ACTIONS[name]}_{armature.name}"))
     return helpers.activate(armature)
 
 
