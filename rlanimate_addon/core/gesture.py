@@ -315,13 +315,13 @@ def fold_missing(rotvecs, joints, present):
     """
     out = rotvecs.copy()
     for chain in FOLDED_CHAINS:
-        kept = [j for j in chain if j in present]
-        if not kept:  # an arm the rig lacks
+        have = [j for j in chain if j in present]
+        if not have:  # an arm the rig lacks
             continue
-        groups = {j: [] for j in kept}
+        groups = {j: [] for j in have}
         for j in chain:
-            below = [p for p in kept if chain.index(p) <= chain.index(j)]
-            groups[below[-1] if below else kept[0]].append(j)
+            below = [p for p in have if chain.index(p) <= chain.index(j)]
+            groups[below[-1] if below else have[0]].append(j)
         for keeper, members in groups.items():
             turn = np.eye(3)
             for j in members:  # chain order: parents first
