@@ -3,7 +3,7 @@ import os
 
 import bpy
 
-from ..core import frame_rate, gesture
+from ..core import behaviours, frame_rate, gesture
 from ..core.errors import RLAnimateError
 from . import armature_io, constraints, follow_target, preferences, properties, vrm_map
 
@@ -14,9 +14,13 @@ def _agent_summary(context, behaviour):
     path = preferences.selected_agent_path(context)
     name = "Bundled default" if path == preferences.BUNDLED_AGENT else path.name
     try:
-        average = preferences.selected_agent(context).average_frames[behaviour]
+        agent = preferences.selected_agent(context)
     except RLAnimateError as error:
         return name, str(error)
+    if behaviour not in agent.behaviours:
+        return name, (f"This agent performs {', '.join(behaviours.title(b) for b in agent.behaviours)}: pick one "
+                      "of them above.")
+    average = agent.average_frames[behaviour]
     fps = properties.scene_fps(context.scene)
     average, shortest, longest = (frame_rate.scene_frames(n, fps)
                                   for n in (average, *gesture.supported_length_range(average)))
@@ -79,14 +83,16 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             layout.prop(obj.rlanimate, "use_own_settings", text=f"Own Settings for {obj.name}")
         layout.prop(settings, "behaviour", expand=True)
         layout.prop(settings, "arm", expand=True)
-        if settings.behaviour == "POINT":
+        kind = properties.behaviour_kind(context, settings.behaviour)
+        if kind == behaviours.TARGET:
             layout.prop(settings, "target")
             if settings.target is None:
                 layout.prop(settings, "use_cursor")
             elif settings.target.type == "ARMATURE":
                 layout.prop_search(settings, "target_bone", settings.target.data, "bones")
-            layout.prop(settings, "exact_aim")
-        else:
+            if settings.behaviour == behaviours.POINT:
+                layout.prop(settings, "exact_aim")
+        elif kind == behaviours.INTENSITY:
             layout.prop(settings, "exaggeration", slider=True)
 
         column = layout.column(align=True)
