@@ -88,6 +88,14 @@ def behaviour_items(settings, context):
     return _items[declared]
 
 
+def chosen_behaviour(settings, context):
+    """The id of the settings' behaviour among the selected agent's, or "" when the stored choice is none of
+    them (another agent's): read from the stored enum number, as `settings.behaviour` would, without the
+    warning Blender prints for a value its items lack (the panel reads it on every redraw)."""
+    number = settings.get("behaviour", behaviour_number(POINT))
+    return next((item[0] for item in behaviour_items(settings, context) if item[3] == number), "")
+
+
 def behaviour_kind(context, behaviour):
     """The kind (behaviours.TARGET or INTENSITY) of `behaviour` in the selected agent; its known kind, or
     None, when the agent cannot be loaded or lacks it."""

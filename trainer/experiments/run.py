@@ -190,7 +190,8 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     trainer = Trainer(agent, session.env, session.train_clips, train_config, settings.behaviour, settings.seed,
                       references=session.references, epochs=epochs)
     if not select_clips(session.test_clips, trainer.trained):
-        print(f"note: the library has no held-out {settings.behaviour} clips (split \"test\"): the run is scored on "
+        held_out = " or ".join(behaviours.key(b) for b in trainer.trained)
+        print(f"note: the library has no held-out {held_out} clips (split \"test\"): the run is scored on "
               "training clips only. Mark some clips \"split\": \"test\" in the manifest to measure unseen requests.",
               file=sys.stderr)
     if saved is not None:
