@@ -38,9 +38,11 @@ class MotionClip:
 
 
 def library_space(clips):
-    """The ObjectiveSpace of every behaviour among labelled `clips` (an agent trained on them declares it)."""
-    return spaces.ObjectiveSpace(behaviours.ordered(behaviours.Behaviour(c.behaviour, c.behaviour_kind)
-                                                    for c in clips))
+    """The ObjectiveSpace of every behaviour among labelled `clips` (an agent trained on them declares it):
+    the paper's (point and wave, Table 2's codes) for clips of point or wave alone, so that a one-behaviour
+    run labels its behaviour as the paper does and its agent plays beside the others."""
+    declared = behaviours.ordered(behaviours.Behaviour(c.behaviour, c.behaviour_kind) for c in clips)
+    return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 
 @dataclass
