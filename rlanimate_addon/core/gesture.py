@@ -158,8 +158,8 @@ def build_objectives(space, behaviour, arm, frame_count, *, targets=None, rest_h
     check_length(frame_count)
     if space.kind(behaviour) == behaviours.TARGET:
         if targets is None:
-            raise RLAnimateError(f"{behaviour.title()} needs a target: pick a target object, or tick "
-                                 f"'Use 3D Cursor'.")
+            raise RLAnimateError(f"{behaviours.title(behaviour)} needs a target: pick a target object, or tick "
+                                 "'Use 3D Cursor'.")
         attributes = pointing_directions(arm, targets, rest_heads)
     else:
         attributes = exaggeration
