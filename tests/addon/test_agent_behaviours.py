@@ -7,9 +7,9 @@ import bpy
 import declared_agents
 import numpy as np
 import pytest
-from test_registration import _draw
+from test_registration import RecordingLayout, _draw
 
-from rlanimate_addon.blender import gestures, properties
+from rlanimate_addon.blender import gestures, preferences, properties
 
 ADDED = [("BECKON", "target"), ("RAISE_HAND", "intensity")]
 
@@ -51,6 +51,19 @@ def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survi
     settings.behaviour = "WAVE"
     preferences.agent_path = ""
     assert settings.behaviour == "WAVE", "Point and Wave keep their values across agents"
+
+
+def test_preferences_name_the_chosen_agents_behaviours(four):
+    settings, path = four
+
+    def labels():
+        layout = RecordingLayout()
+        preferences.RLANIMATE_AP_preferences.draw(type("PreferencesStandIn", (), {"layout": layout})(), bpy.context)
+        return [call[1].get("text", "") for call in layout.calls if call[0] == "label"]
+
+    assert "Behaviours: Point, Wave" in labels()
+    addon_helpers.addon_preferences().agent_path = str(path)
+    assert "Behaviours: Point, Wave, Beckon, Raise Hand" in labels()
 
 
 def test_the_panel_shows_target_for_a_target_behaviour_and_exaggeration_for_an_intensity_one(four):
