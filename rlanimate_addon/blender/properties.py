@@ -64,7 +64,8 @@ _NUMBERS = {POINT: 0, WAVE: 1}
 
 
 def behaviour_number(behaviour):
-    """The enum number of a behaviour id: stable across agents, and never another id's."""
+    """The enum number of a behaviour id, the same in every agent: POINT 0, WAVE 1, another id a crc32 of it
+    (two ids of one agent sharing one: about 1 in 10^9)."""
     return _NUMBERS.get(behaviour, 2 + zlib.crc32(behaviour.encode()) % (2 ** 30))
 
 
