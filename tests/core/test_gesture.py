@@ -149,7 +149,8 @@ def test_a_point_shorter_than_the_agents_average_is_its_average_point_played_fas
     for frames, steps in ((30, average), (average, average), (70, 70)):
         gesture.run_agent(agent, "POINT", spaces.PAPER_SPACE.make_objective("POINT", "RIGHT", [0.0, -1.0, 0.0], frames))
         assert len(agent.calls[-1][0]) == steps
-    assert gesture.rollout_length(30, average, "WAVE") == 30, "a quick wave is the agent's own"
+    assert gesture.rollout_length(30, average, "intensity") == 30, "a quick wave is the agent's own"
+    assert gesture.rollout_length(30, average, "target") == average, "as is any target behaviour's"
 
 
 def _animated(rig, frames, scale=0.3):
