@@ -59,7 +59,7 @@ def main():
     parser.add_argument("--no-write", action="store_true", help="print the section only")
     args = parser.parse_args()
     agent = runtime.load_agent(ROOT / "rlanimate_addon" / "agents" / "default.npz")
-    objectives = gesture.build_objectives("POINT", "RIGHT", FRAMES, targets=np.tile([-1.2, -2.5, 1.7], (FRAMES, 1)),
+    objectives = gesture.build_objectives(agent.space, "POINT", "RIGHT", FRAMES, targets=np.tile([-1.2, -2.5, 1.7], (FRAMES, 1)),
                                           rest_heads=gesture.canonical_rig().rest_heads)
     agent.rollout(objectives)
     blas = [i for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas"]

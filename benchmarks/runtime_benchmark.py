@@ -74,7 +74,7 @@ def measure():
             average = int(round(runtime.average_frames["POINT"]))
             for scale in LENGTH_SCALES:
                 frames = max(2, int(round(scale * average)))
-                objectives = spaces.make_objective("POINT", "RIGHT", [-0.3, -0.9, 0.2], frames)
+                objectives = spaces.PAPER_SPACE.make_objective("POINT", "RIGHT", [-0.3, -0.9, 0.2], frames)
                 cases.append((label, frames, torch_agent is not None))
                 runs.append(lambda r=runtime, o=objectives: r.rollout(o))
                 runs.append(lambda r=runtime, o=objectives: r.rollout(o, seed=1))

@@ -54,9 +54,9 @@ def synthetic_buffer(rng):
         kind = ("random target", "random target", "random target", "pointing clip", "wave clip")[k % 5]
         arm = skeleton.ARMS[k % 2]
         if kind == "wave clip":
-            objective = spaces.make_objective("WAVE", arm, rng.random(), frames)
+            objective = spaces.PAPER_SPACE.make_objective("WAVE", arm, rng.random(), frames)
         else:
-            objective = spaces.make_objective("POINT", arm, rng.normal(size=3), frames)
+            objective = spaces.PAPER_SPACE.make_objective("POINT", arm, rng.normal(size=3), frames)
         hold = np.zeros(frames)
         if kind != "wave clip":
             hold[int(0.45 * frames): int(0.73 * frames)] = 1.0

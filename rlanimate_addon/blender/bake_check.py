@@ -127,8 +127,8 @@ def _rest_matrices(obj, names):
 
 
 def verify(scene, plan):
-    """RLAnimateError when the baked plan does not play: the deformed hand or finger off the plan, or a
-    Point target that moves with the gesture. plan: generate._Plan after its write."""
+    """RLAnimateError when the baked plan does not play: the deformed hand or finger off the plan, or the
+    target of a target behaviour (Point) that moves with the gesture. plan: generate._Plan after its write."""
     obj, rig, arm = plan.obj, plan.rig, plan.settings.arm
     pose = bake_measure.planned_pose(rig, arm, plan.bones, plan.keyed)  # (N, B, 4, 4)
     planned = bake_measure.planned_points(rig, arm, pose)  # (N, 3, 3)
@@ -155,7 +155,8 @@ def verify(scene, plan):
 
 
 def _check_target(obj, plan, frame, sampled, scale):
-    """RLAnimateError when the Point target, evaluated at frame after the bake, left where it was read."""
+    """RLAnimateError when the target (of Point or another target behaviour), evaluated at frame after the
+    bake, left where it was read."""
     now = armature_io.target_point(obj, plan.target, plan.target_bone, bpy.context.scene)
     moved = float(np.linalg.norm(now - sampled)) * scale
     if moved > bake_measure.HAND_TOLERANCE:

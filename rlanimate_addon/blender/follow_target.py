@@ -1,8 +1,8 @@
 """Follow Target: while Scene.rlanimate.follow_target is on, moving the target of an armature's last
-Point gesture re-bakes that gesture, so a dragged empty has the arm following it.
+gesture of a target behaviour (Point) re-bakes that gesture, so a dragged empty has the arm following it.
 
 A depsgraph_update_post handler (persistent, so it outlives a file load) looks, after each update
-that touched an object, whether the target of an armature's last Point gesture (blender/gestures.py)
+that touched an object, whether the target of an armature's last target gesture (blender/gestures.py)
 now sits elsewhere than the gesture aimed at on the current frame, and re-bakes the gesture from its
 recorded settings, replacing it in place. Re-bakes are throttled: one runs at once, later moves
 within THROTTLE seconds wait for a timer that re-bakes once for the last position. A gesture whose
@@ -51,11 +51,11 @@ def _stop(gesture, why):
 
 
 def follow(scene, moved=None):
-    """Re-bake every armature's last Point gesture whose target moved (`moved`: the objects an update
+    """Re-bake every armature's last target gesture whose target moved (`moved`: the objects an update
     touched, None for any); returns the armatures re-baked."""
     rebaked = []
     for obj in [o for o in scene.objects if o.type == "ARMATURE"]:
-        gesture = gestures.last_point(obj)
+        gesture = gestures.last_targeted(obj)
         if gesture is None or gesture.record["note"]:
             continue
         target = _gesture_settings(gesture.record).target
@@ -105,8 +105,8 @@ def _on_update(scene, depsgraph):
 
 
 def note(obj):
-    """Why Follow Target stopped for the armature's last Point gesture, or ""."""
-    gesture = None if obj is None or obj.type != "ARMATURE" else gestures.last_point(obj)
+    """Why Follow Target stopped for the armature's last target gesture, or ""."""
+    gesture = None if obj is None or obj.type != "ARMATURE" else gestures.last_targeted(obj)
     return "" if gesture is None else gesture.record["note"]
 
 

@@ -2,18 +2,25 @@
 import bpy
 import numpy as np
 
-from ..core import blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
+from ..core import behaviours, blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
 from ..core import rigify as rig_rigify
 from ..core.errors import RLAnimateError
 from . import action_adapter, armature_io, bake_check, constraints, gestures, preferences, properties, rigify
 
 
-def _check_target(settings):
-    """RLAnimateError when Point has no target, or a target bone its target armature lacks."""
-    if settings.behaviour != "POINT":
+def _check_request(settings, agent):
+    """RLAnimateError when the agent does not perform the behaviour, or a target behaviour (Point) has no
+    target, or a target bone its target armature lacks."""
+    if settings.behaviour not in agent.behaviours:
+        performs = ", ".join(behaviours.title(b) for b in agent.behaviours)
+        asked = f"no {behaviours.title(settings.behaviour)}" if settings.behaviour else "not the behaviour chosen"
+        raise RLAnimateError(f"The selected agent performs {performs}, {asked}: pick one of its behaviours in "
+                             "the panel, or choose an agent trained for it in Preferences > Add-ons > RLAnimate.")
+    if agent.kind(settings.behaviour) != behaviours.TARGET:
         return
     if settings.target is None and not settings.use_cursor:
-        raise RLAnimateError("Point needs a target: pick a target object, or tick 'Use 3D Cursor'.")
+        raise RLAnimateError(f"{behaviours.title(settings.behaviour)} needs a target: pick a target object, or "
+                             "tick 'Use 3D Cursor'.")
     target, bone = settings.target, target_bone(settings)
     if bone and bone not in target.pose.bones:
         raise RLAnimateError(f"The target {target.name!r} has no bone {bone!r}: pick one of its bones, "
@@ -131,7 +138,8 @@ def _compute(context, plan, settings, agent, frames):
     with blas_threads.single_blas_thread():
         obj, scene = plan.obj, context.scene
         original_frame = scene.frame_current
-        target = settings.target if settings.behaviour == "POINT" else None
+        targeted = agent.kind(settings.behaviour) == behaviours.TARGET
+        target = settings.target if targeted else None
         bone = target_bone(settings) if target else ""
         try:
             # Read with the constraints it mutes off: the pose the gesture plays over, which Exact Aim solves on.
@@ -149,7 +157,7 @@ def _compute(context, plan, settings, agent, frames):
             if scene.frame_current != original_frame:
                 scene.frame_set(original_frame)
         request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
-                                         targets=targets if settings.behaviour == "POINT" else None,
+                                         targets=targets if targeted else None,
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
                                          exact_aim=settings.exact_aim, fps=properties.scene_fps(scene))
         plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
@@ -204,7 +212,7 @@ def bake(context, requests, progress=lambda step: None, mute_constraints=False):
     for plan in plans:
         gesture.check_length(int(plan.settings.frame_count))
         check_frames(int(plan.settings.start_frame), int(plan.settings.frame_count))
-        _check_target(plan.settings)
+        _check_request(plan.settings, agent)
     progress(1)
     for plan in plans:
         start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
@@ -239,14 +247,15 @@ def _write(plan, agent, scene):
     settings = plan.settings
     start, count = int(settings.start_frame), int(settings.frame_count)
     end = start + count - 1
-    label = f"{settings.behaviour.title()} {settings.arm.title()}"
+    label = f"{behaviours.title(settings.behaviour)} {settings.arm.title()}"
     note = ""
     span = frame_rate.agent_frames(count, properties.scene_fps(scene))
-    steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], settings.behaviour)
+    kind = agent.kind(settings.behaviour)
+    steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], kind)
     if steps != span:
         note += f" (time-scaled from the agent's {steps}-frame gesture)"
     note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
-    if settings.behaviour == "POINT" and not settings.exact_aim:
+    if settings.behaviour == behaviours.POINT and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     digest = action_adapter.KeyDigest()
     if plan.previous is not None:  # its constraints' fade undone first, so the new one applies once
@@ -261,8 +270,8 @@ def _write(plan, agent, scene):
     if plan.ik_share is not None:
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
     influence_before = constraints.mute(plan.obj, plan.overriding, start, end)
-    gestures.record(action, gestures.snapshot(settings), start, end, plan.under, plan.targets, digest.hexdigest(),
-                    influence_before, plan.rig.animated)
+    gestures.record(action, gestures.snapshot(settings), kind, start, end, plan.under, plan.targets,
+                    digest.hexdigest(), influence_before, plan.rig.animated)
     muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
     editable = ""
@@ -274,7 +283,7 @@ def _write(plan, agent, scene):
 
 
 class RLANIMATE_OT_generate_gesture(bpy.types.Operator):
-    """Bake a pointing or waving gesture onto the selected armatures with the RLAnimate agent"""
+    """Bake the chosen behaviour's gesture onto the selected armatures with the RLAnimate agent"""
     bl_idname = "rlanimate.generate_gesture"
     bl_label = "Generate Gesture"
     bl_options = {"REGISTER", "UNDO"}

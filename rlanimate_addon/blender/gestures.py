@@ -13,7 +13,7 @@ import contextlib
 import bpy
 import numpy as np
 
-from ..core.behaviours import POINT
+from ..core.behaviours import KNOWN_KINDS, TARGET
 from . import action_adapter, armature_io
 
 #: The custom property of a gesture's action that holds its record.
@@ -58,9 +58,10 @@ def overlapping(obj, arm, start, end):
                  if g.record["arm"] == arm and g.record["start"] <= end and start <= g.record["end"]), None)
 
 
-def last_point(obj):
-    """The armature's topmost Point gesture, or None."""
-    return next((g for g in placed_gestures(obj) if g.record["behaviour"] == POINT), None)
+def last_targeted(obj):
+    """The armature's topmost gesture of a target behaviour (Point), or None."""
+    return next((g for g in placed_gestures(obj)
+                 if g.record.get("kind", KNOWN_KINDS.get(g.record["behaviour"])) == TARGET), None)
 
 
 @contextlib.contextmanager
@@ -148,14 +149,16 @@ class Backup:
         bpy.data.actions.remove(self.copy)
 
 
-def record(action, settings, start, end, under, aimed_at, keys, influence_before=None, animated=True):
-    """Write the action's record: settings (a mapping of Scene.rlanimate's names to values), under
+def record(action, settings, kind, start, end, under, aimed_at, keys, influence_before=None, animated=True):
+    """Write the action's record: settings (a mapping of Scene.rlanimate's names to values), kind (the
+    behaviour's, behaviours.TARGET or INTENSITY), under
     ({bone: channel values} of bones that stand still underneath), aimed_at ((N, 3) armature-space
     targets per frame, or None), keys (the hex KeyDigest of the keys written), influence_before
     ({influence path: values per frame} of the constraints it muted, before it muted them:
     constraints.mute), animated (whether it was baked over animation, not on a still rig)."""
     action[RECORD] = {
-        "behaviour": settings["behaviour"], "arm": settings["arm"], "start": int(start), "end": int(end),
+        "behaviour": settings["behaviour"], "kind": kind, "arm": settings["arm"], "start": int(start),
+        "end": int(end),
         "settings": settings, "under": {bone: list(map(float, values)) for bone, values in under.items()},
         "aimed_at": [] if aimed_at is None else np.asarray(aimed_at, dtype=np.float64).ravel().tolist(),
         "keys": keys, "note": "", "animated": bool(animated), "influence_before": [{"path": path, "values": list(map(float, values))}

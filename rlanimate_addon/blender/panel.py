@@ -3,7 +3,7 @@ import os
 
 import bpy
 
-from ..core import frame_rate, gesture
+from ..core import behaviours, frame_rate, gesture
 from ..core.errors import RLAnimateError
 from . import armature_io, constraints, follow_target, preferences, properties, vrm_map
 
@@ -14,22 +14,26 @@ def _agent_summary(context, behaviour):
     path = preferences.selected_agent_path(context)
     name = "Bundled default" if path == preferences.BUNDLED_AGENT else path.name
     try:
-        average = preferences.selected_agent(context).average_frames[behaviour]
+        agent = preferences.selected_agent(context)
     except RLAnimateError as error:
         return name, str(error)
+    if behaviour not in agent.behaviours:
+        return name, (f"The chosen behaviour is not one of this agent's ("
+                      f"{', '.join(behaviours.title(b) for b in agent.behaviours)}): pick one above.")
+    average = agent.average_frames[behaviour]
     fps = properties.scene_fps(context.scene)
     average, shortest, longest = (frame_rate.scene_frames(n, fps)
                                   for n in (average, *gesture.supported_length_range(average)))
     return f"{name}: learned {average} frames, supported {shortest}-{longest}", None
 
 
-def _overriding_constraints(context, settings):
+def _overriding_constraints(context, settings, behaviour):
     """Constraints of the active armature that would override the gesture (empty for other objects)."""
     obj = context.active_object
     if obj is None or obj.type != "ARMATURE":
         return []
     return constraints.against_gesture(obj, constraints.driven_bones(_rig_roles(obj, settings.bone_map_file),
-                                                                     settings.behaviour, settings.arm))
+                                                                     behaviour, settings.arm))
 
 
 _roles = {}
@@ -79,14 +83,17 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             layout.prop(obj.rlanimate, "use_own_settings", text=f"Own Settings for {obj.name}")
         layout.prop(settings, "behaviour", expand=True)
         layout.prop(settings, "arm", expand=True)
-        if settings.behaviour == "POINT":
+        behaviour = properties.chosen_behaviour(settings, context)
+        kind = properties.behaviour_kind(context, behaviour)
+        if kind == behaviours.TARGET:
             layout.prop(settings, "target")
             if settings.target is None:
                 layout.prop(settings, "use_cursor")
             elif settings.target.type == "ARMATURE":
                 layout.prop_search(settings, "target_bone", settings.target.data, "bones")
-            layout.prop(settings, "exact_aim")
-        else:
+            if behaviour == behaviours.POINT:
+                layout.prop(settings, "exact_aim")
+        elif kind == behaviours.INTENSITY:
             layout.prop(settings, "exaggeration", slider=True)
 
         column = layout.column(align=True)
@@ -116,14 +123,14 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
             if obj.rlanimate.vrm_file:
                 row.prop(obj.rlanimate, "vrm_file", text="")
 
-        label, error = _agent_summary(context, settings.behaviour)
+        label, error = _agent_summary(context, behaviour)
         box = layout.box()
         box.label(text=label, icon="INFO")
         if error:
             box.label(text=error, icon="ERROR")
 
         layout.operator("rlanimate.generate_gesture", icon="ARMATURE_DATA")
-        overriding = _overriding_constraints(context, settings)
+        overriding = _overriding_constraints(context, settings, behaviour)
         if overriding:
             box = layout.box()
             box.label(text=f"{constraints.describe(overriding)} would override the gesture", icon="ERROR")

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import bpy
 
+from ..core import behaviours
 from ..core.errors import RLAnimateError
 
 _PARTS = __package__.split(".")
@@ -29,6 +30,12 @@ class RLANIMATE_AP_preferences(bpy.types.AddonPreferences):
     def draw(self, context):
         self.layout.prop(self, "agent_path")
         self.layout.label(text="Empty: the bundled default agent.", icon="INFO")
+        try:
+            performs = ", ".join(behaviours.title(b) for b in selected_agent(context).behaviours)
+        except RLAnimateError as error:
+            self.layout.label(text=str(error), icon="ERROR")
+        else:
+            self.layout.label(text=f"Behaviours: {performs}", icon="ARMATURE_DATA")
 
 
 def selected_agent_path(context):

@@ -1,12 +1,15 @@
 """`Scene.rlanimate`: the gesture settings the panel shows and Generate Gesture reads.
 
 The names behaviour, arm, target, exaggeration, frame_count, start_frame, seed and exact_aim are a
-contract that outside tools and checks use: keep them.
+contract that outside tools and checks use: keep them. `behaviour` lists the selected agent's behaviours
+(`behaviour_items`): its values are their ids, "POINT" and "WAVE" for those.
 """
+import zlib
+
 import bpy
 
-from ..core import frame_rate
-from ..core.behaviours import POINT, WAVE
+from ..core import behaviours, frame_rate
+from ..core.behaviours import INTENSITY, KNOWN_KINDS, POINT, TARGET, WAVE
 from ..core.errors import RLAnimateError
 from . import preferences
 
@@ -52,11 +55,64 @@ def _set_frame_count(settings, value):
     settings["frame_count"] = min(max(int(value), length.hard_min), length.hard_max)
 
 
+#: Tooltips of the paper's pair; another behaviour's says what its kind asks for.
+_DESCRIPTIONS = {POINT: "Point the index finger at the target", WAVE: "Wave the hand; exaggeration sets its size"}
+_KIND_DESCRIPTIONS = {TARGET: "{name}, toward the target", INTENSITY: "{name}; exaggeration sets how much"}
+#: The enum numbers of the paper's pair; another behaviour's is a hash of its id, so that a stored choice
+#: names the same behaviour whichever agent is selected (Blender stores an enum's number).
+_NUMBERS = {POINT: 0, WAVE: 1}
+
+
+def behaviour_number(behaviour):
+    """The enum number of a behaviour id, the same in every agent: POINT 0, WAVE 1, another id a crc32 of it
+    (two ids of one agent sharing one: about 1 in 10^9)."""
+    return _NUMBERS.get(behaviour, 2 + zlib.crc32(behaviour.encode()) % (2 ** 30))
+
+
+_items = {}
+
+
+def behaviour_items(settings, context):
+    """The `behaviour` enum's items: the selected agent's behaviours (point and wave when it cannot be
+    loaded; the panel says why). The list is kept here, per set of behaviours: Blender reads the strings
+    after this returns, and crashes or shows garbage if Python has freed them (the bpy.props.EnumProperty
+    documentation's known bug with item callbacks)."""
+    try:
+        agent = preferences.selected_agent(context or bpy.context)
+        declared = tuple((name, agent.kind(name)) for name in agent.behaviours)
+    except RLAnimateError:
+        declared = tuple(KNOWN_KINDS.items())
+    if declared not in _items:
+        _items[declared] = [(name, behaviours.title(name),
+                             _DESCRIPTIONS.get(name) or _KIND_DESCRIPTIONS[kind].format(name=behaviours.title(name)),
+                             behaviour_number(name)) for name, kind in declared]
+    return _items[declared]
+
+
+def chosen_behaviour(settings, context):
+    """The id of the settings' behaviour among the selected agent's, or "" when the stored choice is none of
+    them (another agent's): read from the stored enum number, as `settings.behaviour` would, without the
+    warning Blender prints for a value its items lack (the panel reads it on every redraw)."""
+    number = settings.get("behaviour", behaviour_number(POINT))
+    return next((item[0] for item in behaviour_items(settings, context) if item[3] == number), "")
+
+
+def behaviour_kind(context, behaviour):
+    """The kind (behaviours.TARGET or INTENSITY) of `behaviour` in the selected agent; its known kind, or
+    None, when the agent cannot be loaded or lacks it."""
+    try:
+        agent = preferences.selected_agent(context)
+        if behaviour in agent.behaviours:
+            return agent.kind(behaviour)
+    except RLAnimateError:
+        pass
+    return KNOWN_KINDS.get(behaviour)
+
+
 class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     behaviour: bpy.props.EnumProperty(
-        name="Behaviour", default=POINT,
-        items=[(POINT, "Point", "Point the index finger at the target"),
-               (WAVE, "Wave", "Wave the hand; exaggeration sets its size")])
+        name="Behaviour", default=behaviour_number(POINT), items=behaviour_items,
+        description="The gesture: one of the selected agent's behaviours")
     arm: bpy.props.EnumProperty(
         name="Arm", default="RIGHT",
         items=[("LEFT", "Left", "The character's left arm"), ("RIGHT", "Right", "The character's right arm")])

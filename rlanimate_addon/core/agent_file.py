@@ -35,7 +35,11 @@ except ImportError:  # a Python built without lzma, whose zipfile cannot inflate
 FORMAT_NAME = "rlanimate-agent"
 #: 2: waves' objectives carry their rhythm (core/rhythm.py) and the file its `wave_rhythm` model.
 #: 3: that model holds the training waves' rhythms, not a line through them.
-FORMAT_VERSION = 3
+#: 4: the file declares its behaviours (`behaviours`: name and kind each), which lay out its objective
+#:    (core/spaces.py); a version 3 file holds point and wave, and still loads as them.
+FORMAT_VERSION = 4
+#: Versions still read, as FORMAT_VERSION with the defaults it adds.
+_READ_VERSIONS = (3, FORMAT_VERSION)
 #: Older versions, and why this add-on cannot play them.
 _RETIRED_VERSIONS = {1: "from before waves carried their rhythm in the objective",
                      2: "whose wave rhythm is a line through the training waves, not the waves themselves"}
@@ -47,6 +51,8 @@ INITIAL_ACTION = 0.5
 #: Metadata fields every agent file has.
 REQUIRED_METADATA = ("format", "format_version", "variant", "agent_config", "action_bounds", "average_frames",
                      "wave_rhythm")
+#: ... and those every file of FORMAT_VERSION has besides.
+REQUIRED_SINCE_4 = ("behaviours",)
 _AGENT_SIZES = ("task_size", "behaviour_size", "stochastic_size", "hidden_size", "portrayal_hidden_size",
                 "hidden_layers")
 _AGENT_SCALARS = ("min_std", "concentration_floor", "concentration_scale")
@@ -79,13 +85,14 @@ def gru_shapes(name, inputs, size, suffix=""):
             f"{name}.bias_ih{suffix}": (3 * size,), f"{name}.bias_hh{suffix}": (3 * size,)}
 
 
-def expected_weight_shapes(agent_config, variant):
-    """{array name: shape} of an agent with `agent_config` (a dict of AgentConfig fields) and `variant`."""
+def expected_weight_shapes(agent_config, variant, objective_size):
+    """{array name: shape} of an agent with `agent_config` (a dict of AgentConfig fields), `variant` and
+    objectives of `objective_size` (its ObjectiveSpace's size)."""
     if variant not in VARIANTS:
         raise RLAnimateError(f"Unknown agent variant {variant!r}: the file must name one of "
                              f"{', '.join(VARIANTS)}.")
     c = agent_config
-    O, D, A = spaces.OBJECTIVE_SIZE, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
+    O, D, A = objective_size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
     E, Z, hid, n = c["behaviour_size"], c["stochastic_size"], c["hidden_size"], c["hidden_layers"]
     task = c["task_size"] if uses_task_state(variant) else O  # what f2 and the heads see of the task
     head_inputs = (c["task_size"] if uses_task_state(variant) else 0) + E + Z
@@ -102,8 +109,18 @@ def expected_weight_shapes(agent_config, variant):
     return shapes
 
 
+def objective_space(metadata):
+    """The ObjectiveSpace of a loaded file's metadata: its declared behaviours, or point and wave for a
+    version 3 file (which declares none)."""
+    if metadata["format_version"] == 3:
+        return spaces.PAPER_SPACE
+    return spaces.ObjectiveSpace(tuple(behaviours.Behaviour(b["name"], b["kind"]) for b in metadata["behaviours"]))
+
+
 def load_agent_file(path):
     """(weights {name: float array}, metadata dict) from the agent file at `path`, fully validated.
+
+    A version 3 file declares no behaviours: it holds point and wave (`objective_space`).
 
     Nothing is allocated or inflated before its declared size is checked: the metadata against
     MAX_METADATA_BYTES, each weight array's npy header against the shape the metadata implies. Every
@@ -309,11 +326,11 @@ def _parse_metadata(path, entry):
         raise RLAnimateError(f"The agent file {path} is format version {version}, {_RETIRED_VERSIONS[version]}; "
                              f"this add-on reads version {FORMAT_VERSION}: retrain the agent with this version's "
                              f"trainer (python trainer/train.py).")
-    if not _is_int(version) or version != FORMAT_VERSION:
+    if not _is_int(version) or version not in _READ_VERSIONS:
         raise RLAnimateError(f"The agent file {path} is format version {version!r}, but "
                              f"this add-on reads version {FORMAT_VERSION}: update the add-on, or re-export "
                              f"the agent with this version's trainer.")
-    missing = [key for key in REQUIRED_METADATA if key not in metadata]
+    missing = [key for key in REQUIRED_METADATA + (REQUIRED_SINCE_4 if version >= 4 else ()) if key not in metadata]
     if missing:
         raise RLAnimateError(f"The agent file {path} lacks metadata {', '.join(missing)}: re-export it with "
                              f"trainer/agent/agent_export.py.")
@@ -371,7 +388,8 @@ def _check_metadata_values(path, metadata):
     if not isinstance(metadata["variant"], str):
         raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
                              f"{', '.join(VARIANTS)}.")
-    expected = expected_weight_shapes(config, metadata["variant"])
+    space = _checked_space(path, metadata)
+    expected = expected_weight_shapes(config, metadata["variant"], space.size)
     parameters = sum(math.prod(shape) for shape in expected.values())
     if parameters > MAX_PARAMETERS:
         raise RLAnimateError(f"The agent file {path} describes an agent of {parameters:,} parameters, more than "
@@ -385,11 +403,11 @@ def _check_metadata_values(path, metadata):
                              f"re-export it with trainer/agent/agent_export.py.")
     frames = metadata["average_frames"]
     if not isinstance(frames, dict) or not frames or any(
-            b not in behaviours.BEHAVIOURS or not _is_number(n) or not 2 <= n <= MAX_AVERAGE_FRAMES
+            b not in space.names or not _is_number(n) or not 2 <= n <= MAX_AVERAGE_FRAMES
             for b, n in frames.items()):
         raise RLAnimateError(f"The agent file {path} has invalid average_frames (need a length of 2 to "
                              f"{MAX_AVERAGE_FRAMES:,} frames for each behaviour it was trained for, among "
-                             f"{', '.join(behaviours.BEHAVIOURS)}): re-export it.")
+                             f"{', '.join(space.names)}): re-export it.")
     if metadata["wave_rhythm"] is not None:
         largest = _largest_number(metadata["wave_rhythm"])
         if not largest <= MAX_RHYTHM_VALUE:
@@ -398,6 +416,31 @@ def _check_metadata_values(path, metadata):
                                  f"gesture are small numbers): re-export it with trainer/agent/agent_export.py.")
         rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
     return {name: tuple(shape) for name, shape in expected.items()}
+
+
+def _checked_space(path, metadata):
+    """The ObjectiveSpace of the metadata: point and wave in version 3, else its `behaviours`, a list of
+    {"name", "kind"}, 1 to MAX_BEHAVIOURS of them, in objective order (behaviours.ordered), each name once."""
+    if metadata["format_version"] == 3:
+        return spaces.PAPER_SPACE
+    declared, problem = metadata["behaviours"], None
+    if not isinstance(declared, list) or not 0 < len(declared) <= behaviours.MAX_BEHAVIOURS or any(
+            not isinstance(b, dict) or set(b) != {"name", "kind"} or not all(isinstance(v, str) for v in b.values())
+            for b in declared):
+        problem = (f"need a list of 1 to {behaviours.MAX_BEHAVIOURS} behaviours, each "
+                   f'{{"name": ..., "kind": "{behaviours.TARGET}" or "{behaviours.INTENSITY}"}}')
+    else:
+        try:
+            space = spaces.ObjectiveSpace(tuple(behaviours.Behaviour(b["name"], b["kind"]) for b in declared))
+        except RLAnimateError as error:
+            problem = str(error)
+        else:
+            if space.behaviours != behaviours.ordered(space.behaviours):
+                problem = "they are not in objective order (point, wave, then the others by name)"
+    if problem:
+        raise RLAnimateError(f"The agent file {path} declares invalid behaviours ({problem}): re-export it with "
+                             f"trainer/agent/agent_export.py.")
+    return space
 
 
 def _read_weights(path, archive, entries, expected):

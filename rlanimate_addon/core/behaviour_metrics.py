@@ -303,28 +303,42 @@ def wave_accepted(comparison):
                 and comparison["generated"]["cycles"] >= WAVE_MIN_CYCLES)
 
 
+def wave_row(generated, reference, arm, target, fps):
+    """WAVE's measures (`compare_wave` and `wave_accepted`) of descriptions (F, 42), as a flat dict."""
+    waves = compare_wave(spaces.description_joint_positions(generated), spaces.description_joint_positions(reference),
+                         arm, fps)
+    result = {k: v for k, v in waves.items() if k.endswith("_ratio")}
+    result.update({f"{k}": float(v) for k, v in waves["generated"].items()})
+    result.update({f"reference_{k}": float(v) for k, v in waves["reference"].items()})
+    result["wave_accepted"] = float(wave_accepted(waves))
+    return result
+
+
+def point_row(generated, reference, arm, target, fps):
+    """POINT's measures (`point_measures` of both, target (3,) in the character frame) as a flat dict."""
+    if target is None:
+        raise RLAnimateError("Pointing measures need the target position (x, y, z).")
+    point, reference_point = (point_measures(spaces.description_joint_positions(d), finger_direction(d, arm), arm,
+                                             target, fps) for d in (generated, reference))
+    return {"pointing_angle": point["angle"], "hold_s": point["hold_s"],
+            "reference_pointing_angle": reference_point["angle"], "reference_hold_s": reference_point["hold_s"],
+            "hold_ratio": ratio(point["hold_s"], reference_point["hold_s"])}
+
+
+#: Each behaviour's own measures, by id: measure(generated, reference, arm, target, fps) -> {name: float}
+#: from descriptions (F, 42) of a generated clip and its reference (target: (3,) in the character frame
+#: for a target behaviour, else None). A behaviour without an entry is measured by raise and lower alone;
+#: a new behaviour's metrics plug in here.
+MEASURES = {"WAVE": wave_row, "POINT": point_row}
+
+
 def compare(generated, reference, behaviour, arm, target=None, fps=FPS):
     """The behaviour measures of one request, from descriptions (F, 42) of the generated clip and of
-    its reference (lengths may differ): raise and lower, and for WAVE `compare_wave`, for POINT
-    `point_measures` of both (target: (3,) in the character frame). A flat dict of floats."""
+    its reference (lengths may differ): raise and lower, and the behaviour's own MEASURES. A flat dict
+    of floats."""
     gen, ref = np.asarray(generated), np.asarray(reference)
     gen_positions, ref_positions = spaces.description_joint_positions(gen), spaces.description_joint_positions(ref)
     result = {f"elevation_{k}": v for k, v in raise_lower(gen_positions, ref_positions, arm).items()}
-    if behaviour == "WAVE":
-        waves = compare_wave(gen_positions, ref_positions, arm, fps)
-        result.update({k: v for k, v in waves.items() if k.endswith("_ratio")})
-        result.update({f"{k}": float(v) for k, v in waves["generated"].items()})
-        result.update({f"reference_{k}": float(v) for k, v in waves["reference"].items()})
-        result["wave_accepted"] = float(wave_accepted(waves))
-    elif behaviour == "POINT":
-        if target is None:
-            raise RLAnimateError("Pointing measures need the target position (x, y, z).")
-        point = point_measures(gen_positions, finger_direction(gen, arm), arm, target, fps)
-        reference_point = point_measures(ref_positions, finger_direction(ref, arm), arm, target, fps)
-        result.update({"pointing_angle": point["angle"], "hold_s": point["hold_s"],
-                       "reference_pointing_angle": reference_point["angle"],
-                       "reference_hold_s": reference_point["hold_s"],
-                       "hold_ratio": ratio(point["hold_s"], reference_point["hold_s"])})
-    else:
-        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use POINT or WAVE.")
+    if behaviour in MEASURES:
+        result.update(MEASURES[behaviour](gen, ref, arm, target, fps))
     return result

@@ -1,23 +1,35 @@
-"""The behaviours an agent performs, spelt one way from the clip manifest to the panel.
+"""The behaviours an agent performs: data, named by the clips and declared by the agent file.
 
-A behaviour is named by its id, POINT or WAVE: the clip manifest's `behaviour`, MotionClip.behaviour,
-GestureRequest, the agent file's per-behaviour data and the panel's Scene.rlanimate.behaviour all hold
-it. Command lines, run folders and report keys use its `key`, the id in lower case ("point"). A training
-run's `--behaviour` names a training set: one behaviour's key, or "both" (every behaviour, drawn in turn).
+A behaviour is a name and a kind:
+    target     conditioned on a direction to a target (point, "this way"): the objective's attributes
+               are the unit vector from the arm's rest shoulder to the target;
+    intensity  conditioned on an exaggeration in [0, 1] (wave, raise a hand): the attributes are the
+               exaggeration (and, for WAVE, its rhythm; core/rhythm.py).
+Its id is its name in upper case ("POINT", "THIS_WAY"): the clip manifest's `behaviour`,
+MotionClip.behaviour, GestureRequest, the agent file's declaration and Scene.rlanimate.behaviour hold
+it. Command lines, run folders and report keys use its `key`, the id in lower case ("point").
 
-The set is fixed today. To let an agent file declare its behaviours, BEHAVIOURS becomes the file's list
-(each id with its kind: a target to point at, or an intensity such as the wave's exaggeration); `parse`,
-`key` and `training_set` keep their meaning.
+PAPER is the paper's pair (Table 2): what a clip library or an agent file that declares nothing holds.
+A training run's `--behaviour` names a training set (`training_set`): "all" (every behaviour of the
+library), "both" (point and wave), one behaviour's key, or keys joined by commas ("point,beckon").
 """
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass
+
 from .errors import RLAnimateError
+
+TARGET = "target"
+INTENSITY = "intensity"
+KINDS = (TARGET, INTENSITY)
 
 POINT = "POINT"
 WAVE = "WAVE"
-#: Every behaviour, in the order of its objective type code (Table 2: point 1, wave 2).
-BEHAVIOURS = (POINT, WAVE)
 
-#: The training set of every behaviour.
-BOTH = "both"
+#: An id: a letter, then letters, digits or underscores, 32 characters at most.
+_ID = re.compile(r"[A-Z][A-Z0-9_]{0,31}")
+#: The most behaviours one agent declares (the objective's one-hot label has one entry each).
+MAX_BEHAVIOURS = 64
 
 
 def key(behaviour: str) -> str:
@@ -25,21 +37,77 @@ def key(behaviour: str) -> str:
     return behaviour.lower()
 
 
-#: A training run's --behaviour choices: {key: the behaviours it trains, in BEHAVIOURS order}.
-TRAINING_SETS = {**{key(behaviour): (behaviour,) for behaviour in BEHAVIOURS}, BOTH: BEHAVIOURS}
+def title(behaviour: str) -> str:
+    """The behaviour's name as the panel and the gesture's track show it ("THIS_WAY" -> "This Way")."""
+    return behaviour.replace("_", " ").title()
 
 
 def parse(name: str) -> str:
-    """The id of a behaviour written either way ("point" or "POINT"), as a manifest or a user gives it;
-    RLAnimateError naming the choices for anything else."""
+    """The id of a behaviour name written in either case ("this_way" -> "THIS_WAY"); RLAnimateError for a
+    name that is not a letter followed by letters, digits or underscores (32 at most)."""
     behaviour = str(name).upper()
-    if behaviour not in BEHAVIOURS:
-        raise RLAnimateError(f"Unknown behaviour {name!r}: use {' or '.join(BEHAVIOURS)}.")
+    if not isinstance(name, str) or not _ID.fullmatch(behaviour):
+        raise RLAnimateError(f"{name!r} is not a behaviour name: use a letter followed by letters, digits or "
+                             f"underscores, 32 at most (such as POINT, WAVE or THIS_WAY).")
     return behaviour
 
 
-def training_set(name: str) -> tuple[str, ...]:
-    """The behaviours the training set `name` ("point", "wave" or "both") trains; RLAnimateError otherwise."""
-    if name not in TRAINING_SETS:
-        raise RLAnimateError(f"Unknown behaviour {name!r} to train: use {', '.join(TRAINING_SETS)}.")
-    return TRAINING_SETS[name]
+@dataclass(frozen=True)
+class Behaviour:
+    """A behaviour: `name` its id (upper case), `kind` TARGET or INTENSITY."""
+    name: str
+    kind: str
+
+    def __post_init__(self):
+        if parse(self.name) != self.name:
+            raise RLAnimateError(f"Behaviour {self.name!r} must be named in upper case: {parse(self.name)}.")
+        if self.kind not in KINDS:
+            raise RLAnimateError(f"Behaviour {self.name} has the kind {self.kind!r}: use {' or '.join(KINDS)}.")
+
+    @property
+    def key(self) -> str:
+        return key(self.name)
+
+    def to_dict(self) -> dict:
+        return {"name": self.name, "kind": self.kind}
+
+
+#: The paper's pair, in the order of Table 2's type codes (point 1, wave 2).
+PAPER = (Behaviour(POINT, TARGET), Behaviour(WAVE, INTENSITY))
+#: The kind of each behaviour whose kind a manifest need not give.
+KNOWN_KINDS = {b.name: b.kind for b in PAPER}
+
+#: Training sets: every behaviour of the library, and the paper's pair.
+ALL = "all"
+BOTH = "both"
+
+
+def ordered(declared: Iterable[Behaviour]) -> tuple[Behaviour, ...]:
+    """Behaviours in their objective order: the paper's pair first, in Table 2's order, then the others by
+    name; RLAnimateError when one name has two kinds or there are more than MAX_BEHAVIOURS."""
+    kinds = {}
+    for behaviour in declared:
+        if kinds.setdefault(behaviour.name, behaviour.kind) != behaviour.kind:
+            raise RLAnimateError(f"Behaviour {behaviour.name} is given as both {kinds[behaviour.name]} and "
+                                 f"{behaviour.kind}: give every clip of one behaviour the same kind.")
+    if len(kinds) > MAX_BEHAVIOURS:
+        raise RLAnimateError(f"{len(kinds)} behaviours, more than an agent learns ({MAX_BEHAVIOURS}): "
+                             f"train fewer at once.")
+    paper = [b.name for b in PAPER if b.name in kinds]
+    return tuple(Behaviour(name, kinds[name]) for name in paper + sorted(set(kinds) - set(paper)))
+
+
+def training_set(name: str, library: Iterable[str]) -> tuple[str, ...]:
+    """The ids a training set `name` trains ("all", "both", a key or keys joined by commas), in the
+    library's order (`library`: the ids the clip library has, in objective order); RLAnimateError
+    naming the choices for a set the library cannot train."""
+    library = tuple(library)
+    if name == ALL:
+        return library
+    wanted = {POINT, WAVE} if name == BOTH else {parse(part.strip()) for part in str(name).split(",")}
+    missing = sorted(wanted - set(library))
+    if missing:
+        raise RLAnimateError(f"The clip library has no {', '.join(key(b) for b in missing)} training clips: add "
+                             f"some, or train with --behaviour set to all, or to some of "
+                             f"{', '.join(key(b) for b in library) or 'its behaviours'}.")
+    return tuple(b for b in library if b in wanted)

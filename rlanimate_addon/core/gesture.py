@@ -26,7 +26,7 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
 """
 import numpy as np
 
-from . import aim, frame_rate, rig_roles, skeleton, spaces
+from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, inverse
 from .rotations import (matrix_to_quat, matrix_to_rotvec, quat_to_matrix, quat_to_rotvec, rotvec_to_matrix,
@@ -151,17 +151,21 @@ def arm_reach(arm, rest_heads):
     return float(ratio * np.linalg.norm(np.subtract(rest_heads[prefix + "Hand"], shoulder)))
 
 
-def build_objectives(behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5, rhythm=None):
-    """(N, 7) objectives for a gesture: POINT needs targets (N, 3) and rest_heads; WAVE an exaggeration
-    and, for an agent trained with them, rhythm signals (N, 2) (GestureAgent.wave_rhythm)."""
+def build_objectives(space, behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5,
+                     rhythm=None):
+    """(N, O) objectives of the ObjectiveSpace `space` for a gesture: a target behaviour needs targets
+    (N, 3) and rest_heads; an intensity behaviour an exaggeration and, for WAVE from an agent trained with
+    them, rhythm signals (N, 2) (GestureAgent.wave_rhythm)."""
     check_length(frame_count)
-    if behaviour == "POINT":
+    if space.kind(behaviour) == behaviours.TARGET:
         if targets is None:
-            raise RLAnimateError("Point needs a target: pick a target object, or tick 'Use 3D Cursor'.")
+            raise RLAnimateError(f"{behaviours.title(behaviour)} needs a target: pick a target object, or tick "
+                                 "'Use 3D Cursor'.")
         attributes = pointing_directions(arm, targets, rest_heads)
     else:
         attributes = exaggeration
-    return spaces.make_objective(behaviour, arm, attributes, frame_count, rhythm if behaviour == "WAVE" else None)
+    return space.make_objective(behaviour, arm, attributes, frame_count,
+                                rhythm if behaviour == behaviours.WAVE else None)
 
 
 def resample(values, count):
@@ -176,28 +180,29 @@ def resample(values, count):
     return values[low] * (1.0 - frac) + values[high] * frac
 
 
-def rollout_length(frame_count, average_frames, behaviour):
+def rollout_length(frame_count, average_frames, kind):
     """Steps the agent runs for a gesture of frame_count frames: clamped into its supported range, and
-    for POINT never fewer than the agent's average. A shorter point is the average-length point played
-    faster: the agent's own quick points hold for a few frames and miss by more (docs/EXTENSION.md,
-    "Short points")."""
+    for a target behaviour (`kind`) never fewer than the agent's average. A shorter point is the
+    average-length point played faster: the agent's own quick points hold for a few frames and miss by
+    more (docs/EXTENSION.md, "Short points")."""
     shortest, longest = supported_length_range(average_frames)
-    if behaviour == "POINT":
+    if kind == behaviours.TARGET:
         shortest = max(shortest, int(round(average_frames)))
     return int(np.clip(frame_count, shortest, longest))
 
 
 def run_agent(agent, behaviour, objectives, seed=None, frame_count=None):
-    """Canonical local rotation vectors (N, 15, 3) for the objectives (M, 7) at the agent's rate.
+    """Canonical local rotation vectors (N, 15, 3) for the objectives (M, O) at the agent's rate.
 
     The agent runs for `rollout_length(M)` steps; its actions are resampled to the N = frame_count
     scene frames (M when None) when that differs (time-scaled, or played at the scene's rate).
     """
     count = len(objectives) if frame_count is None else int(frame_count)
-    steps = rollout_length(len(objectives), agent.average_frames[behaviour], behaviour)
+    kind = agent.kind(behaviour)
+    steps = rollout_length(len(objectives), agent.average_frames[behaviour], kind)
     agent_objectives = resample(objectives, steps)
     agent_objectives[:, spaces.OBJECTIVE_TIME] = np.linspace(0.0, 1.0, steps)
-    if behaviour == "POINT":
+    if kind == behaviours.TARGET:
         attrs = agent_objectives[:, spaces.OBJECTIVE_ATTRIBUTES]
         agent_objectives[:, spaces.OBJECTIVE_ATTRIBUTES] = attrs / np.linalg.norm(attrs, axis=1, keepdims=True)
     actions = np.asarray(agent.rollout(agent_objectives, seed=seed), dtype=np.float64)  # (steps, 45)
@@ -516,18 +521,19 @@ def gesture_rotations(agent, request, rig):
     check_length(request.frame_count)
     span = request.agent_frames  # M: the gesture's seconds at the agent's rate
     rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed)
-              if request.behaviour == "WAVE" else None)
+              if request.behaviour == behaviours.WAVE else None)
     if request.targets is not None:
         check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))
     asked = None if request.targets is None else resample(
         hips_relative_targets(rig, request.targets, request.frame_count), span)  # (M, 3)
-    objectives = build_objectives(request.behaviour, request.arm, span, targets=asked,
+    objectives = build_objectives(agent.space, request.behaviour, request.arm, span, targets=asked,
                                   rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
     canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed,
                           frame_count=request.frame_count)  # (N, 15, 3)
-    phase_base = played_finger_base(canonical, request.arm) if request.behaviour == "POINT" else None
+    targeted = agent.kind(request.behaviour) == behaviours.TARGET
+    phase_base = played_finger_base(canonical, request.arm) if targeted else None
     names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
-    if request.behaviour == "POINT":
+    if request.behaviour == behaviours.POINT:
         hand_names, hand = pointing_hand_rotations(request.arm, request.frame_count)
         present = [i for i, name in enumerate(hand_names) if name in rig.roles]
         names += [hand_names[i] for i in present]
@@ -551,13 +557,13 @@ def gesture_rotations(agent, request, rig):
         start = np.where(at_rest[..., None], standing, under)
     keyed = blend_from_pose(start, retarget(canonical, conversions, parent_conversions),
                             blend_weights(request.frame_count))
-    if request.behaviour == "POINT":
+    if targeted:  # the eyes look at the target; Point's finger is aimed exactly on the rig
         phase = aim.pointing_phase(phase_base)
         targets = np.broadcast_to(request.targets, (request.frame_count, 3))
         basis = under_basis.copy()
         basis[:, columns, :3, :3] = quat_to_matrix(keyed) * np.linalg.norm(basis[:, columns, :3, :3], axis=-2,
                                                                           keepdims=True)
-        if request.exact_aim:
+        if request.exact_aim and request.behaviour == behaviours.POINT:
             arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
             aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
             keyed[:, arm_column] = matrix_to_quat(_rotation_part(aimed))

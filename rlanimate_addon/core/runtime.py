@@ -77,7 +77,8 @@ def _gru_sequence(inputs, gru):
 
 
 class GestureAgent:
-    """An exported agent ready to play: `rollout` objectives (N, 7) -> actions (N, 45) in [0, 1].
+    """An exported agent ready to play: `rollout` objectives (N, O) -> actions (N, 45) in [0, 1], O the
+    size of the objective `space` its file declares.
 
     The per-frame loop does one matrix product per input that changes in it (e_t, z_t, a_t): each
     input's weights into every layer it feeds are joined side by side at load time.
@@ -88,12 +89,14 @@ class GestureAgent:
         self.variant = metadata["variant"]
         self.action_bounds = np.asarray(metadata["action_bounds"], dtype=np.float64)  # (45, 2)
         trained = {b: float(n) for b, n in metadata["average_frames"].items()}
-        #: The behaviours the agent was trained for, in behaviours.BEHAVIOURS order.
-        self.behaviours = tuple(b for b in behaviours.BEHAVIOURS if b in trained)
-        #: Average gesture length in frames per behaviour (the UI's default length); a behaviour the
+        #: The objective space of the behaviours the file declares (core/spaces.py).
+        self.space = agent_file.objective_space(metadata)
+        #: The ids of the behaviours the agent was trained for, in objective order.
+        self.behaviours = tuple(b for b in self.space.names if b in trained)
+        #: Average gesture length in frames per declared behaviour (the UI's default length); one the
         #: agent was not trained for gets the mean of the others, so the UI always has a default.
         self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values()))))
-                               for b in behaviours.BEHAVIOURS}
+                               for b in self.space.names}
         rhythm_values = metadata.get("wave_rhythm")
         #: The training waves' rhythms (core/rhythm.py), or None for an agent trained on the paper's objective.
         self.rhythm_model = None if rhythm_values is None else rhythm.RhythmModel.from_dict(rhythm_values)
@@ -107,7 +110,7 @@ class GestureAgent:
         self._concentration_scale = float(config["concentration_scale"])
         self._uses_portrayal = agent_file.uses_portrayal(self.variant)
         self._uses_task_state = agent_file.uses_task_state(self.variant)
-        task_size = int(config["task_size"]) if self._uses_task_state else spaces.OBJECTIVE_SIZE
+        task_size = int(config["task_size"]) if self._uses_task_state else self.space.size
         if self._uses_portrayal:
             self._portrayal = _mlp_arrays(w, "portrayal", layers)
         if self._uses_task_state:
@@ -128,21 +131,24 @@ class GestureAgent:
         self._from_a = cell_a  # (A, 3E)
 
     def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None) -> np.ndarray | None:
-        """(N, 2) rhythm signals for a wave's objectives (spaces.make_objective), drawn as core/rhythm.py
+        """(N, 2) rhythm signals for a wave's objectives (ObjectiveSpace.make_objective), drawn as core/rhythm.py
         says (the training waves' mean for seed None), or None for an agent without a rhythm model."""
         if self.rhythm_model is None:
             return None
         return rhythm.signals(self.rhythm_model.draw(exaggeration, seed), frame_count)
 
+    def kind(self, behaviour: str) -> str:
+        """The kind of a declared behaviour (behaviours.TARGET or INTENSITY)."""
+        return self.space.kind(behaviour)
+
     def rollout(self, objectives: ArrayLike, seed: int | None = None) -> np.ndarray:
-        """Objectives (N, 7) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""
+        """Objectives (N, O) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""
         objectives = np.asarray(objectives, dtype=np.float64)
-        if objectives.ndim != 2 or objectives.shape[1] != spaces.OBJECTIVE_SIZE or len(objectives) == 0 \
+        if objectives.ndim != 2 or objectives.shape[1] != self.space.size or len(objectives) == 0 \
                 or not np.all(np.isfinite(objectives)):
-            raise RLAnimateError(f"The agent needs finite objectives of shape (frames, {spaces.OBJECTIVE_SIZE}), got "
+            raise RLAnimateError(f"The agent needs finite objectives of shape (frames, {self.space.size}), got "
                                  f"{objectives.shape}: give the gesture at least one frame and a valid target.")
-        untrained = set(objectives[:, spaces.OBJECTIVE_TYPE]) - {spaces.BEHAVIOUR_TYPE[b] for b in self.behaviours}
-        if untrained:
+        if self.space.behaviours_in(objectives) - set(self.behaviours):
             trained = " and ".join(behaviours.key(b) for b in self.behaviours)
             raise RLAnimateError(f"This agent was trained for {trained} "
                                  f"only: choose an agent trained for the requested behaviour in the add-on "

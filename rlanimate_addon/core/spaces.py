@@ -1,12 +1,15 @@
-"""The paper's spaces (Tables 2 and 3) as named, fixed-size numpy encodings.
+"""The paper's spaces (Tables 2 and 3) as named numpy encodings.
 
-Objective o_t (7): [type, left_arm, right_arm, attr_x, attr_y, attr_z, t/N]
-    type is 1 for point and 2 for wave (Table 2). For point, the attributes are the unit vector
-    from the pointing arm's rest shoulder joint to the target, in the character frame, so a finger
-    laid along that line from the shoulder passes through the target whatever its distance. For wave,
-    they are the exaggeration in [0, 1] and the wave's rhythm [A_t sin(phi_t), A_t cos(phi_t)]
-    (core/rhythm.py), or, for an agent trained on the paper's objective, the exaggeration three
-    times. t/N runs over 0..1 (t = 0..N-1, divided by N-1).
+Objective o_t (L + 6), laid out by an ObjectiveSpace from the agent's behaviours (core/behaviours.py):
+    [label (L), left_arm, right_arm, attr_x, attr_y, attr_z, t/N]
+    The label names the behaviour: for at most two behaviours, Table 2's type code (1 for the first,
+    2 for the second; L = 1), so point and wave give the paper's 7 numbers; for more, a one-hot over
+    them (L = N). The fields after it are addressed from the end, the same for any N. For a target
+    behaviour (point), the attributes are the unit vector from the arm's rest shoulder joint to the
+    target, in the character frame, so a finger laid along that line from the shoulder passes through
+    the target whatever its distance. For an intensity behaviour (wave), they are the exaggeration in
+    [0, 1] three times, or, for WAVE with its rhythm, the exaggeration and the wave's rhythm
+    [A_t sin(phi_t), A_t cos(phi_t)] (core/rhythm.py). t/N runs over 0..1 (t = 0..N-1, divided by N-1).
 Description d_t (42), in the character frame in metres:
     [0:12]  unit effector vectors: left eye, right eye, left index, right index (skeleton.EFFECTORS)
     [12:42] positions of skeleton.DESCRIPTION_JOINTS: collars, shoulders, elbows, wrists, index bases
@@ -23,20 +26,18 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import skeleton
-from .behaviours import BEHAVIOURS, POINT, WAVE
+from . import behaviours
+from .behaviours import INTENSITY, TARGET, WAVE, Behaviour
 from .errors import RLAnimateError
 
-OBJECTIVE_SIZE = 7
 DESCRIPTION_SIZE = 42
 ACTION_SIZE = 3 * len(skeleton.ACTION_JOINTS)
 
-#: The objective's type code of each behaviour (Table 2).
-BEHAVIOUR_TYPE = {POINT: 1.0, WAVE: 2.0}
-
-OBJECTIVE_TYPE = 0
-OBJECTIVE_ARM = slice(1, 3)
-OBJECTIVE_ATTRIBUTES = slice(3, 6)
-OBJECTIVE_TIME = 6
+#: The objective's fields after its label, the same for any number of behaviours.
+OBJECTIVE_ARM = slice(-6, -4)
+OBJECTIVE_ATTRIBUTES = slice(-4, -1)
+OBJECTIVE_TIME = -1
+_FIELDS_AFTER_LABEL = 6
 
 DESCRIPTION_EFFECTORS = slice(0, 12)
 DESCRIPTION_POSITIONS = slice(12, 42)
@@ -62,50 +63,120 @@ DEFAULT_ACTION_BOUNDS = np.array(
     [[-_joint_bound(j), _joint_bound(j)] for j in skeleton.ACTION_JOINTS for _ in range(3)])
 
 
-def check_request(behaviour: str, arm: str, frame_count: int) -> None:
-    """RLAnimateError naming what no agent or baseline can answer: an unknown behaviour or arm, or under 2 frames."""
-    if behaviour not in BEHAVIOURS:
-        raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(BEHAVIOURS)}.")
+def check_arm_and_length(arm: str, frame_count: int) -> None:
+    """RLAnimateError for an unknown arm or a gesture of under 2 frames."""
     if arm not in skeleton.ARMS:
         raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
     if int(frame_count) < 2:
         raise RLAnimateError(f"A gesture needs at least 2 frames, got {frame_count}: set a longer length.")
 
 
-def make_objective(behaviour: str, arm: str, attributes: ArrayLike, frame_count: int,
-                   rhythm: ArrayLike | None = None) -> np.ndarray:
-    """(N, 7) objectives for a gesture of `frame_count` frames.
+class ObjectiveSpace:
+    """The objective layout of an agent's behaviours (a tuple of core.behaviours.Behaviour, in objective
+    order): its size, each behaviour's label, and the objectives of a request."""
 
-    `attributes` is, for POINT, a unit vector (3,) or one per frame (N, 3), so a moving target is
-    tracked; for WAVE, the exaggeration in [0, 1] (scalar or (N,)). `rhythm` (N, 2), WAVE only: the
-    swing signals of core/rhythm.py; None gives the paper's objective (the exaggeration three times).
-    """
-    check_request(behaviour, arm, frame_count)
-    n = int(frame_count)
-    attrs = np.asarray(attributes, dtype=np.float64)
-    if behaviour == POINT:
-        attrs = np.broadcast_to(attrs, (n, 3))
-        norms = np.linalg.norm(attrs, axis=1, keepdims=True)
-        if not np.all(np.isfinite(attrs)) or np.any(norms < 1e-9):
-            raise RLAnimateError("The pointing direction is zero or not a number: move the target away "
-                                 "from the character's shoulder.")
-        attrs = attrs / norms
-    else:
-        exaggeration = np.broadcast_to(attrs, (n,))
-        if not np.all(np.isfinite(exaggeration)) or np.any((exaggeration < 0) | (exaggeration > 1)):
-            raise RLAnimateError("Exaggeration must be a number between 0 and 1.")
-        attrs = np.repeat(exaggeration[:, None], 3, axis=1)
-        if rhythm is not None:
-            rhythm = np.asarray(rhythm, dtype=np.float64)
-            if rhythm.shape != (n, 2) or not np.all(np.isfinite(rhythm)):
-                raise RLAnimateError(f"The wave rhythm must be finite signals of shape ({n}, 2), got {rhythm.shape}.")
-            attrs[:, 1:] = rhythm
-    objective = np.zeros((n, OBJECTIVE_SIZE))
-    objective[:, OBJECTIVE_TYPE] = BEHAVIOUR_TYPE[behaviour]
-    objective[:, OBJECTIVE_ARM] = (1.0, 0.0) if arm == "LEFT" else (0.0, 1.0)
-    objective[:, OBJECTIVE_ATTRIBUTES] = attrs
-    objective[:, OBJECTIVE_TIME] = np.linspace(0.0, 1.0, n)
-    return objective
+    def __init__(self, declared: tuple[Behaviour, ...]):
+        if not declared:
+            raise RLAnimateError("An agent needs at least one behaviour.")
+        self.behaviours = tuple(declared)
+        self.names = tuple(b.name for b in self.behaviours)
+        if len(set(self.names)) != len(self.names):
+            raise RLAnimateError(f"The behaviours {', '.join(self.names)} name one behaviour twice.")
+        self._kinds = {b.name: b.kind for b in self.behaviours}
+        count = len(self.behaviours)
+        #: (N, L) each behaviour's label: Table 2's type code for at most two behaviours, else one-hot.
+        self.labels = np.arange(1.0, count + 1.0)[:, None] if count <= 2 else np.eye(count)
+        self.label_size = self.labels.shape[1]
+        self.size = self.label_size + _FIELDS_AFTER_LABEL
+
+    def __eq__(self, other):
+        return isinstance(other, ObjectiveSpace) and self.behaviours == other.behaviours
+
+    def __hash__(self):
+        return hash(self.behaviours)
+
+    def __repr__(self):
+        return f"ObjectiveSpace({', '.join(f'{b.name} {b.kind}' for b in self.behaviours)})"
+
+    def kind(self, behaviour: str) -> str:
+        """The kind (behaviours.TARGET or INTENSITY) of the behaviour id `behaviour`."""
+        self.check_behaviour(behaviour)
+        return self._kinds[behaviour]
+
+    def of_kind(self, kind: str) -> tuple[str, ...]:
+        """The ids of the behaviours of `kind`, in objective order."""
+        return tuple(name for name in self.names if self._kinds[name] == kind)
+
+    def check_behaviour(self, behaviour: str) -> None:
+        if behaviour not in self._kinds:
+            raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(self.names)}.")
+
+    def check_request(self, behaviour: str, arm: str, frame_count: int) -> None:
+        """RLAnimateError naming what no agent or baseline can answer: an unknown behaviour or arm, or
+        under 2 frames."""
+        self.check_behaviour(behaviour)
+        check_arm_and_length(arm, frame_count)
+
+    def label_mask(self, objectives: ArrayLike, behaviour: str) -> np.ndarray:
+        """(...,) bool: which objectives (..., L + 6) carry the label of `behaviour`."""
+        label = self.labels[self.names.index(behaviour)]
+        return np.all(np.asarray(objectives)[..., :self.label_size] == label, axis=-1)
+
+    def kind_mask(self, objectives: ArrayLike, kind: str) -> np.ndarray:
+        """(...,) bool: which objectives (..., L + 6) belong to a behaviour of `kind`."""
+        masks = [self.label_mask(objectives, name) for name in self.of_kind(kind)]
+        return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
+
+    def behaviours_in(self, objectives: ArrayLike) -> set[str]:
+        """The ids whose labels the objectives (..., L + 6) carry; RLAnimateError for a label of none."""
+        objectives = np.asarray(objectives)
+        masks = {name: self.label_mask(objectives, name) for name in self.names}
+        if not np.all(np.any(list(masks.values()), axis=0)):
+            raise RLAnimateError(f"The objectives carry a behaviour label that is none of {', '.join(self.names)}.")
+        return {name for name, mask in masks.items() if mask.any()}
+
+    def make_objective(self, behaviour: str, arm: str, attributes: ArrayLike, frame_count: int,
+                       rhythm: ArrayLike | None = None) -> np.ndarray:
+        """(N, L + 6) objectives for a gesture of `frame_count` frames.
+
+        `attributes` is, for a target behaviour, a unit vector (3,) or one per frame (N, 3), so a moving
+        target is tracked; for an intensity behaviour, the exaggeration in [0, 1] (scalar or (N,)).
+        `rhythm` (N, 2), WAVE only: the swing signals of core/rhythm.py; None gives the paper's
+        objective (the exaggeration three times).
+        """
+        self.check_request(behaviour, arm, frame_count)
+        n = int(frame_count)
+        attrs = np.asarray(attributes, dtype=np.float64)
+        if self._kinds[behaviour] == TARGET:
+            attrs = np.broadcast_to(attrs, (n, 3))
+            norms = np.linalg.norm(attrs, axis=1, keepdims=True)
+            if not np.all(np.isfinite(attrs)) or np.any(norms < 1e-9):
+                raise RLAnimateError("The pointing direction is zero or not a number: move the target away "
+                                     "from the character's shoulder.")
+            attrs = attrs / norms
+        else:
+            exaggeration = np.broadcast_to(attrs, (n,))
+            if not np.all(np.isfinite(exaggeration)) or np.any((exaggeration < 0) | (exaggeration > 1)):
+                raise RLAnimateError("Exaggeration must be a number between 0 and 1.")
+            attrs = np.repeat(exaggeration[:, None], 3, axis=1)
+            if rhythm is not None:
+                if behaviour != WAVE:
+                    raise RLAnimateError(f"Only a wave carries a rhythm in its objective, not {behaviour}.")
+                rhythm = np.asarray(rhythm, dtype=np.float64)
+                if rhythm.shape != (n, 2) or not np.all(np.isfinite(rhythm)):
+                    raise RLAnimateError(f"The wave rhythm must be finite signals of shape ({n}, 2), got "
+                                         f"{rhythm.shape}.")
+                attrs[:, 1:] = rhythm
+        objective = np.zeros((n, self.size))
+        objective[:, :self.label_size] = self.labels[self.names.index(behaviour)]
+        objective[:, OBJECTIVE_ARM] = (1.0, 0.0) if arm == "LEFT" else (0.0, 1.0)
+        objective[:, OBJECTIVE_ATTRIBUTES] = attrs
+        objective[:, OBJECTIVE_TIME] = np.linspace(0.0, 1.0, n)
+        return objective
+
+
+#: Point and wave (Table 2): the space of every agent file that declares no behaviours.
+PAPER_SPACE = ObjectiveSpace(behaviours.PAPER)
 
 
 def pointing_direction(arm: str, target: ArrayLike) -> np.ndarray:

@@ -53,7 +53,7 @@ def test_moving_the_target_re_bakes_the_point_at_the_new_position(settings):
 
 def test_a_gesture_edited_by_hand_is_never_re_baked(settings):
     rig, target = _point(settings)
-    assert not gestures.edited_by_hand(gestures.last_point(rig)), "the keys as written hash as read back"
+    assert not gestures.edited_by_hand(gestures.last_targeted(rig)), "the keys as written hash as read back"
     action = rig.animation_data.action
     fcurve = action_adapter.all_fcurves(action)[0]
     fcurve.keyframe_points[10].co.y += 0.1  # the animator's own edit
@@ -81,7 +81,7 @@ def test_moving_a_handle_of_editable_keys_is_an_edit(settings):
     target = helpers.add_empty("Target", OLD)
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, editable_keys=True) \
         == {"FINISHED"}
-    gesture = gestures.last_point(rig)
+    gesture = gestures.last_targeted(rig)
     assert not gestures.edited_by_hand(gesture)
     point = next(p for f in action_adapter.all_fcurves(gesture.action) for p in f.keyframe_points
                  if p.interpolation == "BEZIER")
@@ -92,7 +92,7 @@ def test_moving_a_handle_of_editable_keys_is_an_edit(settings):
 def test_a_re_bake_records_its_settings_and_follows_again(settings):
     rig, target = _point(settings)
     _move(target, NEW)
-    record = gestures.last_point(rig).record
+    record = gestures.last_targeted(rig).record
     assert record["note"] == "" and record["settings"]["target"] == target
     assert np.allclose(np.reshape(record["aimed_at"], (-1, 3))[0], np.array(rig.matrix_world.inverted() @ target.location))
     _move(target, OLD)

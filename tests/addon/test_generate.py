@@ -340,7 +340,7 @@ def test_exact_aim_off_bakes_the_agents_own_aim(settings, arm):
         runs[exact] = finger_angles(rig, arm, location, frames)[0], helpers.bone_heads(
             rig, [b.name for b in rig.pose.bones], frames)
     agent = preferences.load_agent(preferences.BUNDLED_AGENT)
-    objectives = gesture.build_objectives("POINT", arm, count, targets=np.tile(location, (count, 1)),
+    objectives = gesture.build_objectives(agent.space, "POINT", arm, count, targets=np.tile(location, (count, 1)),
                                           rest_heads=gesture.canonical_rig().rest_heads)
     _, base, finger, _ = aim.finger_lines(gesture.run_agent(agent, "POINT", objectives), arm)
     raw = behaviour_metrics.pointing_angles(base, finger, location)

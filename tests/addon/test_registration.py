@@ -12,6 +12,7 @@ import pytest
 
 import rlanimate_addon
 from rlanimate_addon.blender import panel, registration
+from rlanimate_addon.blender import properties as blender_properties
 from rlanimate_addon.core import runtime
 
 CONTRACT = {
@@ -47,8 +48,14 @@ def test_scene_settings_keep_the_contract(settings):
     properties = settings.bl_rna.properties
     for name, (kind, items) in CONTRACT.items():
         assert properties[name].type == kind, name
-        if items is not None:
-            assert {item.identifier for item in properties[name].enum_items} == items
+        if items is not None:  # `behaviour` lists the selected agent's (the bundled one's) behaviours
+            listed = (properties[name].enum_items if name != "behaviour"
+                      else [types.SimpleNamespace(identifier=item[0]) for item in
+                            blender_properties.behaviour_items(settings, bpy.context)])
+            assert {item.identifier for item in listed} == items
+            for value in items:
+                setattr(settings, name, value)
+                assert getattr(settings, name) == value
     assert properties["target"].fixed_type.identifier == "Object"
     assert (properties["exaggeration"].hard_min, properties["exaggeration"].hard_max) == (0.0, 1.0)
     assert settings.frame_count >= 2, "the default length must be a usable gesture"

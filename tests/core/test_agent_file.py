@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import torch
 
-from rlanimate_addon.core import agent_file
+from rlanimate_addon.core import agent_file, spaces
 from rlanimate_addon.core.agent_file import load_agent_file
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.agent_export import export_agent
@@ -37,7 +37,7 @@ def rewrite(path, weights, metadata, **extra):
 def test_a_real_exported_file_loads(exported):
     weights, metadata = load_agent_file(exported)
     assert metadata["variant"] == "rlanimate"
-    assert set(weights) == set(agent_file.expected_weight_shapes(metadata["agent_config"], "rlanimate"))
+    assert set(weights) == set(agent_file.expected_weight_shapes(metadata["agent_config"], "rlanimate", 7))
 
 
 def test_missing_file(tmp_path):
@@ -69,6 +69,33 @@ def test_wrong_format_version(tmp_path, exported):
     path = rewrite(tmp_path / "v99.npz", weights, {**metadata, "format_version": 99})
     with pytest.raises(RLAnimateError, match="format version 99"):
         load_agent_file(path)
+
+
+def test_a_file_declares_its_behaviours_and_a_version_3_file_loads_as_point_and_wave(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    assert metadata["format_version"] == agent_file.FORMAT_VERSION == 4
+    assert metadata["behaviours"] == [{"name": "POINT", "kind": "target"}, {"name": "WAVE", "kind": "intensity"}]
+    old = {key: value for key, value in metadata.items() if key != "behaviours"}
+    _, loaded = load_agent_file(rewrite(tmp_path / "v3.npz", weights, {**old, "format_version": 3}))
+    assert agent_file.objective_space(loaded) == spaces.PAPER_SPACE
+    with pytest.raises(RLAnimateError, match="lacks metadata behaviours"):
+        load_agent_file(rewrite(tmp_path / "v4.npz", weights, old))
+
+
+@pytest.mark.parametrize("declared, message", [
+    ([], "a list of 1 to 64 behaviours"),
+    ([{"name": "POINT", "kind": "target"}], "invalid average_frames.*among POINT"),  # WAVE is not declared
+    ([{"name": "POINT", "kind": "target", "extra": 1}, {"name": "WAVE", "kind": "intensity"}], "a list of 1 to 64"),
+    ([{"name": "POINT", "kind": "aim"}, {"name": "WAVE", "kind": "intensity"}], "kind 'aim'"),
+    ([{"name": "WAVE", "kind": "intensity"}, {"name": "POINT", "kind": "target"}], "not in objective order"),
+    ([{"name": "POINT", "kind": "target"}, {"name": "POINT", "kind": "target"}], "name one behaviour twice"),
+    ([{"name": "point", "kind": "target"}, {"name": "WAVE", "kind": "intensity"}], "upper case"),
+    ([{"name": "import os", "kind": "target"}, {"name": "WAVE", "kind": "intensity"}], "not a behaviour name"),
+])
+def test_invalid_declared_behaviours_are_refused(tmp_path, exported, declared, message):
+    weights, metadata = load_agent_file(exported)
+    with pytest.raises(RLAnimateError, match=message):
+        load_agent_file(rewrite(tmp_path / "declared.npz", weights, {**metadata, "behaviours": declared}))
 
 
 def test_a_version_1_file_from_before_the_wave_rhythm_is_refused_with_the_fix(tmp_path, exported):

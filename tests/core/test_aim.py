@@ -27,7 +27,7 @@ def random_target(arm, rng):
 
 
 def agent_gesture(agent, arm, target, frames=FRAMES):
-    objectives = gesture.build_objectives("POINT", arm, frames, targets=np.tile(target, (frames, 1)),
+    objectives = gesture.build_objectives(agent.space, "POINT", arm, frames, targets=np.tile(target, (frames, 1)),
                                           rest_heads=gesture.canonical_rig().rest_heads)
     return gesture.run_agent(agent, "POINT", objectives)  # (N, 15, 3)
 

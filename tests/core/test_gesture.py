@@ -19,6 +19,10 @@ class ReplayAgent:
 
     action_bounds = spaces.DEFAULT_ACTION_BOUNDS
     average_frames = {"POINT": 50, "WAVE": 80}
+    space = spaces.PAPER_SPACE
+
+    def kind(self, behaviour):
+        return self.space.kind(behaviour)
 
     def __init__(self, actions):
         self.actions, self.calls = actions, []
@@ -143,9 +147,10 @@ def test_a_point_shorter_than_the_agents_average_is_its_average_point_played_fas
     agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(80, spaces.ACTION_SIZE)))
     average = agent.average_frames["POINT"]
     for frames, steps in ((30, average), (average, average), (70, 70)):
-        gesture.run_agent(agent, "POINT", spaces.make_objective("POINT", "RIGHT", [0.0, -1.0, 0.0], frames))
+        gesture.run_agent(agent, "POINT", spaces.PAPER_SPACE.make_objective("POINT", "RIGHT", [0.0, -1.0, 0.0], frames))
         assert len(agent.calls[-1][0]) == steps
-    assert gesture.rollout_length(30, average, "WAVE") == 30, "a quick wave is the agent's own"
+    assert gesture.rollout_length(30, average, "intensity") == 30, "a quick wave is the agent's own"
+    assert gesture.rollout_length(30, average, "target") == average, "as is any target behaviour's"
 
 
 def _animated(rig, frames, scale=0.3):

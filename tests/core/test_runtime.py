@@ -19,9 +19,9 @@ RHYTHM = rhythm.RhythmModel.fit([0.0, 0.5, 1.0], [rhythm.Rhythm(0.08, 0.3, 0.7, 
 
 
 def objectives_for_tests(frames=150):
-    point = spaces.make_objective("POINT", "LEFT", [0.4, -0.8, 0.3], frames)
-    wave = spaces.make_objective("WAVE", "RIGHT", 0.7, frames // 2)
-    swinging = spaces.make_objective("WAVE", "LEFT", 0.3, frames, rhythm.signals(RHYTHM.draw(0.3, 4), frames))
+    point = spaces.PAPER_SPACE.make_objective("POINT", "LEFT", [0.4, -0.8, 0.3], frames)
+    wave = spaces.PAPER_SPACE.make_objective("WAVE", "RIGHT", 0.7, frames // 2)
+    swinging = spaces.PAPER_SPACE.make_objective("WAVE", "LEFT", 0.3, frames, rhythm.signals(RHYTHM.draw(0.3, 4), frames))
     return [point, wave, swinging]
 
 
@@ -125,7 +125,9 @@ def test_metadata_accessors(tmp_path):
 def test_shipped_default_agent_plays(tmp_path):
     from pathlib import Path
     runtime = load_agent(Path(__file__).resolve().parents[2] / "rlanimate_addon" / "agents" / "default.npz")
-    actions = runtime.rollout(spaces.make_objective("WAVE", "LEFT", 0.5, 40))
+    assert runtime.metadata["format_version"] == 3 and runtime.space == spaces.PAPER_SPACE  # declares none
+    assert runtime.behaviours == ("POINT", "WAVE")
+    actions = runtime.rollout(spaces.PAPER_SPACE.make_objective("WAVE", "LEFT", 0.5, 40))
     assert actions.shape == (40, spaces.ACTION_SIZE)
     assert np.all(np.isfinite(actions)) and np.all((actions >= 0.0) & (actions <= 1.0))
     assert isinstance(runtime, GestureAgent)
@@ -152,3 +154,28 @@ def test_single_behaviour_agent_plays_only_its_behaviour(tmp_path):
     assert runtime.rollout(point).shape == (len(point), spaces.ACTION_SIZE)
     with pytest.raises(RLAnimateError, match="trained for point only"):
         runtime.rollout(wave)
+
+
+def test_an_agent_of_four_declared_behaviours_lists_them_and_plays_each_with_its_label(tmp_path):
+    from rlanimate_addon.core import behaviours
+    from rlanimate_addon.core.behaviours import INTENSITY, TARGET, Behaviour
+    from rlanimate_addon.core.errors import RLAnimateError
+    space = spaces.ObjectiveSpace(behaviours.ordered([*behaviours.PAPER, Behaviour("THIS_WAY", TARGET),
+                                                      Behaviour("RAISE_HAND", INTENSITY)]))
+    torch.manual_seed(0)
+    agent = RLAnimateAgent(load_preset("debug")[0], "rlanimate", space)
+    path = tmp_path / "four.npz"
+    export_agent(agent, path, {"average_frames": {"POINT": 80, "WAVE": 95, "THIS_WAY": 70}})
+    runtime = load_agent(path)
+    assert runtime.space == space and runtime.behaviours == ("POINT", "WAVE", "THIS_WAY")
+    assert runtime.kind("THIS_WAY") == TARGET and runtime.kind("RAISE_HAND") == INTENSITY
+    assert runtime.average_frames["RAISE_HAND"] == pytest.approx((80 + 95 + 70) / 3)
+    guide = space.make_objective("THIS_WAY", "LEFT", [0.3, -0.9, 0.2], 40)
+    actions = runtime.rollout(guide)
+    np.testing.assert_allclose(actions, torch_rollout(agent, guide), atol=1e-5)
+    other = runtime.rollout(space.make_objective("POINT", "LEFT", [0.3, -0.9, 0.2], 40))
+    assert np.abs(actions - other).max() > 1e-4, "the label changes the gesture"
+    with pytest.raises(RLAnimateError, match="trained for point and wave and this_way only"):
+        runtime.rollout(space.make_objective("RAISE_HAND", "LEFT", 0.5, 40))
+    with pytest.raises(RLAnimateError, match=r"objectives of shape \(frames, 10\)"):
+        runtime.rollout(spaces.PAPER_SPACE.make_objective("POINT", "LEFT", [0.3, -0.9, 0.2], 40))

@@ -4,7 +4,8 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, skeleton, spaces
+from rlanimate_addon.core import skeleton, spaces
+from trainer.motion.clip import MotionClip
 
 _ARM_JOINT = {arm: skeleton.ACTION_JOINTS.index(skeleton.ARM_PREFIX[arm] + "Arm") for arm in skeleton.ARMS}
 _FOREARM_JOINT = {arm: skeleton.ACTION_JOINTS.index(skeleton.ARM_PREFIX[arm] + "ForeArm") for arm in skeleton.ARMS}
@@ -32,8 +33,8 @@ def make_clip(name, behaviour, arm, value, frames):
         t = np.arange(frames) / 30.0
         rotvecs[:, _ARM_JOINT[arm]] = envelope * np.array([0.0, 0.0, side * (0.6 + 0.4 * value)])
         rotvecs[:, _FOREARM_JOINT[arm], 2] = envelope[:, 0] * (0.3 + 0.3 * value) * np.sin(2 * np.pi * 2.5 * t)
-    return SimpleNamespace(name=name, behaviour=behaviour, arm=arm, attributes=attributes,
-                           rotvecs=rotvecs, fps=30.0)
+    return MotionClip(name=name, source=name, fps=30.0, rotvecs=rotvecs, behaviour=behaviour, arm=arm,
+                      attributes=attributes)
 
 
 def make_library(seed=0, per_behaviour=4):
@@ -47,6 +48,6 @@ def make_library(seed=0, per_behaviour=4):
                  else rng.uniform(0, 1))
         return make_clip(f"{behaviour.lower()}_{arm.lower()}_{k}", behaviour, arm, value, frames)
 
-    train = [clip(k, b, skeleton.ARMS[k % 2]) for b in behaviours.BEHAVIOURS for k in range(per_behaviour)]
-    test = [clip(100 + k, b, arm) for b in behaviours.BEHAVIOURS for k, arm in enumerate(skeleton.ARMS)]
+    train = [clip(k, b, skeleton.ARMS[k % 2]) for b in spaces.PAPER_SPACE.names for k in range(per_behaviour)]
+    test = [clip(100 + k, b, arm) for b in spaces.PAPER_SPACE.names for k, arm in enumerate(skeleton.ARMS)]
     return SimpleNamespace(train=train, test=test)

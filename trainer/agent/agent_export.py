@@ -12,14 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import agent_file, behaviours, skeleton, spaces
+from rlanimate_addon.core import agent_file, skeleton, spaces
 from trainer import paths
 from trainer.files import atomic_open
 
 #: Entries of the metadata's "training" that are paths on the training machine.
 TRAINING_PATHS = ("clips",)
-#: Average gesture length in frames (30 fps) when the caller gives none: the UI's default length.
-FALLBACK_AVERAGE_FRAMES = dict.fromkeys(behaviours.BEHAVIOURS, 90)
+#: Average gesture length in frames (30 fps) of each behaviour when the caller gives none: the UI's default.
+FALLBACK_AVERAGE_FRAMES = 90
 
 
 def export_agent(agent, path, metadata=None):
@@ -30,7 +30,8 @@ def export_agent(agent, path, metadata=None):
     "train_config" (a TrainConfig or dict), "average_frames" ({behaviour: n} for each behaviour
     trained, the mean length of its training clips), "wave_rhythm" (a core.rhythm.RhythmModel's dict,
     or None: the paper's wave objective), "action_bounds" ((45, 2), default the spaces' bounds), and
-    any other JSON-serialisable entries (kept as given).
+    any other JSON-serialisable entries (kept as given). The file declares the agent's behaviours
+    (`agent.space`: name and kind each, in objective order).
     """
     extra = dict(metadata or {})
     bounds = np.asarray(extra.pop("action_bounds", spaces.DEFAULT_ACTION_BOUNDS), dtype=np.float64)
@@ -41,11 +42,13 @@ def export_agent(agent, path, metadata=None):
         "variant": agent.variant,
         "agent_config": agent.config.to_dict(),
         "train_config": asdict(train_config) if is_dataclass(train_config) else train_config,
-        "spaces": _spaces(),
+        "behaviours": [b.to_dict() for b in agent.space.behaviours],
+        "spaces": _spaces(agent.space),
         "action_bounds": bounds.tolist(),
         "rig": {"convention": "mixamo", "bone_prefix": skeleton.PREFIX,
                 "required_bones": list(skeleton.REQUIRED_BONES)},
-        "average_frames": {k: float(v) for k, v in extra.pop("average_frames", FALLBACK_AVERAGE_FRAMES).items()},
+        "average_frames": {k: float(v) for k, v in extra.pop(
+            "average_frames", dict.fromkeys(agent.space.names, FALLBACK_AVERAGE_FRAMES)).items()},
         "wave_rhythm": extra.pop("wave_rhythm", None),
         "training": _training(extra.pop("training", {})),
         **extra,
@@ -80,10 +83,10 @@ def _json_value(value):
     raise TypeError(f"Agent metadata must be JSON data; got {type(value).__name__}")
 
 
-def _spaces():
-    return {"objective_size": spaces.OBJECTIVE_SIZE, "description_size": spaces.DESCRIPTION_SIZE,
-            "action_size": spaces.ACTION_SIZE, "behaviours": list(behaviours.BEHAVIOURS),
-            "behaviour_type": dict(spaces.BEHAVIOUR_TYPE), "action_joints": list(skeleton.ACTION_JOINTS),
+def _spaces(space):
+    return {"objective_size": space.size, "description_size": spaces.DESCRIPTION_SIZE,
+            "action_size": spaces.ACTION_SIZE, "behaviour_labels": dict(zip(space.names, space.labels.tolist())),
+            "action_joints": list(skeleton.ACTION_JOINTS),
             "action_encoding": "rotation vector relative to rest, (r - low) / (high - low)",
             "description_joints": [list(j) for j in skeleton.DESCRIPTION_JOINTS],
             "effectors": [list(e) for e in skeleton.EFFECTORS]}

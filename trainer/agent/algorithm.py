@@ -30,20 +30,17 @@ from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
 
-def clips_for_behaviour(clips, behaviour):
+def clips_for_behaviour(clips, behaviour, space):
     """Clips grouped as Algorithm 1 draws them: one group per behaviour of the training set `behaviour`
-    ([[point clips], [wave clips]] for 'both')."""
-    wanted = behaviours.training_set(behaviour)
-    groups = [[clip for clip in clips if clip.behaviour == name] for name in wanted]
-    for name, group in zip(wanted, groups):
-        if not group:
-            raise RLAnimateError(f"The clip library has no {behaviours.key(name)} training clips: add some, "
-                                 f"or train with --behaviour set to a behaviour it has.")
-    return groups
+    (behaviours.training_set, among the ObjectiveSpace `space`'s), in objective order ([[point clips],
+    [wave clips]] for 'both')."""
+    wanted = behaviours.training_set(behaviour, space.names)
+    return [[clip for clip in clips if clip.behaviour == name] for name in wanted]
 
 
-def clip_objective(clip, frame_count=None, rhythm_model=None, with_rhythm=True):
-    """(N, 7) objectives for `clip`'s label, over its own length or `frame_count` frames.
+def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm=True):
+    """(N, O) objectives of the ObjectiveSpace `space` for `clip`'s label, over its own length or
+    `frame_count` frames.
 
     A wave's rhythm (core/rhythm.py) is the clip's own (what the task module knows in training), or,
     given `rhythm_model`, the one it draws for the clip's exaggeration (a request without the clip,
@@ -55,12 +52,12 @@ def clip_objective(clip, frame_count=None, rhythm_model=None, with_rhythm=True):
     if clip.behaviour == behaviours.WAVE and with_rhythm:
         drawn = wave_rhythm.clip_rhythm(clip) if rhythm_model is None else rhythm_model.draw(clip.attributes)
         signals = np.zeros((frames, 2)) if drawn is None else rhythm.signals(drawn, frames)
-    return spaces.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
+    return space.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
 
 
 def rollout_actions(agent, objectives, deterministic=True, generator=None):
-    """(N, 7) numpy objectives -> (N, 45) numpy actions in [0, 1] from one agent rollout."""
-    batch = torch.as_tensor(objectives, dtype=torch.float32)[None]  # (1, N, 7)
+    """(N, O) numpy objectives -> (N, 45) numpy actions in [0, 1] from one agent rollout."""
+    batch = torch.as_tensor(objectives, dtype=torch.float32)[None]  # (1, N, O)
     with torch.no_grad():
         actions = agent.rollout(batch, deterministic=deterministic, generator=generator)  # (1, N, 45)
     return actions[0].double().numpy()
@@ -80,14 +77,17 @@ def gradient_step(agent, optimizer, batch, config, bounds):
 class Trainer:
     """Algorithm 1's state (agent, optimiser, buffer, RNGs, epoch, history) and one iteration of it."""
 
-    def __init__(self, agent, env, clips, train_config, behaviour=behaviours.BOTH, seed=0,
+    def __init__(self, agent, env, clips, train_config, behaviour=behaviours.ALL, seed=0,
                  bounds=spaces.DEFAULT_ACTION_BOUNDS, references=None, epochs=None):
         self.agent = agent
         self.env = env
         self.train_config = train_config
         self.behaviour = behaviour
         self.bounds = np.asarray(bounds, dtype=np.float64)
-        self.clip_groups = clips_for_behaviour(clips, behaviour)
+        self.space = agent.space
+        self.clip_groups = clips_for_behaviour(clips, behaviour, self.space)
+        #: The ids of the behaviours trained, in objective order.
+        self.trained = tuple(group[0].behaviour for group in self.clip_groups)
         waves = [clip for group in self.clip_groups for clip in group if clip.behaviour == behaviours.WAVE]
         #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
         self.rhythm_model = None
@@ -123,15 +123,15 @@ class Trainer:
         ("imitate" 0); only the pointing term, and the dynamics terms L1 and L2, learn from them:
         the objective is the reward, as the paper's RL framing has it."""
         drawn = [self.draw(k) for k in range(len(self.clip_groups))]
-        objectives = [clip_objective(clip, with_rhythm=self.train_config.wave_rhythm) for clip in drawn]
+        objectives = [clip_objective(self.space, clip, with_rhythm=self.train_config.wave_rhythm) for clip in drawn]
         imitated = [True] * len(drawn)
-        points = [clip for group in self.clip_groups for clip in group if clip.behaviour == behaviours.POINT]
-        if points and self.agent.variant != "supervised":
+        targeted = self._target_clips()
+        if targeted and self.agent.variant != "supervised":
             for _ in range(self.train_config.random_targets):
-                clip = points[int(self.rng.integers(len(points)))]
+                clip = targeted[int(self.rng.integers(len(targeted)))]
                 drawn.append(clip)
-                objectives.append(spaces.make_objective(behaviours.POINT, clip.arm, self._random_direction(clip.arm),
-                                                        len(clip.rotvecs)))
+                objectives.append(self.space.make_objective(clip.behaviour, clip.arm,
+                                                            self._random_direction(clip.arm), len(clip.rotvecs)))
                 imitated.append(False)
         self.agent.eval()
         actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
@@ -148,16 +148,21 @@ class Trainer:
                 "description": description,
                 "motion": spaces.encode_action(clip.rotvecs, self.bounds),
                 "motion_description": motion_description,
-                "hold": pointing.hold_frames(clip_objective(clip), motion_description),
+                "hold": (pointing.hold_frames(clip_objective(self.space, clip), motion_description)
+                         if clip.behaviour_kind == behaviours.TARGET else np.zeros(len(objective))),
                 "imitate": np.full(len(objective), float(imitate)),
             })
         return drawn
 
+    def _target_clips(self):
+        """The training clips of target behaviours, whose requests can aim anywhere."""
+        return [clip for group in self.clip_groups for clip in group if clip.behaviour_kind == behaviours.TARGET]
+
     def _random_direction(self, arm):
         """A unit pointing direction for `arm`, uniform in azimuth and elevation over the range of the
         arm's training clips widened by the config's margin (elevation kept within 80 degrees)."""
-        angles = np.degrees([pointing.azimuth_elevation(arm, clip.attributes) for group in self.clip_groups
-                             for clip in group if clip.behaviour == behaviours.POINT and clip.arm == arm])
+        angles = np.degrees([pointing.azimuth_elevation(arm, clip.attributes) for clip in self._target_clips()
+                             if clip.arm == arm])
         margin = self.train_config.random_target_margin_deg
         low = np.maximum(angles.min(axis=0) - margin, (-180.0, -80.0))
         high = np.minimum(angles.max(axis=0) + margin, (180.0, 80.0))
@@ -165,9 +170,9 @@ class Trainer:
         return pointing.direction_from_angles(arm, azimuth, elevation)
 
     def request_objective(self, clip, frame_count=None):
-        """(N, 7) objectives of a request like `clip` (its label and length) as the add-on builds
+        """(N, O) objectives of a request like `clip` (its label and length) as the add-on builds
         them: a wave's rhythm is drawn from the training waves', not read from the clip."""
-        return clip_objective(clip, frame_count, self.rhythm_model, self.train_config.wave_rhythm)
+        return clip_objective(self.space, clip, frame_count, self.rhythm_model, self.train_config.wave_rhythm)
 
     def learning_rate(self):
         """This epoch's Adam step size: cosine from learning_rate down to learning_rate_final over the

@@ -14,9 +14,10 @@ On a batch of C chunks of L frames (batch-major, from trainer/agent/buffer.py):
                  over the 42 numbers), when `portrayal_direct_loss`;
     velocity     optional (`velocity_scale` > 0): Huber of the Beta mean's change from frame to frame to
                  the clip's, summed over the 45 channels, where both frames imitate a clip;
-    wrist        optional (`wrist_scale` > 0): squared distance (m^2) between the waving wrist of the
+    wrist        optional (`wrist_scale` > 0): squared distance (m^2) between the gesturing wrist of the
                  Beta mean's pose and the clip's, through differentiable forward kinematics, on the
-                 wave frames that imitate a clip: the hand path the swing is measured on;
+                 frames of intensity behaviours (wave) that imitate a clip: the hand path the swing is
+                 measured on;
     pointing     the agent's own finger line against the objective's ray at the frames where the clip
                  holds its point (trainer/agent/pointing.py), through differentiable forward kinematics
                  of the Beta's mean pose; on when the action bounds are given;
@@ -32,7 +33,7 @@ import torch
 import torch.nn.functional as F
 from torch.distributions import Beta, Independent, kl_divergence
 
-from rlanimate_addon.core import behaviours, spaces
+from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.agent_file import INITIAL_ACTION
 from trainer.agent import pointing
 from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
@@ -45,7 +46,7 @@ def agent_losses(agent, batch, config, bounds=None):
     """{"description", "kl", "pose", "portrayal", "pointing", "policy", "total"}, and "velocity" when its
     scale is not 0: scalar tensors for `agent` on `batch`; the pointing term is zero without the action
     `bounds` (45, 2) or the batch's "hold"."""
-    objective, motion = batch["objective"], batch["motion"]  # (C, L, 7), (C, L, 45)
+    objective, motion = batch["objective"], batch["motion"]  # (C, L, O), (C, L, 45)
     supervised = agent.variant == "supervised"
     played = motion if supervised else batch["action"]  # (C, L, 45)
     previous = torch.cat([torch.full_like(played[:, :1], INITIAL_ACTION), played[:, :-1]], 1)  # a_{t-1}
@@ -76,8 +77,7 @@ def agent_losses(agent, batch, config, bounds=None):
         terms["pointing"] = pointing.pointing_error(policy.mean[hold], objective[hold],
                                                     torch.as_tensor(bounds, dtype=objective.dtype)).mean()
     if config.wrist_scale and bounds is not None:  # only then: runs without it log the terms they always had
-        wave_type = spaces.BEHAVIOUR_TYPE[behaviours.WAVE]
-        waving = (objective[..., spaces.OBJECTIVE_TYPE] == wave_type) & (imitate > 0.5)  # (C, L)
+        waving = of_kind(agent.space, objective, behaviours.INTENSITY) & (imitate > 0.5)  # (C, L)
         terms["wrist"] = (wrist_error(policy.mean[waving], motion[waving], objective[waving],
                                       torch.as_tensor(bounds, dtype=objective.dtype)).mean()
                           if waving.any() else torch.zeros((), dtype=objective.dtype))
@@ -87,6 +87,13 @@ def agent_losses(agent, batch, config, bounds=None):
               "portrayal": config.portrayal_scale, "pointing": config.pointing_scale, "policy": config.policy_scale}
     terms["total"] = sum(scales[name] * value for name, value in terms.items())
     return terms
+
+
+def of_kind(space, objective, kind):
+    """(C, L) bool: the frames of objective (C, L, O) whose label is one of `kind`'s behaviours in `space`."""
+    labels = torch.as_tensor(space.labels[[space.names.index(n) for n in space.of_kind(kind)]],
+                             dtype=objective.dtype)  # (K, L_label)
+    return (objective[..., None, :space.label_size] == labels).all(-1).any(-1)
 
 
 def velocity_error(poses, motion, imitate, delta):

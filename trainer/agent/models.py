@@ -62,13 +62,17 @@ class MLP(nn.Module):
 
 
 class RLAnimateAgent(nn.Module):
-    def __init__(self, agent_config, variant="rlanimate"):
+    """The agent for objectives of `space` (a core.spaces.ObjectiveSpace: its behaviours; point and wave
+    by default), whose size O is the width of every objective tensor below."""
+
+    def __init__(self, agent_config, variant="rlanimate", space=spaces.PAPER_SPACE):
         super().__init__()
         if variant not in VARIANTS:
             raise RLAnimateError(f"Unknown agent variant {variant!r}: use one of {', '.join(VARIANTS)}.")
         c = self.config = agent_config
         self.variant = variant
-        O, D, A = spaces.OBJECTIVE_SIZE, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
+        self.space = space
+        O, D, A = space.size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
         E, Z, hid, n = c.behaviour_size, c.stochastic_size, c.hidden_size, c.hidden_layers
         self.uses_portrayal = agent_file.uses_portrayal(variant)
         self.uses_task_state = agent_file.uses_task_state(variant)
@@ -87,11 +91,11 @@ class RLAnimateAgent(nn.Module):
     # --- the models, one frame or a whole sequence at a time -------------------------------------
 
     def self_description(self, objectives):
-        """Portrayal model: (B, T, 7) -> (B, T, 42) self-descriptions d_t, or None in single_state."""
+        """Portrayal model: (B, T, O) -> (B, T, 42) self-descriptions d_t, or None in single_state."""
         return self.portrayal(objectives) if self.uses_portrayal else None
 
     def task_features(self, objectives):
-        """(B, T, 7) -> (B, T, K): the task state h_{1:T} (K = task_size), or o_{1:T} without one."""
+        """(B, T, O) -> (B, T, K): the task state h_{1:T} (K = task_size), or o_{1:T} without one."""
         if not self.uses_task_state:
             return objectives
         states, _ = self.task_rnn(objectives)  # h_0 = 0

@@ -14,7 +14,7 @@ target REFERENCE_DISTANCE away), averaged over the frames the reference clip hol
 import numpy as np
 import torch
 
-from rlanimate_addon.core import behaviours, skeleton, spaces
+from rlanimate_addon.core import skeleton, spaces
 from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
 
 #: Metres: the nearest target distance the agent is asked to hit (targets are 1.5-4 m away).
@@ -24,7 +24,7 @@ HOLD_ANGLE, HOLD_OFFSET = np.radians(1.0), 0.01
 
 
 def pointing_error(actions, objectives, bounds):
-    """(N,) pointing term of actions (N, 45) in [0, 1] against POINT objectives (N, 7): pass only the
+    """(N,) pointing term of actions (N, 45) in [0, 1] against target objectives (N, O): pass only the
     frames that count (the hold), since forward kinematics is most of a training step's cost."""
     rotvecs = action_rotvecs(actions, bounds)
     ray = objectives[..., spaces.OBJECTIVE_ATTRIBUTES]
@@ -56,10 +56,9 @@ def direction_from_angles(arm, azimuth, elevation):
 
 
 def hold_frames(objective, motion_description):
-    """(F,) 1.0 where a POINT reference (descriptions (F, 42)) holds its finger on the objective's ray."""
+    """(F,) 1.0 where the reference of a target behaviour's objective (F, O) (its descriptions (F, 42))
+    holds its index finger on the objective's ray."""
     objective = np.asarray(objective)
-    if objective[0, spaces.OBJECTIVE_TYPE] != spaces.BEHAVIOUR_TYPE[behaviours.POINT]:
-        return np.zeros(len(objective))
     arm = skeleton.ARMS[int(np.argmax(objective[0, spaces.OBJECTIVE_ARM]))]
     side = skeleton.ARMS.index(arm)
     finger = motion_description[:, spaces.DESCRIPTION_EFFECTORS].reshape(-1, 4, 3)[:, 2 + side]

@@ -377,7 +377,8 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
         entries, problems = checked_entries(manifest, manifest_path, default_fps)
     elif path.is_dir():
         folder, manifest_path, problems = path, None, []
-        entries = [ManifestEntry(k, p.name, None, None, fps=float(expected_fps or EXPECTED_FPS))
+        entries = [ManifestEntry(k, p.name, behaviour=None, kind=None, arm=None,
+                                 fps=float(expected_fps or EXPECTED_FPS))
                    for k, p in enumerate(sorted(path.iterdir()), start=1) if p.suffix.lower() in CLIP_SUFFIXES]
     else:
         raise _no_library(path)

@@ -102,7 +102,7 @@ class ProceduralIK:
         return np.stack(local)
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        spaces.check_request(behaviour, arm, frame_count)
+        spaces.PAPER_SPACE.check_request(behaviour, arm, frame_count)
         self._set_pose(self.neutral)
         side = skeleton.ARM_PREFIX[arm]
         if behaviour == "POINT":

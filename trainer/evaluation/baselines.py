@@ -67,19 +67,20 @@ class NearestClip:
     def nearest(self, behaviour, arm, attributes):
         """The training clip of `behaviour` and `arm` whose label is closest to `attributes`."""
         candidates = clips_of(self.clips, behaviour, arm, "nearest-clip")
-        return min(candidates, key=lambda c: self.label_distance(behaviour, c.attributes, attributes))
+        kind = candidates[0].behaviour_kind
+        return min(candidates, key=lambda c: self.label_distance(kind, c.attributes, attributes))
 
     @staticmethod
-    def label_distance(behaviour, a, b):
-        """Angle (rad) between pointing directions, or |difference| of exaggerations."""
-        if behaviour == behaviours.POINT:
+    def label_distance(kind, a, b):
+        """Angle (rad) between the directions of a target behaviour, or |difference| of exaggerations."""
+        if kind == behaviours.TARGET:
             a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
             cos = a @ b / (np.linalg.norm(a) * np.linalg.norm(b))
             return float(np.arccos(np.clip(cos, -1.0, 1.0)))
         return abs(float(np.ravel(a)[0]) - float(np.ravel(b)[0]))
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        spaces.check_request(behaviour, arm, frame_count)
+        spaces.check_arm_and_length(arm, frame_count)
         return time_warp(self.nearest(behaviour, arm, attributes).rotvecs, frame_count)
 
 
@@ -90,7 +91,7 @@ class NoMotion:
         self.neutral = np.asarray(neutral, dtype=np.float64)  # (15, 3)
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        spaces.check_request(behaviour, arm, frame_count)
+        spaces.check_arm_and_length(arm, frame_count)
         return np.repeat(self.neutral[None], int(frame_count), axis=0)
 
 
@@ -103,7 +104,7 @@ class ClassMean:
         self.clips = list(clips)
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        spaces.check_request(behaviour, arm, frame_count)
+        spaces.check_arm_and_length(arm, frame_count)
         group = clips_of(self.clips, behaviour, arm, "class-mean")
         quats = rotations.rotvec_to_quat(np.stack([time_warp(c.rotvecs, frame_count) for c in group]))  # (C, F, 15, 4)
         quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
@@ -129,8 +130,8 @@ class TrainedAgentMethod:
         generator = None if seed is None else torch.Generator().manual_seed(int(seed))
         signals = (rhythm.signals(self.rhythm_model.draw(attributes, seed), frame_count)
                    if behaviour == behaviours.WAVE and self.rhythm_model is not None else None)
-        actions = rollout_actions(self.agent, spaces.make_objective(behaviour, arm, attributes, frame_count, signals),
-                                  deterministic=seed is None, generator=generator)
+        objectives = self.agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
+        actions = rollout_actions(self.agent, objectives, deterministic=seed is None, generator=generator)
         return spaces.decode_action(actions, self.bounds)
 
 
@@ -147,7 +148,7 @@ class AgentMethod:
         """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed), and for
         a wave the rhythm the agent draws for the seed."""
         signals = self.agent.wave_rhythm(attributes, frame_count, seed) if behaviour == behaviours.WAVE else None
-        objectives = spaces.make_objective(behaviour, arm, attributes, frame_count, signals)
+        objectives = self.agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
         return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
 
 

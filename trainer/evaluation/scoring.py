@@ -9,6 +9,8 @@ descriptions are compared with the FK of the clip's own motion by the one scorer
 raise and lower). A clip set's scores are the means over its clips, its behaviour measures the medians
 and extremes of `evaluation.behaviour.summarise`.
 """
+from functools import partial
+
 import numpy as np
 
 from rlanimate_addon.core import behaviour_metrics, behaviours, metrics, spaces
@@ -19,10 +21,10 @@ from trainer.evaluation.behaviour import clip_target, summarise
 SEEN_CLIP_COUNT = 10
 
 
-def select_clips(clips, behaviour, count=None):
-    """The clips of the training set `behaviour` ('point', 'wave' or 'both'); with `count`, that many spread
-    evenly over them (the paper's 10 training clips), balanced between behaviours for 'both'."""
-    groups = [[c for c in clips if c.behaviour == name] for name in behaviours.training_set(behaviour)]
+def select_clips(clips, trained, count=None):
+    """The clips of the behaviours `trained` (ids); with `count`, that many spread evenly over them (the
+    paper's 10 training clips), balanced between the behaviours."""
+    groups = [[c for c in clips if c.behaviour == name] for name in trained]
     if count is None:
         return [c for group in groups for c in group]
     chosen = []
@@ -34,18 +36,19 @@ def select_clips(clips, behaviour, count=None):
 
 
 def generate_descriptions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUNDS):
-    """Deterministic rollouts for a list of (N_i, 7) objectives -> list of (N_i, 42) descriptions."""
+    """Deterministic rollouts for a list of (N_i, O) objectives -> list of (N_i, 42) descriptions."""
     actions = [rollout_actions(agent, objective, deterministic=True) for objective in objectives]
     rotvecs = spaces.decode_action(np.concatenate(actions), bounds)  # (sum N, 15, 3)
     descriptions = np.asarray(env.evaluate(rotvecs).descriptions)  # (sum N, 42)
     return np.split(descriptions, np.cumsum([len(a) for a in actions])[:-1])
 
 
-def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS, objective=clip_objective):
+def evaluate_clips(agent, env, clips, references, bounds=spaces.DEFAULT_ACTION_BOUNDS, objective=None):
     """score_descriptions of `agent`'s deterministic rollouts on each clip's request: objective(clip,
-    frame_count=None) -> (N, 7) (Trainer.request_objective plays a wave at the rhythm the agent draws
-    for it, as the add-on does)."""
+    frame_count=None) -> (N, O) (Trainer.request_objective plays a wave at the rhythm the agent draws
+    for it, as the add-on does; None: the clip's own objective in the agent's space)."""
     agent.eval()
+    objective = objective or partial(clip_objective, agent.space)
     generated = generate_descriptions(agent, env, [objective(clip) for clip in clips], bounds)
     return score_descriptions(clips, generated, references)
 
@@ -69,7 +72,7 @@ def clip_row(clip, generated, reference):
            "smoothness": float(metrics.smoothness(positions)),
            "aligned_score": behaviour_metrics.aligned_score(positions, reference_positions)}
     target = clip_target(clip)
-    if behaviour == behaviours.WAVE or target is not None:
+    if target is not None or clip.behaviour_kind == behaviours.INTENSITY:
         row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm, target))
     else:  # a pointing clip without a target (real capture): its elevation only
         row.update({f"elevation_{k}": v for k, v in behaviour_metrics.raise_lower(
@@ -91,18 +94,19 @@ def evaluate_seen_unseen(trainer, session):
     """Held-out (unseen) and SEEN_CLIP_COUNT training (seen) clips of the trainer's behaviour(s): {split:
     evaluate_clips's result} for each split that has clips (a library whose every clip is "train" has no
     'unseen')."""
-    unseen = select_clips(session.test_clips, trainer.behaviour)
-    seen = select_clips(session.train_clips, trainer.behaviour, SEEN_CLIP_COUNT)
+    unseen = select_clips(session.test_clips, trainer.trained)
+    seen = select_clips(session.train_clips, trainer.trained, SEEN_CLIP_COUNT)
     return {split: evaluate_clips(trainer.played_agent, session.env, clips, session.references, trainer.bounds,
                                   trainer.request_objective)
             for split, clips in (("unseen", unseen), ("seen", seen)) if clips}
 
 
 def length_flexibility(agent, env, clips, training_clips, scales, bounds=spaces.DEFAULT_ACTION_BOUNDS,
-                       objective=clip_objective):
+                       objective=None):
     """Section 4.4: mean smoothness of each clip's gesture time-scaled to `scale` x the average
     length of its behaviour's training clips -> {behaviour: {scale: smoothness}} for each scale."""
     agent.eval()
+    objective = objective or partial(clip_objective, agent.space)
     average = {}
     for clip in training_clips:
         average.setdefault(clip.behaviour, []).append(len(clip.rotvecs))

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import behaviours, kinematics
+from rlanimate_addon.core import behaviours, kinematics, spaces
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
@@ -63,7 +63,8 @@ def measure(path, behaviour_name, session, target_count):
     """The behaviour measures of the agent at `path` on the held-out requests of its behaviour."""
     method = AgentMethod(path)
     lengths = behaviour.class_lengths(session.train_clips)
-    clips = [c for c in session.test_clips if c.behaviour in behaviours.training_set(behaviour_name)]
+    clips = [c for c in session.test_clips
+             if c.behaviour in behaviours.training_set(behaviour_name, spaces.PAPER_SPACE.names)]
     rows = behaviour.request_rows(method, clips, session.references, describe, lengths)
     result = {"held_out": behaviour.summarise(rows)[behaviour_name],
               "update_steps": method.agent.metadata["train_config"]["update_steps"]}

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import behaviours, metrics
+from rlanimate_addon.core import behaviours, metrics, spaces
 from trainer.agent import checkpoint
 from trainer.agent.config import load_preset
 from trainer.agent.models import VARIANTS, RLAnimateAgent
@@ -27,7 +27,7 @@ from trainer.reporting.table4 import table4_markdown
 
 COLUMNS = tuple(plots.COLUMN_LABELS)  # wave, point, both
 #: The paper's training lengths (Figure 3): 50 epochs for one behaviour, 100 for both.
-PAPER_EPOCHS = {column: 50 * len(behaviours.training_set(column)) for column in COLUMNS}
+PAPER_EPOCHS = {column: 50 * len(behaviours.training_set(column, spaces.PAPER_SPACE.names)) for column in COLUMNS}
 #: Random unseen pointing targets per arm at which every pointing agent's own aim is measured.
 RANDOM_TARGETS = 100
 LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
@@ -110,7 +110,7 @@ def evaluate_runs(settings, runs, session):
     results = {}
     for split, clips in splits.items():
         for column in settings.columns:
-            wanted = [c for c in clips if c.behaviour in behaviours.training_set(column)]
+            wanted = [c for c in clips if c.behaviour in behaviours.training_set(column, spaces.PAPER_SPACE.names)]
             entry = results.setdefault(split, {}).setdefault(column, {})
             for (seed, variant, run_column), folder in sorted(runs.items()):
                 if run_column == column:
@@ -127,7 +127,7 @@ def random_target_aim(settings, runs, session):
     frames = behaviour.class_lengths(session.train_clips)[behaviours.POINT]
     results = {}
     for (seed, variant, column), folder in sorted(runs.items()):
-        if behaviours.POINT in behaviours.training_set(column):
+        if behaviours.POINT in behaviours.training_set(column, spaces.PAPER_SPACE.names):
             sweeps = behaviour.random_target_sweeps(AgentMethod(folder / "agent.npz"), frames, session.describe,
                                                      RANDOM_TARGETS)
             results.setdefault(column, {}).setdefault(variant, []).append(
@@ -197,7 +197,7 @@ def write_length_flexibility(settings, results, session):
     if not is_finished(folder, planned_epochs(settings, behaviours.BOTH)):
         return None
     agent = load_trained_agent(folder)
-    test = scoring.select_clips(session.test_clips, behaviours.BOTH)
+    test = scoring.select_clips(session.test_clips, spaces.PAPER_SPACE.names)
     flexibility = scoring.length_flexibility(agent, session.env, test, session.train_clips, LENGTH_SCALES)
     atomic_write_text(results / "length_flexibility.json", json.dumps(flexibility, indent=2) + "\n")
     plots.length_flexibility(flexibility, results / "length_flexibility.png", metrics.ARTEFACT_THRESHOLD)

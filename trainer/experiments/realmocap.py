@@ -159,8 +159,7 @@ def point_agent_and_library(point_agent, runs, epochs, seed):
         try:
             installed = baselines.AgentMethod(INSTALLED_AGENT)
             training = installed.agent.metadata.get("training", {})
-            trained = behaviours.TRAINING_SETS.get(training.get("behaviour"), ())
-            if not training.get("untrained") and behaviours.POINT in trained:
+            if not training.get("untrained") and behaviours.POINT in installed.agent.behaviours:
                 return installed, clips
         except RLAnimateError as error:
             print(f"realmocap: not using the installed agent: {error}", file=sys.stderr)

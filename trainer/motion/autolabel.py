@@ -147,7 +147,11 @@ def label_clip(clip, behaviour):
     """Label an unlabelled MotionClip in place from its motion and return it: `behaviour` point or wave,
     either spelling (the user says which; the arm and the attributes come from the motion). This is what
     an `--autolabel` import or training path calls for a user's own clips."""
-    if behaviours.parse(behaviour) == behaviours.WAVE:
+    behaviour = behaviours.parse(behaviour)
+    if behaviour not in behaviours.KNOWN_KINDS:
+        raise RLAnimateError(f"Auto-labels read points and waves only, not {behaviour}: label the clips of "
+                             f"{behaviour} in a manifest (docs/TRAINING.md, \"Teach it a new gesture\").")
+    if behaviour == behaviours.WAVE:
         label = label_wave(clip.rotvecs, clip.fps)
         clip.behaviour, clip.arm = behaviours.WAVE, label.arm
         clip.exaggeration = clip.attributes = label.exaggeration

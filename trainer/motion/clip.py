@@ -3,6 +3,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from rlanimate_addon.core import behaviours, spaces
+
 
 @dataclass
 class MotionClip:
@@ -12,9 +14,10 @@ class MotionClip:
     fps: float
     rotvecs: np.ndarray  # (F, 15, 3) local rotation vectors of skeleton.ACTION_JOINTS
     fingers: dict = field(default_factory=dict)  # {canonical finger bone: (F, 3)}; empty without fingers
-    behaviour: str = None  # "POINT" or "WAVE"
+    behaviour: str = None  # the behaviour's id: "POINT", "WAVE", or a user's own ("BECKON")
+    kind: str = None  # behaviours.TARGET or INTENSITY; None for POINT and WAVE is their known kind
     arm: str = None  # "LEFT" or "RIGHT"
-    attributes: object = None  # POINT: unit vector (3,) from the arm's shoulder; WAVE: exaggeration
+    attributes: object = None  # target kind: unit vector (3,) from the arm's shoulder; intensity: exaggeration
     target: tuple = None
     exaggeration: float = None
     split: str = None  # "train" or "test"
@@ -27,6 +30,19 @@ class MotionClip:
     @property
     def frames(self):
         return len(self.rotvecs)
+
+    @property
+    def behaviour_kind(self):
+        """The clip's behaviours.TARGET or INTENSITY."""
+        return self.kind or behaviours.KNOWN_KINDS[self.behaviour]
+
+
+def library_space(clips):
+    """The ObjectiveSpace of every behaviour among labelled `clips` (an agent trained on them declares it):
+    the paper's (point and wave, Table 2's codes) for clips of point or wave alone, so that a one-behaviour
+    run labels its behaviour as the paper does and its agent plays beside the others."""
+    declared = behaviours.ordered(behaviours.Behaviour(c.behaviour, c.behaviour_kind) for c in clips)
+    return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 
 @dataclass

@@ -5,9 +5,13 @@ imported, and putting an entry's labels on its clip.
      "arm": "LEFT", "target": [x, y, z] or null, "direction": [ux, uy, uz] or null,
      "exaggeration": null or e, "frames": F, "fps": 30, "split": "train" or "test"}, ...]}
 
-`frames`, `fps` and `split` may be left out (a clip without a split is a training clip). An entry with
-a field of the wrong type or out of range is skipped with a note naming the manifest, the entry and the
-field, as a clip file that does not import is.
+`behaviour` is any name (a letter, then letters, digits or underscores): POINT and WAVE, or a gesture of
+the user's own ("beckon"). Its kind (core/behaviours.py) is the entry's "kind" ("target" or "intensity")
+when given, POINT's target and WAVE's intensity, else what the entry gives: a target behaviour's clip a
+"target" or "direction", an intensity behaviour's an "exaggeration" in [0, 1]. Every clip of one behaviour
+has the same kind. `frames`, `fps` and `split` may be left out (a clip without a split is a training
+clip). An entry with a field of the wrong type or out of range is skipped with a note naming the
+manifest, the entry and the field, as a clip file that does not import is.
 """
 import json
 import reprlib
@@ -32,7 +36,8 @@ class ManifestEntry:
     """One checked manifest entry: `number` is its place in the manifest's 'clips' list (from 1)."""
     number: int
     file: str
-    behaviour: str  # behaviours.POINT or WAVE
+    behaviour: str  # the behaviour's id ("POINT", "WAVE", "BECKON")
+    kind: str  # behaviours.TARGET or INTENSITY
     arm: str  # "LEFT" or "RIGHT"
     target: tuple = None  # (3,) in the character frame, or None
     direction: tuple = None  # (3,) unit vector, or None
@@ -78,10 +83,15 @@ def read_manifest(path):
 def checked_entries(manifest, path, default_fps):
     """(entries, problems): a ManifestEntry for every usable entry of `manifest` (read_manifest's), and
     one message per entry skipped, naming the manifest, the entry, the field and the fix."""
-    entries, problems = [], []
+    entries, problems, kinds = [], [], {}
     for number, raw in enumerate(manifest["clips"], start=1):
         try:
-            entries.append(_checked(number, raw, default_fps))
+            entry = _checked(number, raw, default_fps)
+            if kinds.setdefault(entry.behaviour, entry.kind) != entry.kind:
+                raise _EntryProblem(f"it is a {entry.kind} clip, but the manifest's earlier {entry.behaviour} clips "
+                                    f"are {kinds[entry.behaviour]} clips; give every clip of a behaviour the same "
+                                    f"kind.")
+            entries.append(entry)
         except _EntryProblem as problem:
             name = f" ({raw['file']!r})" if isinstance(raw, dict) and isinstance(raw.get("file"), str) else ""
             problems.append(f"{path}: entry {number}{name}: {problem} The entry is skipped.")
@@ -147,7 +157,12 @@ def _checked(number, raw, default_fps):
             and all(len(part.encode()) <= 255 for part in PurePath(file).parts)):
         raise _field("file", file, "give the clip's file name, relative to the manifest's folder (at most 255 "
                                    "bytes per folder or file name)")
-    behaviour = _label(raw, "behaviour", behaviours.BEHAVIOURS)
+    try:
+        behaviour = behaviours.parse(raw.get("behaviour"))
+    except RLAnimateError:
+        raise _field("behaviour", raw.get("behaviour"), "name the behaviour with a letter followed by letters, "
+                                                        "digits or underscores, such as POINT or BECKON") from None
+    kind = _kind(raw, behaviour)
     arm = _label(raw, "arm", skeleton.ARMS)
     frames = raw.get("frames")
     if frames is not None:
@@ -163,7 +178,7 @@ def _checked(number, raw, default_fps):
     if split not in SPLITS:
         raise _field("split", split, 'use "train" or "test" (or leave it out for a training clip)')
     target, direction, exaggeration = _vector(raw, "target"), _vector(raw, "direction"), None
-    if behaviour == behaviours.POINT:
+    if kind == behaviours.TARGET:
         if direction is not None:
             norm = float(np.linalg.norm(direction))
             if norm < 1e-6:
@@ -176,13 +191,31 @@ def _checked(number, raw, default_fps):
                 raise _field("target", raw["target"], "the target sits on the pointing shoulder: give one "
                                                            "away from the character") from None
         else:
-            raise _EntryProblem("a point clip needs a 'target' [x, y, z] or a 'direction' [ux, uy, uz]; add one.")
+            raise _EntryProblem(f"a {behaviours.key(behaviour)} clip (a target behaviour) needs a 'target' "
+                                "[x, y, z] or a 'direction' [ux, uy, uz]; add one.")
     else:
         exaggeration = raw.get("exaggeration")
         if not (_is_number(exaggeration) and 0.0 <= exaggeration <= 1.0):
-            raise _field("exaggeration", exaggeration, "a wave clip needs its exaggeration, a number from 0 to 1")
+            raise _field("exaggeration", exaggeration, f"a {behaviours.key(behaviour)} clip (an intensity behaviour) "
+                                                       "needs its exaggeration, a number from 0 to 1")
         exaggeration = float(exaggeration)
-    return ManifestEntry(number, file, behaviour, arm, target, direction, exaggeration, frames, float(fps), split)
+    return ManifestEntry(number, file, behaviour, kind, arm, target, direction, exaggeration, frames, float(fps),
+                         split)
+
+
+def _kind(raw, behaviour):
+    """The entry's behaviour kind: its "kind", the known kind of POINT and WAVE, else the one its fields give."""
+    if raw.get("kind") is not None:
+        if raw["kind"] not in behaviours.KINDS:
+            raise _field("kind", raw["kind"], f"use {' or '.join(map(repr, behaviours.KINDS))}, or leave it out")
+        return raw["kind"]
+    if behaviour in behaviours.KNOWN_KINDS:
+        return behaviours.KNOWN_KINDS[behaviour]
+    targeted = raw.get("target") is not None or raw.get("direction") is not None
+    if targeted == (raw.get("exaggeration") is not None):
+        raise _EntryProblem(f"the kind of {behaviour} is not given: add \"kind\": \"target\" with a 'target' or "
+                            "'direction', or \"kind\": \"intensity\" with an 'exaggeration'.")
+    return behaviours.TARGET if targeted else behaviours.INTENSITY
 
 
 def labelled(clip, entry, manifest_path):
@@ -192,9 +225,9 @@ def labelled(clip, entry, manifest_path):
         raise RLAnimateError(f"{entry.describe(manifest_path)}: the manifest's field 'frames' says {entry.frames}, "
                              f"but the clip {clip.source} has {clip.frames} frames. Correct 'frames' in the manifest, "
                              "or regenerate the clip library.")
-    clip.behaviour, clip.arm, clip.split = entry.behaviour, entry.arm, entry.split
+    clip.behaviour, clip.kind, clip.arm, clip.split = entry.behaviour, entry.kind, entry.arm, entry.split
     clip.target = entry.target
-    if entry.behaviour == behaviours.POINT:
+    if entry.kind == behaviours.TARGET:
         clip.attributes = np.asarray(entry.direction) if entry.direction is not None \
             else spaces.pointing_direction(entry.arm, entry.target)
     else:

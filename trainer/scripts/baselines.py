@@ -32,7 +32,7 @@ def sample_library_comparison(agent_path, manifest):
     references = ClipReferences(session.env)
     sets = {}
     for behaviour in ("point", "wave"):
-        clips = select_clips(session.test_clips, behaviour)
+        clips = select_clips(session.test_clips, (behaviours.parse(behaviour),))
         rows = {}
         for name, method in methods.items():
             motions = generate_for(method, clips)

@@ -4,15 +4,14 @@
     blender -b -P trainer/train.py -- [ARGS]      (Blender's Python finds torch through a venv of
                                                    the same minor version on PYTHONPATH; see README)
 
-With no arguments it trains the both-behaviour RLAnimate agent on the sample clip library into
-runs/default/. `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
+With no arguments it trains the RLAnimate agent of every behaviour of the sample clip library (point and
+wave) into runs/default/. `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
 report to docs/results/. Outputs: see trainer/experiments/run.py. `--resume` continues the run in --output
 from its checkpoint with the run's own settings; the continuation equals the uninterrupted run.
 """
 import argparse
 from pathlib import Path
 
-from rlanimate_addon.core.behaviours import TRAINING_SETS
 from trainer.agent.models import VARIANTS
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
@@ -26,7 +25,9 @@ def build_parser():
     resumed run its checkpoint's values."""
     defaults = NEW_RUN_DEFAULTS
     parser = argparse.ArgumentParser(prog="trainer/train.py", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--behaviour", choices=TRAINING_SETS, help=f"default {defaults['behaviour']}")
+    parser.add_argument("--behaviour", help="the behaviours to learn: all (every behaviour of the clip library), "
+                                             "both (point and wave), one behaviour (point), or several joined by "
+                                             f"commas (point,beckon); default {defaults['behaviour']}")
     parser.add_argument("--clips", help="clip library: a manifest.json or the folder that holds one "
                                         "(default sample_rigs/clips)")
     parser.add_argument("--epochs", type=int,

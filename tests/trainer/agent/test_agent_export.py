@@ -102,6 +102,13 @@ def test_the_shipped_agent_is_what_the_readme_run_exports_and_names_no_machine_p
         "evaluation": shipped["evaluation"]})
     for metadata in (written, shipped):
         metadata["training"] = {k: v for k, v in metadata["training"].items() if k not in ("git_commit", "date")}
+    # The shipped file is format 3, which declares no behaviours: it holds point and wave, as exported now.
+    assert (shipped["format_version"], written["format_version"]) == (3, agent_file.FORMAT_VERSION)
+    assert written.pop("behaviours") == [{"name": "POINT", "kind": "target"}, {"name": "WAVE", "kind": "intensity"}]
+    assert shipped["spaces"].pop("behaviour_type") == {"POINT": 1.0, "WAVE": 2.0}
+    assert written["spaces"].pop("behaviour_labels") == {"POINT": [1.0], "WAVE": [2.0]}  # the same type codes
+    assert shipped["spaces"].pop("behaviours") == ["POINT", "WAVE"]  # now the file's own `behaviours`
+    written["format_version"] = shipped["format_version"]
     assert written == shipped
     with np.load(path) as new, np.load(INSTALLED_AGENT) as old:
         assert new.files == old.files

@@ -84,9 +84,10 @@ def library():
 
 
 def test_training_both_draws_one_clip_per_behaviour(library):
-    groups = clips_for_behaviour(library.train, "both")
+    groups = clips_for_behaviour(library.train, "both", spaces.PAPER_SPACE)
     assert [{c.behaviour for c in g} for g in groups] == [{"POINT"}, {"WAVE"}]
-    assert len(clips_for_behaviour(library.train, "wave")) == 1
+    assert len(clips_for_behaviour(library.train, "wave", spaces.PAPER_SPACE)) == 1
+    assert len(clips_for_behaviour(library.train, "all", spaces.PAPER_SPACE)) == 2
 
 
 def test_collect_stores_real_descriptions_and_clip_motion(env, library):
@@ -100,7 +101,7 @@ def test_collect_stores_real_descriptions_and_clip_motion(env, library):
         imitated = k < 2
         assert np.all(episode["imitate"] == float(imitated))
         if imitated:
-            np.testing.assert_allclose(episode["objective"], clip_objective(clip), atol=1e-6)
+            np.testing.assert_allclose(episode["objective"], clip_objective(spaces.PAPER_SPACE, clip), atol=1e-6)
         else:  # a random target, timed like the clip
             assert len(episode["objective"]) == len(clip.rotvecs) and np.all(episode["objective"][:, 0] == 1.0)
             direction = episode["objective"][0, 3:6]

@@ -16,7 +16,7 @@ torch.set_num_threads(1)
 def synthetic_batch(chunks, length, seed=0):
     """Chunks whose clip pose and description are smooth functions of the objective (learnable)."""
     generator = torch.Generator().manual_seed(seed)
-    objective = torch.zeros(chunks, length, spaces.OBJECTIVE_SIZE)
+    objective = torch.zeros(chunks, length, spaces.PAPER_SPACE.size)
     objective[..., 0] = torch.randint(1, 3, (chunks, 1), generator=generator).float()
     objective[..., 1] = torch.randint(0, 2, (chunks, 1), generator=generator).float()
     objective[..., 2] = 1.0 - objective[..., 1]
@@ -36,7 +36,7 @@ def test_parameters_match_the_agent_file_layout(variant):
     config, _ = load_preset("debug")
     agent = RLAnimateAgent(config, variant)
     shapes = {name: tuple(t.shape) for name, t in agent.state_dict().items()}
-    expected = {name: tuple(s) for name, s in agent_file.expected_weight_shapes(config.to_dict(), variant).items()}
+    expected = {name: tuple(s) for name, s in agent_file.expected_weight_shapes(config.to_dict(), variant, agent.space.size).items()}
     assert shapes == expected
 
 

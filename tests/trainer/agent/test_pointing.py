@@ -19,7 +19,7 @@ def test_the_torch_finger_matches_the_numpy_forward_kinematics():
 
 def _pointing_clip(arm, target, seed=4):
     clip = gs.synthesise(gs.GestureSpec("POINT", arm, target=target, seed=seed))
-    objective = spaces.make_objective("POINT", arm, spaces.pointing_direction(arm, target), clip.frames)
+    objective = spaces.PAPER_SPACE.make_objective("POINT", arm, spaces.pointing_direction(arm, target), clip.frames)
     return clip, objective
 
 
@@ -41,7 +41,7 @@ def test_a_clip_is_on_target_exactly_where_it_holds_and_a_turned_arm_misses_by_i
 
 
 def test_a_wave_has_no_hold_and_the_error_has_a_gradient():
-    objective = spaces.make_objective("WAVE", "LEFT", 0.5, 20)
+    objective = spaces.PAPER_SPACE.make_objective("WAVE", "LEFT", 0.5, 20)
     assert not pointing.hold_frames(objective, np.zeros((20, spaces.DESCRIPTION_SIZE))).any()
     _, point = _pointing_clip("LEFT", (1.5, -2.0, 1.0))
     actions = torch.full((len(point), spaces.ACTION_SIZE), 0.5, dtype=torch.float64, requires_grad=True)
@@ -53,7 +53,7 @@ def test_the_wrist_term_is_the_squared_wrist_distance_on_each_frames_own_arm():
     rotvecs = np.random.default_rng(1).normal(0.0, 0.4, (8, 15, 3))
     bounds = torch.tensor(spaces.DEFAULT_ACTION_BOUNDS)
     motion = torch.tensor(spaces.encode_action(rotvecs))
-    objective = torch.tensor(np.vstack([spaces.make_objective("WAVE", arm, 0.5, 4) for arm in skeleton.ARMS]))
+    objective = torch.tensor(np.vstack([spaces.PAPER_SPACE.make_objective("WAVE", arm, 0.5, 4) for arm in skeleton.ARMS]))
     assert wrist_error(motion, motion, objective, bounds).abs().max() < 1e-12
     turned = rotvecs.copy()
     turned[:, skeleton.ACTION_JOINTS.index("LeftForeArm")] += (0.0, 0.0, 0.2)

@@ -265,8 +265,8 @@ def test_load_clip_set_attaches_the_manifest_labels_and_split(library, tmp_path)
     assert (point.behaviour, point.arm, wave.behaviour, wave.arm) == ("POINT", "LEFT", "WAVE", "RIGHT")
     np.testing.assert_allclose(point.attributes, spaces.pointing_direction("LEFT", target))
     assert wave.attributes == wave.exaggeration == 0.35
-    objective = spaces.make_objective(point.behaviour, point.arm, point.attributes, point.frames)
-    assert objective.shape == (FRAMES, spaces.OBJECTIVE_SIZE)
+    objective = spaces.PAPER_SPACE.make_objective(point.behaviour, point.arm, point.attributes, point.frames)
+    assert objective.shape == (FRAMES, spaces.PAPER_SPACE.size)
 
 
 def count_imports(monkeypatch):

@@ -17,12 +17,14 @@ torch.set_num_threads(1)
 class ReplayAgent(torch.nn.Module):
     """Answers each clip's objectives with the clip's own motion, plus optional per-frame noise."""
 
+    space = spaces.PAPER_SPACE
+
     def __init__(self, clips, noise=0.0):
         super().__init__()
         rng = np.random.default_rng(0)
         self.motions = {}
         for clip in clips:
-            key = torch.as_tensor(clip_objective(clip), dtype=torch.float32).numpy().tobytes()
+            key = torch.as_tensor(clip_objective(spaces.PAPER_SPACE, clip), dtype=torch.float32).numpy().tobytes()
             motion = spaces.encode_action(clip.rotvecs)
             self.motions[key] = np.clip(motion + noise * rng.standard_normal(motion.shape), 0, 1)
 
@@ -41,11 +43,11 @@ def library():
 
 
 def test_select_clips_spreads_and_balances(library):
-    assert scoring.select_clips(library.test, "point") == [c for c in library.test if c.behaviour == "POINT"]
-    chosen = scoring.select_clips(library.train, "both", 5)
+    assert scoring.select_clips(library.test, ("POINT",)) == [c for c in library.test if c.behaviour == "POINT"]
+    chosen = scoring.select_clips(library.train, ("POINT", "WAVE"), 5)
     assert [c.behaviour for c in chosen].count("POINT") == 3 and len(chosen) == 5
     points = [c for c in library.train if c.behaviour == "POINT"]
-    assert scoring.select_clips(library.train, "point", 2) == [points[0], points[-1]]
+    assert scoring.select_clips(library.train, ("POINT",), 2) == [points[0], points[-1]]
 
 
 def test_a_replayed_clip_scores_100_and_noise_lowers_score_and_smoothness(env, library):
@@ -79,7 +81,7 @@ def test_length_flexibility_rolls_out_each_scaled_length(env, library):
         assert all(0.0 <= value <= 100.0 for value in by_scale.values())
     waves = [c for c in library.test if c.behaviour == "WAVE"]
     mean_length = np.mean([len(c.rotvecs) for c in library.train if c.behaviour == "WAVE"])
-    objectives = [clip_objective(c, int(round(1.5 * mean_length))) for c in waves]
+    objectives = [clip_objective(spaces.PAPER_SPACE, c, int(round(1.5 * mean_length))) for c in waves]
     positions = [spaces.description_joint_positions(d) for d in scoring.generate_descriptions(agent, env, objectives)]
     assert [len(p) for p in positions] == [int(round(1.5 * mean_length))] * len(waves)
     assert result["wave"]["1.5"] == pytest.approx(np.mean([metrics.smoothness(p) for p in positions]))

@@ -26,7 +26,7 @@ def test_a_library_without_held_out_clips_trains_to_an_agent(session, tmp_path, 
     settings = RunSettings(output=str(output), preset="debug", epochs=2, eval_every=eval_every, seed=1,
                            progress=False)
     report, trainer = train(settings, session)
-    assert "note: the library has no held-out both clips (split \"test\")" in capsys.readouterr().err
+    assert "note: the library has no held-out point or wave clips (split \"test\")" in capsys.readouterr().err
     assert trainer.epoch == 2 and report["held_out"] is None
     assert len(report["training"]["clips"]) == 10  # SEEN_CLIP_COUNT of the 12 training clips
     agent = runtime.load_agent(output / "agent.npz")

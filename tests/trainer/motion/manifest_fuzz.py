@@ -16,8 +16,9 @@ import traceback
 
 import numpy as np
 
-from rlanimate_addon.core import spaces
+from rlanimate_addon.core.behaviours import TARGET
 from rlanimate_addon.core.errors import RLAnimateError
+from trainer.motion.clip import library_space
 from trainer.paths import DEFAULT_MANIFEST
 
 FIELDS = ("file", "behaviour", "arm", "target", "direction", "exaggeration", "frames", "fps", "split")
@@ -135,11 +136,11 @@ def _label_failure(clip):
     """Why an accepted clip's labels cannot train (None when they can): its objective must be finite."""
     if clip.split not in ("train", "test"):
         return f"split {clip.split!r}"
-    if clip.behaviour == "POINT":
+    if clip.behaviour_kind == TARGET:  # a mutated name is another behaviour, of the kind its fields give
         direction = np.asarray(clip.attributes, dtype=np.float64)
         if direction.shape != (3,) or not math.isclose(float(np.linalg.norm(direction)), 1.0, rel_tol=1e-6):
             return f"pointing direction {clip.attributes!r}"
     elif not (isinstance(clip.attributes, float) and 0.0 <= clip.attributes <= 1.0):
         return f"exaggeration {clip.attributes!r}"
-    objective = spaces.make_objective(clip.behaviour, clip.arm, clip.attributes, clip.frames)
+    objective = library_space([clip]).make_objective(clip.behaviour, clip.arm, clip.attributes, clip.frames)
     return None if np.all(np.isfinite(objective)) else "an objective that is not finite"

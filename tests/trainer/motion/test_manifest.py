@@ -46,7 +46,8 @@ def check(path):
     ({**WAVE, "exaggeration": "big"}, "exaggeration", "'big'", "a number from 0 to 1"),
     ({**WAVE, "exaggeration": 1e300}, "exaggeration", "1e+300", "a number from 0 to 1"),
     ({**WAVE, "exaggeration": None}, "exaggeration", "null", "a number from 0 to 1"),
-    ({**WAVE, "behaviour": "DANCE"}, "behaviour", "'DANCE'", "use POINT or WAVE"),
+    ({**WAVE, "behaviour": "2 hands"}, "behaviour", "'2 hands'", "a letter followed by letters, digits or underscores"),
+    ({**WAVE, "behaviour": "DANCE", "kind": "rhythm"}, "kind", "'rhythm'", "use 'target' or 'intensity'"),
     ({**WAVE, "arm": 1}, "arm", "1", "use LEFT or RIGHT"),
     ({**WAVE, "split": "validation"}, "split", "'validation'", 'use "train" or "test"'),
     ({**WAVE, "file": 7}, "file", "7", "give the clip's file name"),
@@ -72,7 +73,7 @@ def test_an_entry_that_is_not_an_object_is_skipped_with_how_to_write_one(tmp_pat
 
 def test_a_point_without_target_or_direction_is_skipped(tmp_path):
     entries, (problem,) = check(write(tmp_path, [{**POINT, "target": None}]))
-    assert entries == [] and "a point clip needs a 'target' [x, y, z] or a 'direction'" in problem
+    assert entries == [] and "a point clip (a target behaviour) needs a 'target' [x, y, z] or a 'direction'" in problem
 
 
 @pytest.mark.parametrize("text, reason", [
@@ -115,7 +116,7 @@ def test_labels_of_checked_entries_make_finite_objectives(tmp_path):
     assert problems == []
     for entry in entries:
         clip = labelled(MotionClip(entry.file, entry.file, 30.0, np.zeros((40, 15, 3))), entry, "manifest.json")
-        objective = spaces.make_objective(clip.behaviour, clip.arm, clip.attributes, clip.frames)
+        objective = spaces.PAPER_SPACE.make_objective(clip.behaviour, clip.arm, clip.attributes, clip.frames)
         assert np.all(np.isfinite(objective))
     np.testing.assert_allclose(labelled(MotionClip("d", "d", 30.0, np.zeros((40, 15, 3))), entries[2], "m").attributes,
                                [0, -0.6, 0.8])

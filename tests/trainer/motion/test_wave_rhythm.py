@@ -48,5 +48,5 @@ def test_a_clip_without_a_swing_has_no_rhythm_and_a_still_objective():
     clip.rotvecs = np.repeat(clip.rotvecs[:1], clip.frames, axis=0)  # the first pose, held
     clip.attributes = 0.5
     assert wave_rhythm.clip_rhythm(clip) is None
-    objective = clip_objective(clip)
+    objective = clip_objective(spaces.PAPER_SPACE, clip)
     assert np.all(objective[:, spaces.OBJECTIVE_ATTRIBUTES][:, 1:] == 0.0)  # the rhythm signals: no swing

@@ -39,7 +39,7 @@ def test_train_cli_writes_an_agent_report_and_plots_that_load(tiny_library, tmp_
 
     agent = runtime.load_agent(output / "agent.npz")  # numpy only: no torch, no pickle
     clip = load_clip_set(tiny_library).test[0]
-    actions = agent.rollout(clip_objective(clip))
+    actions = agent.rollout(clip_objective(agent.space, clip))
     assert actions.shape == (len(clip.rotvecs), 45) and np.all((actions >= 0) & (actions <= 1))
 
 

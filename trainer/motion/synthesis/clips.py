@@ -135,8 +135,8 @@ def _synthesise_wave(spec, style):
 
 def synthesise(spec):
     """GestureClip for a GestureSpec; raises RLAnimateError for an unusable spec."""
-    if spec.behaviour not in behaviours.BEHAVIOURS:
-        raise RLAnimateError(f"Unknown behaviour {spec.behaviour!r}: use POINT or WAVE.")
+    if spec.behaviour not in behaviours.KNOWN_KINDS:
+        raise RLAnimateError(f"The generator has no {spec.behaviour!r} gesture: use POINT or WAVE.")
     if spec.arm not in skeleton.ARMS:
         raise RLAnimateError(f"Unknown arm {spec.arm!r}: use LEFT or RIGHT.")
     style = draw_style(spec.seed)

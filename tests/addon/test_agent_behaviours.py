@@ -1,0 +1,104 @@
+"""The panel's behaviours are the selected agent's: the Behaviour enum lists them (POINT and WAVE keep their
+ids), a stored choice survives a change of agent, the panel shows Target or Exaggeration by the behaviour's
+kind, and Generate bakes a behaviour the agent declares beyond point and wave (tests/addon/declared_agents.py
+widens the shipped agent to four behaviours with numpy alone, so this runs on Blender 4.2 and 5.0)."""
+import addon_helpers
+import bpy
+import declared_agents
+import numpy as np
+import pytest
+from test_registration import RecordingLayout, _draw
+
+from rlanimate_addon.blender import gestures, preferences, properties
+
+ADDED = [("BECKON", "target"), ("RAISE_HAND", "intensity")]
+
+
+@pytest.fixture
+def four(settings, tmp_path):
+    """Scene.rlanimate with a four-behaviour agent file written (not yet selected); returns its path."""
+    path = tmp_path / "four.npz"
+    declared_agents.widened_agent(path, ADDED)
+    return settings, path
+
+
+def _listed(settings):
+    return [item[0] for item in properties.behaviour_items(settings, bpy.context)]
+
+
+def _shown(settings):
+    return {call[2] for call in _draw(settings) if call[0] == "prop"}
+
+
+def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survives_a_change_of_agent(four):
+    settings, path = four
+    preferences = addon_helpers.addon_preferences()
+    assert _listed(settings) == ["POINT", "WAVE"] and settings.behaviour == "POINT"
+    preferences.agent_path = str(path)
+    assert _listed(settings) == ["POINT", "WAVE", "BECKON", "RAISE_HAND"]
+    settings.behaviour = "BECKON"
+    assert settings.behaviour == "BECKON"
+    preferences.agent_path = ""  # the bundled agent has no Beckon: the choice is kept, not replaced
+    assert properties.chosen_behaviour(settings, bpy.context) == ""
+    with pytest.raises(TypeError, match='enum "BECKON" not found'):
+        settings.behaviour = "BECKON"
+    errors = " ".join(c[1].get("text", "") for c in _draw(settings) if c[0] == "label" and c[1].get("icon") == "ERROR")
+    assert "not one of this agent's (Point, Wave): pick one above" in errors
+    with pytest.raises(RuntimeError, match="The selected agent performs Point, Wave, not the behaviour chosen"):
+        addon_helpers.generate(addon_helpers.load_sample_rig(), settings)
+    preferences.agent_path = str(path)
+    assert settings.behaviour == "BECKON", "the same behaviour again with the agent that has it"
+    settings.behaviour = "WAVE"
+    preferences.agent_path = ""
+    assert settings.behaviour == "WAVE", "Point and Wave keep their values across agents"
+
+
+def test_preferences_name_the_chosen_agents_behaviours(four):
+    settings, path = four
+
+    def labels():
+        layout = RecordingLayout()
+        preferences.RLANIMATE_AP_preferences.draw(type("PreferencesStandIn", (), {"layout": layout})(), bpy.context)
+        return [call[1].get("text", "") for call in layout.calls if call[0] == "label"]
+
+    assert "Behaviours: Point, Wave" in labels()
+    addon_helpers.addon_preferences().agent_path = str(path)
+    assert "Behaviours: Point, Wave, Beckon, Raise Hand" in labels()
+
+
+def test_the_panel_shows_target_for_a_target_behaviour_and_exaggeration_for_an_intensity_one(four):
+    settings, path = four
+    addon_helpers.addon_preferences().agent_path = str(path)
+    settings.behaviour = "BECKON"
+    shown = _shown(settings)
+    assert "target" in shown and "exaggeration" not in shown
+    assert "exact_aim" not in shown, "Exact Aim lays the index finger on the target: Point's alone"
+    settings.behaviour = "RAISE_HAND"
+    shown = _shown(settings)
+    assert "exaggeration" in shown and "target" not in shown
+
+
+def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviours_target(four):
+    settings, path = four
+    addon_helpers.addon_preferences().agent_path = str(path)
+    rig = addon_helpers.load_sample_rig()
+    with pytest.raises(RuntimeError, match="Beckon needs a target"):
+        addon_helpers.generate(rig, settings, behaviour="BECKON", arm="RIGHT")
+    target = addon_helpers.add_empty("Target", (-1.5, -2.0, 1.6))
+    frames = np.arange(1, 91)
+    assert addon_helpers.generate(rig, settings, behaviour="BECKON", arm="RIGHT", target=target, start_frame=1,
+                                  frame_count=90) == {"FINISHED"}
+    beckon = gestures.last_targeted(rig)
+    assert beckon is not None and beckon.record["kind"] == "target" and beckon.record["behaviour"] == "BECKON"
+    assert beckon.action.name.startswith("RLAnimate Beckon Right")
+    aimed = np.reshape(beckon.record["aimed_at"], (-1, 3))
+    assert len(aimed) == len(frames) and np.allclose(aimed, aimed[0])
+    hand = addon_helpers.rig_bone(rig, "RightHand")
+    travel = np.linalg.norm(addon_helpers.bone_heads(rig, [hand], frames)[:, 0] - addon_helpers.bone_heads(
+        rig, [hand], frames[:1])[0, 0], axis=1).max()
+    assert travel > 0.1, f"the hand moves ({travel:.3f} m)"
+    assert addon_helpers.generate(rig, settings, behaviour="RAISE_HAND", arm="LEFT", exaggeration=0.9,
+                                  start_frame=200, frame_count=80) == {"FINISHED"}
+    raised = gestures.placed_gestures(rig)[0]
+    assert (raised.record["behaviour"], raised.record["kind"]) == ("RAISE_HAND", "intensity")
+    assert gestures.last_targeted(rig).action == beckon.action, "Follow Target follows the target behaviour"
