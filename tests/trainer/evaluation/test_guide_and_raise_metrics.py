@@ -39,11 +39,10 @@ def _raise(rotvecs, planned, reference):
 
 
 def _class_mean(library, behaviour, arm, frames):
-    """The per-frame mean of the behaviour's training clips of the arm (the ClassMean baseline, which groups by
-    label only: the clips are handed to it under the POINT label the baseline accepts today)."""
-    group = [MotionClip(name=p.file, source=p.file, fps=30.0, rotvecs=r, behaviour=POINT, arm=arm)
+    """The per-frame mean of the behaviour's training clips of the arm (the ClassMean baseline)."""
+    group = [MotionClip(name=p.file, source=p.file, fps=30.0, rotvecs=r, behaviour=behaviour, arm=arm)
              for p, r in _of(library, behaviour, arm, "train")]
-    return baselines.ClassMean(group).generate(POINT, arm, None, frames)
+    return baselines.ClassMean(group).generate(behaviour, arm, None, frames)
 
 
 def test_every_generated_guide_passes_with_an_upturned_palm_towards_the_target(library):
