@@ -242,6 +242,19 @@ def _degrees_between(a, b):
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
+def free_arm_rise(positions, arm):
+    """How far (in its own arm lengths) the *other* arm's wrist rises above its first frame at its highest:
+    near 0 when only `arm` gestures, about 1 when both hands go up."""
+    p = _positions(positions)
+    other = "RIGHT" if _side(arm) == "left" else "LEFT"
+    wrist = p[:, _JOINT[f"{other.lower()}_wrist"], 2]
+    return float((wrist.max() - wrist[0]) / arm_length(p, other))
+
+
+#: A one-armed gesture leaves the other arm down: its wrist rises at most this many arm lengths.
+FREE_ARM_RISE = 0.1
+
+
 def _hold_or_apex(p, arm, fps):
     """(frames, hold_s): the frames of the pointing hold (hold_run) and its length in seconds, or the apex
     alone (the finger base farthest from its start) and 0 when there is no hold."""
@@ -257,7 +270,7 @@ def guide_measures(positions, finger_direction, palm, arm, target, fps=FPS):
     {'heading_error' (degrees between the finger's and the target's directions seen from above, the
     target's from the first frame's shoulder joint), 'palm_up' (degrees of the palm normal from
     straight up), 'reach' (the wrist's horizontal distance from the shoulder joint, in arm lengths),
-    'extension' (shoulder-to-wrist distance in arm lengths), 'hold_s'}.
+    'extension' (shoulder-to-wrist distance in arm lengths), 'hold_s', 'free_arm_rise'}.
     finger_direction, palm: (F, 3) per frame (`finger_direction`, `palm_normal`)."""
     p, side = _positions(positions), _side(arm)
     frames, hold_s = _hold_or_apex(p, arm, fps)
@@ -269,12 +282,13 @@ def guide_measures(positions, finger_direction, palm, arm, target, fps=FPS):
     offset = (wrist - shoulder)[frames]
     return {"heading_error": float(np.median(heading)), "palm_up": float(np.median(palm_up)),
             "reach": float(np.median(np.linalg.norm(offset[:, :2], axis=1))) / length,
-            "extension": float(np.median(np.linalg.norm(offset, axis=1))) / length, "hold_s": hold_s}
+            "extension": float(np.median(np.linalg.norm(offset, axis=1))) / length, "hold_s": hold_s,
+            "free_arm_rise": free_arm_rise(p, arm)}
 
 
 #: A "this way" gesture: the fingers head within GUIDE_HEADING_DEG of the target seen from above, the
 #: palm is within GUIDE_PALM_UP_DEG of facing up, the wrist is out GUIDE_REACH arm lengths, held
-#: GUIDE_MIN_HOLD_S or more.
+#: GUIDE_MIN_HOLD_S or more, the other arm left down (FREE_ARM_RISE).
 GUIDE_HEADING_DEG = 20.0
 GUIDE_PALM_UP_DEG = 65.0
 GUIDE_REACH = 0.5
@@ -284,7 +298,8 @@ GUIDE_MIN_HOLD_S = 0.4
 def guide_accepted(measures):
     """Whether `guide_measures` show a "this way" towards the target (the bounds above)."""
     return bool(measures["heading_error"] <= GUIDE_HEADING_DEG and measures["palm_up"] <= GUIDE_PALM_UP_DEG
-                and measures["reach"] >= GUIDE_REACH and measures["hold_s"] >= GUIDE_MIN_HOLD_S)
+                and measures["reach"] >= GUIDE_REACH and measures["hold_s"] >= GUIDE_MIN_HOLD_S
+                and measures["free_arm_rise"] <= FREE_ARM_RISE)
 
 
 def raise_measures(positions, arm, fps=FPS):
@@ -292,7 +307,8 @@ def raise_measures(positions, arm, fps=FPS):
     raised hold; the highest frame's without one), 'height_arm' (the same in arm lengths),
     'forearm_from_vertical' (degrees of elbow-to-wrist from straight up, over the same frames),
     'hold_s' (the longest run of frames with the hand up and the wrist slower than HOLD_SPEED shoulder
-    widths per second), 'strokes' (side-to-side strokes while the hand is up, as a wave counts them)}."""
+    widths per second), 'strokes' (side-to-side strokes while the hand is up, as a wave counts them),
+    'free_arm_rise'}."""
     p, side = _positions(positions), _side(arm)
     shoulder, elbow, wrist = (p[:, _JOINT[f"{side}_{j}"]] for j in ("shoulder", "elbow", "wrist"))
     length, width = arm_length(p, arm), shoulder_width(p)
@@ -306,12 +322,14 @@ def raise_measures(positions, arm, fps=FPS):
     height = float(np.median(above[frames]))
     return {"height": height, "height_arm": height / length,
             "forearm_from_vertical": float(np.median(_degrees_between((wrist - elbow)[frames], [0.0, 0.0, 1.0]))),
-            "hold_s": 0.0 if hold is None else (hold[1] - hold[0] + 1) / fps, "strokes": strokes}
+            "hold_s": 0.0 if hold is None else (hold[1] - hold[0] + 1) / fps, "strokes": strokes,
+            "free_arm_rise": free_arm_rise(p, arm)}
 
 
 #: A raised hand: held RAISE_MIN_HOLD_S or more with the wrist above the shoulder, the forearm within
 #: RAISE_FOREARM_DEG of vertical, no wave (at most RAISE_MAX_STROKES side-to-side strokes: the raise and
-#: the lowering), and the height within RAISE_HEIGHT_ERROR arm lengths of the reference's.
+#: the lowering), the height within RAISE_HEIGHT_ERROR arm lengths of the reference's, and the other arm left
+#: down (FREE_ARM_RISE).
 RAISE_MIN_HOLD_S = 0.5
 RAISE_FOREARM_DEG = 30.0
 RAISE_MAX_STROKES = 3
@@ -330,7 +348,7 @@ def raise_accepted(comparison):
     gen = comparison["generated"]
     return bool(gen["hold_s"] >= RAISE_MIN_HOLD_S and gen["height"] > 0.0
                 and gen["forearm_from_vertical"] <= RAISE_FOREARM_DEG and gen["strokes"] <= RAISE_MAX_STROKES
-                and comparison["height_error"] <= RAISE_HEIGHT_ERROR)
+                and comparison["height_error"] <= RAISE_HEIGHT_ERROR and gen["free_arm_rise"] <= FREE_ARM_RISE)
 
 
 def raise_lower(generated, reference, arm):

@@ -125,3 +125,23 @@ def test_the_wrong_behaviour_fails(library, behaviour, wrong):
                     assert not bm.guide_accepted(measures) and measures["palm_up"] > 80.0
                 else:
                     assert not bm.raise_accepted(_raise(answer, planned, rotvecs))
+
+
+@pytest.mark.parametrize("behaviour", [GUIDE, RAISE_HAND])
+def test_both_hands_at_once_fail_and_the_generators_free_arm_stays_down(library, behaviour):
+    """A right-arm request answered with the gesture on both arms (the left arm's clip of the same index laid
+    over the free arm) passes on the gesturing arm alone; the free arm's rise fails it."""
+    left = _of(library, behaviour, "LEFT")
+    for k, (planned, rotvecs) in enumerate(_of(library, behaviour, "RIGHT")):
+        both = rotvecs.copy()
+        mirrored = baselines.time_warp(left[k][1], len(rotvecs))
+        lefts = [j for j, name in enumerate(skeleton.ACTION_JOINTS) if name.startswith("Left")]
+        both[:, lefts] = mirrored[:, lefts]
+        if behaviour == GUIDE:
+            own, doubled = _guide(rotvecs, planned), _guide(both, planned)
+            assert bm.guide_accepted(own) and own["free_arm_rise"] < 0.05
+            assert doubled["free_arm_rise"] > 0.3 and not bm.guide_accepted(doubled), planned.file
+        else:
+            own, doubled = _raise(rotvecs, planned, rotvecs), _raise(both, planned, rotvecs)
+            assert bm.raise_accepted(own) and own["generated"]["free_arm_rise"] < 0.05
+            assert doubled["generated"]["free_arm_rise"] > 1.0 and not bm.raise_accepted(doubled), planned.file
