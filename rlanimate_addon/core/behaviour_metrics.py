@@ -1,4 +1,5 @@
-"""Behaviour metrics: does a generated gesture wave, point, raise and lower the arm like its reference?
+"""Behaviour metrics: does a generated gesture wave, point, guide ("this way"), raise a hand, raise and lower
+the arm like its reference?
 
 The paper's score (core.metrics) is dominated by joints that barely move and leans on each clip's own
 timing, so a still arm or a class mean scores close to a real wave. These measures read what an
@@ -13,6 +14,10 @@ STROKE_FRACTION x shoulder width (each stroke moves at least that far); a full c
 Point: the finger line (index base b, unit direction f) against the target T; the *hold* is the
 longest run of frames in which b moves slower than HOLD_SPEED shoulder widths per second and is at
 least half its largest distance from its first position.
+Guide ("this way"), over the same hold: the fingers head towards the target seen from above, the palm
+(`palm_normal`) faces up, the wrist is out from the shoulder. Raise hand: held with the hand up and the
+wrist still, the forearm near vertical, no side-to-side strokes beyond the raise and the lowering, and
+the wrist as high above the shoulder as the reference's.
 """
 import numpy as np
 
@@ -219,6 +224,133 @@ def point_measures(positions, finger_direction, arm, target, fps=FPS):
     return {"angle": float(np.median(angles)), "hold_s": (last - first + 1) / fps}
 
 
+def palm_normal(descriptions, arm):
+    """(F, 3) unit normal out of the arm's palm, from descriptions (F, 42): the palm's plane holds the
+    wrist, the index base and the index direction (on a human hand the index base sits to the thumb
+    side of the wrist's line, 14 degrees off the finger on the sample rig), so no hand rotation is needed."""
+    positions = spaces.description_joint_positions(np.asarray(descriptions, dtype=np.float64))
+    side, sign = _side(arm), 1.0 if arm == "LEFT" else -1.0
+    across = positions[..., _JOINT[f"{side}_index_base"], :] - positions[..., _JOINT[f"{side}_wrist"], :]
+    normal = -sign * np.cross(across, finger_direction(descriptions, arm))
+    return normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+
+
+def _degrees_between(a, b):
+    """(F,) degrees between the vectors a (F, 3) and b ((F,) 3)."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    cosine = np.sum(a * b, axis=-1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
+    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+
+
+def free_arm_rise(positions, arm):
+    """How far (in its own arm lengths) the *other* arm's wrist rises above its first frame at its highest:
+    near 0 when only `arm` gestures, about 1 when both hands go up."""
+    p = _positions(positions)
+    other = "RIGHT" if _side(arm) == "left" else "LEFT"
+    wrist = p[:, _JOINT[f"{other.lower()}_wrist"], 2]
+    return float((wrist.max() - wrist[0]) / arm_length(p, other))
+
+
+#: A one-armed gesture leaves the other arm down: its wrist rises at most this many arm lengths.
+FREE_ARM_RISE = 0.1
+
+
+def _hold_or_apex(p, arm, fps):
+    """(frames, hold_s): the frames of the pointing hold (hold_run) and its length in seconds, or the apex
+    alone (the finger base farthest from its start) and 0 when there is no hold."""
+    hold = hold_run(p, arm, fps)
+    if hold is None:
+        base = p[:, _JOINT[f"{_side(arm)}_index_base"]]
+        return np.array([int(np.argmax(np.linalg.norm(base - base[0], axis=1)))]), 0.0
+    return np.arange(hold[0], hold[1] + 1), (hold[1] - hold[0] + 1) / fps
+
+
+def guide_measures(positions, finger_direction, palm, arm, target, fps=FPS):
+    """What a "this way" gesture shows, as medians over its hold (the apex without one):
+    {'heading_error' (degrees between the finger's and the target's directions seen from above, the
+    target's from the first frame's shoulder joint), 'palm_up' (degrees of the palm normal from
+    straight up), 'reach' (the wrist's horizontal distance from the shoulder joint, in arm lengths),
+    'extension' (shoulder-to-wrist distance in arm lengths), 'hold_s', 'free_arm_rise'}.
+    finger_direction, palm: (F, 3) per frame (`finger_direction`, `palm_normal`)."""
+    p, side = _positions(positions), _side(arm)
+    frames, hold_s = _hold_or_apex(p, arm, fps)
+    shoulder, wrist = p[:, _JOINT[f"{side}_shoulder"]], p[:, _JOINT[f"{side}_wrist"]]
+    length = arm_length(p, arm)
+    to_target = np.asarray(target, dtype=np.float64) - shoulder[0]
+    heading = _degrees_between(np.asarray(finger_direction)[frames, :2], to_target[:2])
+    palm_up = _degrees_between(np.asarray(palm)[frames], [0.0, 0.0, 1.0])
+    offset = (wrist - shoulder)[frames]
+    return {"heading_error": float(np.median(heading)), "palm_up": float(np.median(palm_up)),
+            "reach": float(np.median(np.linalg.norm(offset[:, :2], axis=1))) / length,
+            "extension": float(np.median(np.linalg.norm(offset, axis=1))) / length, "hold_s": hold_s,
+            "free_arm_rise": free_arm_rise(p, arm)}
+
+
+#: A "this way" gesture: the fingers head within GUIDE_HEADING_DEG of the target seen from above, the
+#: palm is within GUIDE_PALM_UP_DEG of facing up, the wrist is out GUIDE_REACH arm lengths, held
+#: GUIDE_MIN_HOLD_S or more, the other arm left down (FREE_ARM_RISE).
+GUIDE_HEADING_DEG = 20.0
+GUIDE_PALM_UP_DEG = 65.0
+GUIDE_REACH = 0.5
+GUIDE_MIN_HOLD_S = 0.4
+
+
+def guide_accepted(measures):
+    """Whether `guide_measures` show a "this way" towards the target (the bounds above)."""
+    return bool(measures["heading_error"] <= GUIDE_HEADING_DEG and measures["palm_up"] <= GUIDE_PALM_UP_DEG
+                and measures["reach"] >= GUIDE_REACH and measures["hold_s"] >= GUIDE_MIN_HOLD_S
+                and measures["free_arm_rise"] <= FREE_ARM_RISE)
+
+
+def raise_measures(positions, arm, fps=FPS):
+    """What a raised hand shows: {'height' (m of the wrist above the shoulder joint, median over the
+    raised hold; the highest frame's without one), 'height_arm' (the same in arm lengths),
+    'forearm_from_vertical' (degrees of elbow-to-wrist from straight up, over the same frames),
+    'hold_s' (the longest run of frames with the hand up and the wrist slower than HOLD_SPEED shoulder
+    widths per second), 'strokes' (side-to-side strokes while the hand is up, as a wave counts them),
+    'free_arm_rise'}."""
+    p, side = _positions(positions), _side(arm)
+    shoulder, elbow, wrist = (p[:, _JOINT[f"{side}_{j}"]] for j in ("shoulder", "elbow", "wrist"))
+    length, width = arm_length(p, arm), shoulder_width(p)
+    above = wrist[:, 2] - shoulder[:, 2]  # (F,) m
+    speed = np.linalg.norm(np.gradient(wrist, axis=0), axis=1) * fps
+    hold = longest_run((above >= -HAND_UP_DROP * length) & (speed <= HOLD_SPEED * width))
+    frames = np.arange(hold[0], hold[1] + 1) if hold else np.array([int(np.argmax(above))])
+    run = hand_up_run(p, arm)
+    strokes = 0 if run is None else max(len(turning_points(
+        (wrist[:, 0] - shoulder[:, 0])[run[0]:run[1] + 1], STROKE_FRACTION * width)) - 1, 0)
+    height = float(np.median(above[frames]))
+    return {"height": height, "height_arm": height / length,
+            "forearm_from_vertical": float(np.median(_degrees_between((wrist - elbow)[frames], [0.0, 0.0, 1.0]))),
+            "hold_s": 0.0 if hold is None else (hold[1] - hold[0] + 1) / fps, "strokes": strokes,
+            "free_arm_rise": free_arm_rise(p, arm)}
+
+
+#: A raised hand: held RAISE_MIN_HOLD_S or more with the wrist above the shoulder, the forearm within
+#: RAISE_FOREARM_DEG of vertical, no wave (at most RAISE_MAX_STROKES side-to-side strokes: the raise and
+#: the lowering), the height within RAISE_HEIGHT_ERROR arm lengths of the reference's, and the other arm left
+#: down (FREE_ARM_RISE).
+RAISE_MIN_HOLD_S = 0.5
+RAISE_FOREARM_DEG = 30.0
+RAISE_MAX_STROKES = 3
+RAISE_HEIGHT_ERROR = 0.1
+
+
+def compare_raise(generated, reference, arm, fps=FPS):
+    """Raise measures of both clips and the generated one's height error (arm lengths, absolute):
+    {'generated': {...}, 'reference': {...}, 'height_error'}."""
+    gen, ref = raise_measures(generated, arm, fps), raise_measures(reference, arm, fps)
+    return {"generated": gen, "reference": ref, "height_error": abs(gen["height_arm"] - ref["height_arm"])}
+
+
+def raise_accepted(comparison):
+    """Whether a `compare_raise` result raises the hand like its reference (the bounds above)."""
+    gen = comparison["generated"]
+    return bool(gen["hold_s"] >= RAISE_MIN_HOLD_S and gen["height"] > 0.0
+                and gen["forearm_from_vertical"] <= RAISE_FOREARM_DEG and gen["strokes"] <= RAISE_MAX_STROKES
+                and comparison["height_error"] <= RAISE_HEIGHT_ERROR and gen["free_arm_rise"] <= FREE_ARM_RISE)
+
+
 def raise_lower(generated, reference, arm):
     """Arm elevation (degrees) at the first and last frames of both clips, and the generated clip's
     differences from the reference: {'first', 'last', 'reference_first', 'reference_last',
@@ -329,7 +461,27 @@ def point_row(generated, reference, arm, target, fps):
 #: from descriptions (F, 42) of a generated clip and its reference (target: (3,) in the character frame
 #: for a target behaviour, else None). A behaviour without an entry is measured by raise and lower alone;
 #: a new behaviour's metrics plug in here.
-MEASURES = {"WAVE": wave_row, "POINT": point_row}
+def guide_row(generated, reference, arm, target, fps):
+    """GUIDE's measures (`guide_measures` of both, target (3,) in the character frame, and `guide_accepted`)."""
+    if target is None:
+        raise RLAnimateError("Guiding measures need the target position (x, y, z).")
+    guide, reference_guide = (guide_measures(spaces.description_joint_positions(d), finger_direction(d, arm),
+                                             palm_normal(d, arm), arm, target, fps) for d in (generated, reference))
+    return {**guide, **{f"reference_{k}": v for k, v in reference_guide.items()},
+            "hold_ratio": ratio(guide["hold_s"], reference_guide["hold_s"]),
+            "guide_accepted": float(guide_accepted(guide))}
+
+
+def raise_row(generated, reference, arm, target, fps):
+    """RAISE_HAND's measures (`compare_raise` and `raise_accepted`) of descriptions (F, 42), as a flat dict."""
+    raised = compare_raise(spaces.description_joint_positions(generated), spaces.description_joint_positions(reference),
+                           arm, fps)
+    return {**{k: float(v) for k, v in raised["generated"].items()},
+            **{f"reference_{k}": float(v) for k, v in raised["reference"].items()},
+            "height_error": raised["height_error"], "raise_accepted": float(raise_accepted(raised))}
+
+
+MEASURES = {"WAVE": wave_row, "POINT": point_row, "GUIDE": guide_row, "RAISE_HAND": raise_row}
 
 
 def compare(generated, reference, behaviour, arm, target=None, fps=FPS):

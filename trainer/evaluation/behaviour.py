@@ -13,8 +13,12 @@ method's own aim, or after aim correction (`aim.aim_at`) with exact_aim.
 """
 import numpy as np
 
+from scipy.stats import spearmanr
+
 from rlanimate_addon.core import aim, behaviours, metrics, skeleton, spaces
 from rlanimate_addon.core import behaviour_metrics as bm
+from trainer.motion import library_plan
+from trainer.motion.synthesis import GUIDE, RAISE_HAND
 
 #: Pointing targets as the sample library draws them (trainer/motion/library_plan.py): azimuth from
 #: across the body to out to the arm's side, elevation from the horizontal, distance from the shoulder.
@@ -22,13 +26,19 @@ AZIMUTH_DEG = (-60.0, 95.0)
 ELEVATION_DEG = (-40.0, 55.0)
 DISTANCE_M = (1.5, 4.0)
 LOWEST_TARGET_M = 0.05
+#: Guiding targets as the sample library draws them: azimuth, elevation (degrees), distance (m).
+GUIDE_AZIMUTH_DEG = tuple(np.degrees(library_plan.GUIDE_AZIMUTH_RANGE))
+GUIDE_ELEVATION_DEG = tuple(np.degrees(library_plan.GUIDE_ELEVATION_RANGE))
+GUIDE_DISTANCE_M = library_plan.GUIDE_DISTANCE_RANGE
+#: A raised hand's height must rise with the exaggeration: Spearman's rank correlation above this.
+RAISE_MIN_SPEARMAN = 0.8
 #: Seed of the random unseen pointing targets (`random_target_sweeps`).
 RANDOM_TARGET_SEED = 2024
 EXAGGERATIONS = (0.0, 0.25, 0.5, 0.75, 1.0)
 
 
 def class_lengths(training_clips):
-    """{behaviour: mean frame count} of the training clips ('POINT', 'WAVE')."""
+    """{behaviour: mean frame count} of the training clips ('POINT', 'WAVE', ...)."""
     lengths = {}
     for clip in training_clips:
         lengths.setdefault(clip.behaviour, []).append(len(clip.rotvecs))
@@ -36,7 +46,8 @@ def class_lengths(training_clips):
 
 
 def clip_target(clip):
-    """(3,) the pointing target of a POINT clip in the character frame (None for a wave, or a clip without one)."""
+    """(3,) the target of a target behaviour's clip in the character frame (None for an intensity behaviour's,
+    or a clip without one)."""
     target = getattr(clip, "target", None)
     return None if target is None else np.asarray(target, dtype=np.float64)
 
@@ -87,17 +98,18 @@ def seed_variation(method, clips, describe, seeds):
     return rows
 
 
-def random_targets(rng, arm, count):
-    """(count, 3) pointing targets in the character frame, drawn uniformly over the library's azimuth,
-    elevation and distance ranges from the arm's rest shoulder, at least LOWEST_TARGET_M above the floor."""
+def random_targets(rng, arm, count, azimuths=AZIMUTH_DEG, elevations=ELEVATION_DEG, distances=DISTANCE_M):
+    """(count, 3) targets in the character frame, drawn uniformly over azimuth, elevation (degrees) and
+    distance (m) ranges from the arm's rest shoulder (the library's pointing ranges unless given), at least
+    LOWEST_TARGET_M above the floor."""
     sign = 1.0 if arm == "LEFT" else -1.0
     shoulder = skeleton.shoulder_rest_position(arm)
     targets = []
     while len(targets) < count:
-        azimuth, elevation = np.radians(rng.uniform(*AZIMUTH_DEG)), np.radians(rng.uniform(*ELEVATION_DEG))
+        azimuth, elevation = np.radians(rng.uniform(*azimuths)), np.radians(rng.uniform(*elevations))
         direction = np.array([sign * np.sin(azimuth) * np.cos(elevation), -np.cos(azimuth) * np.cos(elevation),
                               np.sin(elevation)])
-        target = shoulder + rng.uniform(*DISTANCE_M) * direction
+        target = shoulder + rng.uniform(*distances) * direction
         if target[2] >= LOWEST_TARGET_M:
             targets.append(target)
     return np.array(targets)
@@ -136,6 +148,42 @@ def exaggeration_sweep(method, arm, frames, describe, exaggerations=EXAGGERATION
             "swing_rising": bool(np.all(np.diff(swings) > 0))}
 
 
+def guide_sweeps(method, frames, describe, count, seed=RANDOM_TARGET_SEED):
+    """{'left', 'right': measures} of "this way" towards `count` random unseen targets per arm over the
+    library's guiding ranges, at `frames`: the accepted share and the heading error, palm-up angle, reach
+    and hold (median; extremes of the first two) of `behaviour_metrics.guide_measures`."""
+    rng = np.random.default_rng(seed)
+    sweeps = {}
+    for arm in ("LEFT", "RIGHT"):
+        measures = []
+        for target in random_targets(rng, arm, count, GUIDE_AZIMUTH_DEG, GUIDE_ELEVATION_DEG, GUIDE_DISTANCE_M):
+            descriptions = describe(method.generate(GUIDE, arm, spaces.pointing_direction(arm, target), frames))
+            measures.append(bm.guide_measures(spaces.description_joint_positions(descriptions),
+                                              bm.finger_direction(descriptions, arm), bm.palm_normal(descriptions, arm),
+                                              arm, target))
+        values = {key: np.array([m[key] for m in measures]) for key in measures[0]}
+        sweeps[arm.lower()] = {
+            "accepted_share": float(np.mean([bm.guide_accepted(m) for m in measures])),
+            "heading_error_median": float(np.median(values["heading_error"])),
+            "heading_error_max": float(values["heading_error"].max()),
+            "palm_up_median": float(np.median(values["palm_up"])), "palm_up_max": float(values["palm_up"].max()),
+            "reach_median": float(np.median(values["reach"])), "hold_s_median": float(np.median(values["hold_s"]))}
+    return sweeps
+
+
+def raise_sweep(method, arm, frames, describe, exaggerations=EXAGGERATIONS):
+    """Raise-hand measures at each exaggeration; whether the height rises with it (Spearman's rank
+    correlation above RAISE_MIN_SPEARMAN, NaN for a method whose height never changes)."""
+    measures = [bm.raise_measures(spaces.description_joint_positions(
+        describe(method.generate(RAISE_HAND, arm, e, frames))), arm) for e in exaggerations]
+    heights = [m["height"] for m in measures]
+    correlation = float(spearmanr(exaggerations, heights).correlation) if np.ptp(heights) > 0 else float("nan")
+    return {"exaggerations": list(exaggerations), "height": heights,
+            "forearm_from_vertical": [m["forearm_from_vertical"] for m in measures],
+            "hold_s": [m["hold_s"] for m in measures], "strokes": [m["strokes"] for m in measures],
+            "spearman": correlation, "height_rising": bool(correlation > RAISE_MIN_SPEARMAN)}
+
+
 def summarise(rows):
     """{behaviour: summary} of request rows: means of the scores present, medians (and extremes where a
     bound applies) of the behaviour measures (pointing ones when the rows have them)."""
@@ -163,5 +211,17 @@ def summarise(rows):
             entry["pointing_angle_median"] = float(np.median(values("pointing_angle")))
             entry["pointing_angle_max"] = float(values("pointing_angle").max())
             entry["hold_ratio_median"] = float(np.median(values("hold_ratio")))
+        elif "guide_accepted" in group[0]:
+            for key in ("heading_error", "palm_up"):
+                entry[f"{key}_median"], entry[f"{key}_max"] = float(np.median(values(key))), float(values(key).max())
+            entry["reach_median"] = float(np.median(values("reach")))
+            entry["hold_ratio_median"] = float(np.nanmedian(values("hold_ratio")))
+            entry["accepted_share"] = float(values("guide_accepted").mean())
+        elif "raise_accepted" in group[0]:
+            entry["height_error_median"] = float(np.median(values("height_error")))
+            entry["height_error_max"] = float(values("height_error").max())
+            entry["forearm_from_vertical_max"] = float(values("forearm_from_vertical").max())
+            entry["hold_s_min"], entry["strokes_max"] = float(values("hold_s").min()), float(values("strokes").max())
+            entry["accepted_share"] = float(values("raise_accepted").mean())
         summary[behaviour] = entry
     return summary

@@ -12,6 +12,12 @@ WAVE_COLUMNS = ("score", "score, class length", "score, DTW", "smoothness", "swi
                 "elevation error first / last (deg, median; max)")
 POINT_COLUMNS = ("score", "score, class length", "score, DTW", "smoothness", "pointing angle (deg): median / max",
                  "hold ratio", "elevation error first / last (deg, median; max)")
+GUIDE_COLUMNS = ("score", "score, class length", "score, DTW", "smoothness", "heading error (deg): median / max",
+                 "palm from up (deg): median / max", "reach (arm lengths)", "hold ratio", "guides accepted",
+                 "elevation error first / last (deg, median; max)")
+RAISE_COLUMNS = ("score", "score, class length", "score, DTW", "smoothness", "height error (arm lengths): median / max",
+                 "forearm from vertical (deg, max)", "hold (s, min)", "strokes (max)", "raises accepted",
+                 "elevation error first / last (deg, median; max)")
 
 
 def _f(value, digits=2):
@@ -34,10 +40,33 @@ def behaviour_words(behaviour, entry):
         return (f"swing {_f(entry['swing_ratio_median'])}x, frequency {_f(entry['frequency_ratio_median'])}x, "
                 f"at least {entry['cycles_min']:.0f} cycles, {entry['accepted_share'] * entry['requests']:.0f} of "
                 f"{entry['requests']} waves accepted; {elevation}")
+    if behaviour == "guide":
+        return (f"heading {_f(entry['heading_error_median'], 1)} deg median, palm {_f(entry['palm_up_median'], 0)} deg "
+                f"from up, {_accepted(entry)} guides accepted; {elevation}")
+    if behaviour == "raise_hand":
+        return (f"height error {_f(entry['height_error_median'])} arm lengths median, {_accepted(entry)} raises "
+                f"accepted; {elevation}")
     if "pointing_angle_median" in entry:
         return (f"own aim {_f(entry['pointing_angle_median'], 1)} deg median, {_f(entry['pointing_angle_max'], 1)} "
                 f"max; {elevation}")
     return elevation
+
+
+def _accepted(entry):
+    return f"{entry['accepted_share'] * entry['requests']:.0f} of {entry['requests']}"
+
+
+def guide_row(entry):
+    return _scores(entry) + [f"{_f(entry['heading_error_median'], 1)} / {_f(entry['heading_error_max'], 1)}",
+                             f"{_f(entry['palm_up_median'], 0)} / {_f(entry['palm_up_max'], 0)}",
+                             _f(entry["reach_median"]), _f(entry["hold_ratio_median"]), _accepted(entry),
+                             _elevation(entry)]
+
+
+def raise_row(entry):
+    return _scores(entry) + [f"{_f(entry['height_error_median'], 3)} / {_f(entry['height_error_max'], 3)}",
+                             _f(entry["forearm_from_vertical_max"], 1), _f(entry["hold_s_min"]),
+                             f"{entry['strokes_max']:.0f}", _accepted(entry), _elevation(entry)]
 
 
 def wave_row(entry):
@@ -74,6 +103,20 @@ def behaviour_markdown(report):
             lines += ["Aim correction turns the arm towards the target from the start of the stroke (core/aim.py's "
                       "pointing phase), so the finger arrives before the reference's does: the frame-by-frame scores "
                       "fall, the time-aligned (DTW) score does not.", ""]
+    for title, key, columns, row, bounds in (
+            ('"This way" (guide)', "guide", GUIDE_COLUMNS, guide_row,
+             "accepted: heading error at most 20 degrees, palm at most 65 degrees from up, reach at least 0.5 arm "
+             "lengths, held 0.4 s or more"),
+            ("Raise hand", "raise_hand", RAISE_COLUMNS, raise_row,
+             "accepted: held 0.5 s or more above the shoulder, forearm within 30 degrees of vertical, at most 3 "
+             "strokes, height within 0.1 arm lengths of the reference's")):
+        if key in report["sets"]:
+            methods = report["sets"][key]
+            count = next(iter(methods.values()))["requests"]
+            lines += [f"## {title}, held-out clips ({count})", "", f"docs/METRICS.md (\"Guide and raise hand\"); {bounds}.",
+                      ""]
+            lines += markdown_table(("method",) + columns, [[METHOD_LABELS.get(m, m)] + row(e) for m, e in methods.items()])
+            lines.append("")
     agent = report["agent"]
     lines += ["## RLAnimate on its own", "", f"### Pointing at {agent['targets_per_arm']} random unseen targets per arm",
               "", "Targets drawn uniformly over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, "
@@ -89,6 +132,24 @@ def behaviour_markdown(report):
                             [[arm] + [_f(100 * v, 1) for v in s["swing"]] + [" ".join(str(c) for c in s["cycles"]),
                                                                             "yes" if s["swing_rising"] else "no"]
                              for arm, s in sweeps.items()])
+    if "guide_targets" in agent:
+        lines += ["", f"### \"This way\" to {agent['targets_per_arm']} random unseen targets per arm", "",
+                  "Targets drawn uniformly over the library's guiding ranges (azimuth -30 to 95 degrees, elevation -35 "
+                  "to 12, 1.5-5 m from the shoulder), at the class-average length.", ""]
+        lines += markdown_table(("arm", "accepted", "heading error: median / max (deg)", "palm from up: median / max (deg)",
+                                 "reach (arm lengths)", "hold (s, median)"),
+                                [[arm, f"{100 * s['accepted_share']:.0f}%",
+                                  f"{_f(s['heading_error_median'], 1)} / {_f(s['heading_error_max'], 1)}",
+                                  f"{_f(s['palm_up_median'], 0)} / {_f(s['palm_up_max'], 0)}", _f(s["reach_median"]),
+                                  _f(s["hold_s_median"])] for arm, s in agent["guide_targets"].items()])
+    if "raise_sweep" in agent:
+        sweeps = agent["raise_sweep"]
+        exaggerations = next(iter(sweeps.values()))["exaggerations"]
+        lines += ["", "### Raise-hand exaggeration sweep (class-average length)", ""]
+        lines += markdown_table(("arm",) + tuple(f"wrist above shoulder at {e:g} (cm)" for e in exaggerations)
+                                + ("Spearman", "rising"),
+                                [[arm] + [_f(100 * v, 1) for v in s["height"]]
+                                 + [_f(s["spearman"]), "yes" if s["height_rising"] else "no"] for arm, s in sweeps.items()])
     variation = agent["variation"]
     lines += ["", "### Seeds", "",
               "Each variation seed's answers to the held-out requests (the panel's Seed; seed 0 is the "

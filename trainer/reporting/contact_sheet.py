@@ -2,8 +2,9 @@
 (`python -m trainer.scripts.contact_sheet`).
 
 Draws the canonical skeleton (numpy FK, which matches Blender's pose evaluation) as a stick body,
-with the wrist's path over the whole clip as a faint trail, and for pointing the target and the
-index finger's line. Rows: point high, point across the body, small wave, big wave.
+with the wrist's path over the whole clip as a faint trail, and for the target behaviours the index
+finger's line. Rows: point high, point across the body, small wave, big wave, "this way" out to the side,
+a big raised hand.
 """
 from pathlib import Path
 
@@ -32,10 +33,13 @@ def _width(name):
 
 
 def pick_clips(seed=DEFAULT_SEED):
-    """(title, PlannedClip) for point high, point across, small wave, big wave (training clips)."""
+    """(title, PlannedClip) for point high, point across, small wave, big wave, guide out to the side and
+    big raised hand (training clips)."""
     plan = [p for p in plan_library(seed) if p.split == "train"]
     points = [p for p in plan if p.spec.behaviour == "POINT"]
     waves = [p for p in plan if p.spec.behaviour == "WAVE"]
+    guides = [p for p in plan if p.spec.behaviour == "GUIDE"]
+    raises = [p for p in plan if p.spec.behaviour == "RAISE_HAND"]
 
     def across(p):  # how far across the body the target lies
         return -p.spec.target[0] if p.spec.arm == "LEFT" else p.spec.target[0]
@@ -43,16 +47,19 @@ def pick_clips(seed=DEFAULT_SEED):
     return [("point high", max(points, key=lambda p: p.spec.target[2])),
             ("point across", max(points, key=across)),
             ("wave small", min(waves, key=lambda p: p.spec.exaggeration)),
-            ("wave big", max(waves, key=lambda p: p.spec.exaggeration))]
+            ("wave big", max(waves, key=lambda p: p.spec.exaggeration)),
+            ("this way, side", min(guides, key=across)),
+            ("raise hand big", max(raises, key=lambda p: p.spec.exaggeration))]
 
 
 def key_frames(clip, wrist_x):
-    """Six frames that show the motion: for pointing start, wind-up, mid-stroke, hold, mid-return,
-    end; for waving start, mid-raise, three swing extremes (from the wrist's sideways path), mid-lowering."""
+    """Six frames that show the motion: for a held gesture (point, guide, raise hand) start, wind-up,
+    mid-stroke, hold, mid-return, end; for waving start, mid-raise, three swing extremes (from the wrist's
+    sideways path), mid-lowering."""
     p = clip.phases
     if "hold" in p:
-        return [0, p["stroke"][0], (p["stroke"][0] + p["stroke"][1]) // 2, p["hold"][0],
-                (p["return"][0] + p["return"][1]) // 2, clip.frames - 1]
+        out, _, back = (p[name] for name in p)  # the stroke (or raise), the hold, the return (or lowering)
+        return [0, out[0], (out[0] + out[1]) // 2, p["hold"][0], (back[0] + back[1]) // 2, clip.frames - 1]
     first, last = p["wave"]
     sway = wrist_x[first:last + 1]
     turns = [first + i for i in range(1, len(sway) - 1)
@@ -108,7 +115,7 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
         heads = fk.bone_heads(clip.action_rotvecs(), fingers)  # (F, B, 3)
         side = skeleton.ARM_PREFIX[planned.spec.arm]
         trail = heads[:, _INDEX[side + "HandIndex1"]]
-        target = ("ray", side) if planned.spec.behaviour == "POINT" else None
+        target = ("ray", side) if planned.spec.target is not None else None
         label = (f"target {np.round(planned.spec.target, 2).tolist()}" if target
                  else f"exaggeration {planned.spec.exaggeration:.2f}")
         for col, frame in enumerate(key_frames(clip, trail[:, 0])):

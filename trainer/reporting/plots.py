@@ -1,8 +1,9 @@
-"""PNG plots of training runs: loss and score curves, Figure 3, and length flexibility (matplotlib, Agg)."""
+"""PNG plots of training runs: loss and score curves, Figure 3, length flexibility, and hand paths (matplotlib, Agg)."""
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
 
 VARIANT_LABELS = {"rlanimate": "RLAnimate", "single_state": "single state",
                  "single_dynamics": "single dynamics space", "supervised": "supervised loss"}
@@ -104,6 +105,46 @@ def wave_hand_paths(panels, path):
         frontal.set_ylabel("up (cm)")
         frontal.set_aspect("equal", adjustable="datalim")
         over_time.legend(fontsize=7, loc="upper left")
+    figure.tight_layout()
+    figure.savefig(path, dpi=100)
+    plt.close(figure)
+
+
+def gesture_hand_paths(panels, path):
+    """Generated against reference hand paths of held gestures (guide, raise hand), one row per request:
+    the wrist's height above its shoulder over time, its path seen from above (with the line to the
+    target, when there is one) and from the front.
+
+    panels: [(title, arm, {label: (F, 10, 3) description-joint positions}, target (3,) or None)], the
+    reference first."""
+    from rlanimate_addon.core import behaviour_metrics as bm
+
+    figure, axes = plt.subplots(len(panels), 3, figsize=(14, 3.0 * len(panels)), squeeze=False)
+    for (title, arm, clips, target), (over_time, above, frontal) in zip(panels, axes):
+        for k, (label, positions) in enumerate(clips.items()):
+            relative = 100 * (bm.joint(positions, f"{arm.lower()}_wrist") - bm.joint(positions, f"{arm.lower()}_shoulder"))
+            style = {"color": "black", "linewidth": 2.0} if k == 0 else {"linewidth": 1.2}
+            over_time.plot(relative[:, 2], label=label, **style)
+            above.plot(relative[:, 0], -relative[:, 1], label=label, **style)
+            frontal.plot(relative[:, 0], relative[:, 2], label=label, **style)
+            if k == 0 and target is not None:
+                shoulder = bm.joint(positions, f"{arm.lower()}_shoulder")[0]
+                way = np.asarray(target)[:2] - shoulder[:2]
+                way = 80 * way / np.linalg.norm(way)
+                above.plot([0, way[0]], [0, -way[1]], ":", color="green", label="to the target")
+        over_time.set_title(f"{title}: wrist height above the shoulder", fontsize=9)
+        over_time.set_xlabel("frame")
+        over_time.set_ylabel("cm")
+        above.set_title(f"{title}: wrist path from above", fontsize=9)
+        above.set_xlabel("side (cm, + character's left)")
+        above.set_ylabel("forward (cm)")
+        frontal.set_title(f"{title}: wrist path, front view", fontsize=9)
+        frontal.set_xlabel("side (cm)")
+        frontal.set_ylabel("up (cm)")
+        for axis in (above, frontal):
+            axis.set_aspect("equal", adjustable="datalim")
+        over_time.legend(fontsize=7, loc="upper left")
+        above.legend(fontsize=7, loc="best")
     figure.tight_layout()
     figure.savefig(path, dpi=100)
     plt.close(figure)

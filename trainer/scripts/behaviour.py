@@ -1,5 +1,6 @@
 """Behaviour metrics of RLAnimate and the baselines on the sample library's held-out requests:
-docs/results/behaviour.{json,md} and the held-out waves' hand paths (docs/results/behaviour_wave_paths.png).
+docs/results/behaviour.{json,md}, the held-out waves' hand paths (docs/results/behaviour_wave_paths.png) and,
+when the library has guide and raise-hand clips, theirs (behaviour_guide_paths.png, behaviour_raise_hand_paths.png).
 
     nice -n 10 python -m trainer.scripts.behaviour [--agent PATH] [--clips MANIFEST] [--results DIR]
                                                    [--targets 100] [--seeds 1 2 3 4]
@@ -16,12 +17,15 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
 from trainer.evaluation import behaviour
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
+from trainer.motion.synthesis import GUIDE, RAISE_HAND
 from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.reporting.behaviour_report import write_behaviour
-from trainer.reporting.plots import wave_hand_paths
+from trainer.reporting.plots import gesture_hand_paths, wave_hand_paths
 from trainer.scripts.cli import run_main, script_args
 
 WAVE_PATHS = "behaviour_wave_paths.png"
+#: The hand-path figure of each further behaviour's held-out requests.
+HELD_PATHS = {GUIDE: "behaviour_guide_paths.png", RAISE_HAND: "behaviour_raise_hand_paths.png"}
 
 
 def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, target_seed=behaviour.RANDOM_TARGET_SEED):
@@ -43,6 +47,13 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
         sets["wave"][name], sets["point"][name] = summary["wave"], summary["point"]
         sets["point_exact_aim"][name] = summary_aimed["point"]
         clips[name] = rows
+    held = [c for c in test if c.behaviour in HELD_PATHS]
+    for name, method in methods.items():
+        if held and name != "procedural_ik":  # the procedural baseline knows point and wave only
+            rows = behaviour.request_rows(method, held, session.references, session.describe, lengths)
+            for key, summary in behaviour.summarise(rows).items():
+                sets.setdefault(key, {})[name] = summary
+            clips[name] += rows
 
     own, exact = (behaviour.random_target_sweeps(agent, lengths[behaviours.POINT], session.describe, target_count,
                                                  exact_aim=exact_aim, seed=target_seed) for exact_aim in (False, True))
@@ -67,6 +78,21 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
                        {"reference": reference, **answers}))
     Path(results_dir).mkdir(parents=True, exist_ok=True)
     wave_hand_paths(panels, Path(results_dir) / WAVE_PATHS)
+    figures = {f"docs/results/{WAVE_PATHS}": "the held-out waves' wrist, reference against RLAnimate "
+                                             "(deterministic and one seed) and the class mean"}
+    for behaviour_id, figure in HELD_PATHS.items():
+        requests = [c for c in held if c.behaviour == behaviour_id]
+        if requests:
+            gesture_hand_paths([_held_panel(clip, session, methods) for clip in requests], Path(results_dir) / figure)
+            figures[f"docs/results/{figure}"] = (f"the held-out {behaviours.key(behaviour_id)} requests' wrist, "
+                                                 "reference against RLAnimate and the class mean")
+    extra = {}
+    if any(c.behaviour == GUIDE for c in train):
+        extra["guide_targets"] = behaviour.guide_sweeps(agent, lengths[GUIDE], session.describe, target_count,
+                                                        seed=target_seed)
+    if any(c.behaviour == RAISE_HAND for c in train):
+        extra["raise_sweep"] = {arm.lower(): behaviour.raise_sweep(agent, arm, lengths[RAISE_HAND], session.describe)
+                                for arm in ("LEFT", "RIGHT")}
 
     training = agent.agent.metadata.get("training", {})
     provenance = "untrained" if training.get("untrained") else ", ".join(
@@ -81,16 +107,25 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
                    + ("" if target_seed == behaviour.RANDOM_TARGET_SEED else f" --target-seed {target_seed}") + "`.")
     return {"description": description, "class_lengths": lengths, "sets": sets,
             "agent": {"targets_per_arm": target_count, "random_targets": random_targets,
-                      "exaggeration_sweep": sweeps,
+                      "exaggeration_sweep": sweeps, **extra,
                       "seeded": {str(seed): summary for seed, summary in seeded.items()},
                       "variation": {"seeds": list(seeds), "requests": len(varied),
                                     "deterministic": sum(r["deterministic"] for r in varied),
                                     **{name: _spread([r["variation"] for r in varied if r["behaviour"] == name])
                                        for name in ("wave", "point")},
                                     "clips": varied}},
-            "figures": {f"docs/results/{WAVE_PATHS}": "the held-out waves' wrist, reference against RLAnimate "
-                                                      "(deterministic and one seed) and the class mean"},
-            "clips": clips}
+            "figures": figures, "clips": clips}
+
+
+def _held_panel(clip, session, methods):
+    """(title, arm, {label: positions}, target) of one guide or raise-hand request for gesture_hand_paths."""
+    reference = spaces.description_joint_positions(session.references.get(clip)[0])
+    answers = {label: spaces.description_joint_positions(session.describe(methods[key].generate(
+        clip.behaviour, clip.arm, clip.attributes, len(clip.rotvecs))))
+        for key, label in (("rlanimate", "RLAnimate"), ("class_mean", "class mean"))}
+    label = (f"e = {float(np.ravel(clip.attributes)[0]):.2f}" if clip.behaviour == RAISE_HAND
+             else f"target {np.round(clip.target, 1).tolist()}")
+    return f"{clip.name} ({label})", clip.arm.upper(), {"reference": reference, **answers}, behaviour.clip_target(clip)
 
 
 def _spread(values):

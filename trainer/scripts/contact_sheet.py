@@ -1,9 +1,10 @@
 """Contact sheets: the clip library's key frames (docs/contact_sheet.png), or, with --generated, the add-on's
 Generate Gesture on the sample character rendered by Blender (Cycles, CPU) into
-docs/results/generated_frames.png.
+docs/results/generated_frames.png (point and wave), or, with --generated --further, the guide and
+raise-hand gestures into docs/results/generated_guide_raise_frames.png.
 
     python -m trainer.scripts.contact_sheet [--out docs/contact_sheet.png] [--seed S]
-    nice -n 10 python -m trainer.scripts.contact_sheet --generated [--agent PATH] [--out PNG]
+    nice -n 10 python -m trainer.scripts.contact_sheet --generated [--further] [--agent PATH] [--out PNG]
 """
 import argparse
 import tempfile
@@ -15,8 +16,11 @@ from trainer.reporting.contact_sheet import generated_sheet, render
 from trainer.scripts.cli import run_main, script_args
 
 GENERATED_SHEET = RESULTS_DIR / "generated_frames.png"
+FURTHER_SHEET = RESULTS_DIR / "generated_guide_raise_frames.png"
 TARGET_HIGH = (-0.9, -2.0, 1.7)  # ahead, up and to the character's right
 TARGET_ACROSS = (-0.9, -1.8, 0.9)  # low, across the body for the left arm
+TARGET_DOOR = (-2.2, -1.6, 0.9)  # a doorway ahead and out to the character's right, at waist height
+TARGET_FLOOR = (0.6, -2.2, 0.05)  # on the floor ahead, a little to the left
 
 
 def generated_requests():
@@ -35,11 +39,24 @@ def generated_requests():
     ]
 
 
+def further_requests():
+    """The requests of the guide and raise-hand sheet: "this way" to two targets, raised hands small to big."""
+    from trainer.blender_io.gesture_render import RenderRequest
+    return [
+        RenderRequest("this way, right, to a door", {"behaviour": "GUIDE", "arm": "RIGHT", "seed": 0}, target=TARGET_DOOR),
+        RenderRequest("this way, left, to the floor", {"behaviour": "GUIDE", "arm": "LEFT", "seed": 0},
+                      target=TARGET_FLOOR),
+        RenderRequest("raise hand right, e 0.1", {"behaviour": "RAISE_HAND", "arm": "RIGHT", "exaggeration": 0.1, "seed": 0}),
+        RenderRequest("raise hand left, e 0.9", {"behaviour": "RAISE_HAND", "arm": "LEFT", "exaggeration": 0.9, "seed": 0}),
+    ]
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", type=Path)
     parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="library plan seed (library sheet)")
     parser.add_argument("--generated", action="store_true", help="render Generate Gesture's output with Blender")
+    parser.add_argument("--further", action="store_true", help="with --generated: the guide and raise-hand gestures")
     parser.add_argument("--agent", type=Path, help="agent file for the add-on (default: the bundled agent)")
     args = parser.parse_args(script_args(argv))
     if not args.generated:
@@ -47,9 +64,11 @@ def main(argv=None):
         return 0
     from trainer.blender_io.gesture_render import render_requests
     with tempfile.TemporaryDirectory() as frames:
-        requests = render_requests(generated_requests(), frames, agent_path=args.agent)
+        requests = render_requests(further_requests() if args.further else generated_requests(), frames,
+                                   agent_path=args.agent)
         agent = shown(args.agent) if args.agent else "the bundled agent"
-        out = generated_sheet([(r.title, r.frames) for r in requests], args.out or GENERATED_SHEET,
+        out = generated_sheet([(r.title, r.frames) for r in requests],
+                              args.out or (FURTHER_SHEET if args.further else GENERATED_SHEET),
                               f"Generate Gesture on the sample character, {agent}, rendered by Blender (Cycles); "
                               f"red: the target")
     print(f"wrote {out}")

@@ -28,7 +28,7 @@ def test_exported_clip_reimports_within_a_millimetre(tmp_path):
     plan = plan_library()
     bpy = rig_session.import_bpy()
     bones = [b for _, b in skeleton.DESCRIPTION_JOINTS] + ["LeftHandIndex4", "RightHandIndex4", "Head"]
-    for planned in (plan[1], plan[75]):
+    for planned in (plan[1], plan[75], plan[130], plan[175]):  # point, wave, guide, raise hand
         clip = synthesise(planned.spec)
         rig_session.new_empty_scene()
         rig = rig_session.load_rig()

@@ -22,7 +22,7 @@ def _clip(planned):
 @pytest.fixture(scope="module")
 def library():
     """The right arm's training and held-out clips of the sample library, synthesised in numpy."""
-    plan = [p for p in plan_library() if p.spec.arm == "RIGHT"]
+    plan = [p for p in plan_library() if p.spec.arm == "RIGHT" and p.spec.behaviour in ("POINT", "WAVE")]
     train = [_clip(p) for p in plan if p.split == "train"]
     test = [_clip(p) for p in plan if p.split == "test"]
     return train, test
@@ -110,3 +110,41 @@ def test_sweeps_and_seed_variation_on_a_seeded_method(library):
     aimed = behaviour.pointing_sweep(baselines.NearestClip(train), "RIGHT", targets, 100, kinematics.describe,
                                      exact_aim=True)
     assert aimed["max_angle"] < 0.5 and len(aimed["angles"]) == 3
+
+
+def _new_behaviour_clips(arm):
+    """(train, test) guide and raise-hand clips of one arm, synthesised in numpy, labelled as the manifest does."""
+    plan = [p for p in plan_library() if p.spec.arm == arm and p.spec.behaviour in ("GUIDE", "RAISE_HAND")]
+    clips = [MotionClip(name=p.file, source=p.file, fps=30.0, rotvecs=synthesise(p.spec).action_rotvecs(),
+                        behaviour=p.spec.behaviour, arm=arm, target=p.spec.target, exaggeration=p.spec.exaggeration,
+                        attributes=(spaces.pointing_direction(arm, p.spec.target) if p.spec.target is not None
+                                    else p.spec.exaggeration), split=p.split) for p in plan]
+    return [c for c in clips if c.split == "train"], [c for c in clips if c.split == "test"]
+
+
+class Still:
+    """The first frame of a clip held for the whole request."""
+
+    def __init__(self, clip):
+        self.pose = clip.rotvecs[0]
+
+    def generate(self, behaviour_name, arm, attributes, frame_count, seed=None):
+        return np.repeat(self.pose[None], frame_count, axis=0)
+
+
+def test_guide_and_raise_rows_summaries_and_sweeps_pass_a_copy_and_fail_a_still_arm():
+    train, test = _new_behaviour_clips("LEFT")
+    lengths = behaviour.class_lengths(train)
+    copy, still = (behaviour.summarise(behaviour.request_rows(method, test, NumpyReferences(), kinematics.describe,
+                                                              lengths)) for method in (Copy(test), Still(test[0])))
+    assert copy["guide"]["accepted_share"] == 1.0 and copy["guide"]["heading_error_max"] < 3.0
+    assert copy["raise_hand"]["accepted_share"] == 1.0 and copy["raise_hand"]["height_error_max"] < 1e-9
+    assert still["guide"]["accepted_share"] == 0.0 and still["guide"]["palm_up_median"] > 80.0
+    assert still["raise_hand"]["accepted_share"] == 0.0
+    guides = behaviour.guide_sweeps(Still(test[0]), lengths["GUIDE"], kinematics.describe, count=3)
+    assert set(guides) == {"left", "right"} and guides["right"]["accepted_share"] == 0.0
+    assert guides["left"]["palm_up_median"] > 80.0 and guides["left"]["reach_median"] < 0.3
+    raised = behaviour.raise_sweep(Copy(train + test), "LEFT", lengths["RAISE_HAND"], kinematics.describe)
+    assert raised["height_rising"] and raised["spearman"] == pytest.approx(1.0) and max(raised["strokes"]) <= 3
+    flat = behaviour.raise_sweep(Still(train[-1]), "LEFT", 100, kinematics.describe)
+    assert not flat["height_rising"] and np.isnan(flat["spearman"])

@@ -15,12 +15,30 @@ def plan():
     return library_plan.plan_library()
 
 
-def test_plan_has_the_papers_hundred_clips_and_split(plan):
-    assert len(plan) == 100 and len({p.file for p in plan}) == 100
+def test_plan_has_the_papers_hundred_clips_and_split_then_guides_and_raised_hands(plan):
+    assert len(plan) == 200 and len({p.file for p in plan}) == 200
     counts = Counter((p.spec.behaviour, p.spec.arm) for p in plan)
-    assert set(counts.values()) == {25} and len(counts) == 4
+    assert set(counts.values()) == {25} and len(counts) == 8
     tests = Counter((p.spec.behaviour, p.spec.arm) for p in plan if p.split == "test")
-    assert tests == {("POINT", "LEFT"): 3, ("POINT", "RIGHT"): 3, ("WAVE", "LEFT"): 2, ("WAVE", "RIGHT"): 2}
+    assert tests == {("POINT", "LEFT"): 3, ("POINT", "RIGHT"): 3, ("WAVE", "LEFT"): 2, ("WAVE", "RIGHT"): 2,
+                     ("GUIDE", "LEFT"): 3, ("GUIDE", "RIGHT"): 3, ("RAISE_HAND", "LEFT"): 2, ("RAISE_HAND", "RIGHT"): 2}
+    assert [p.spec.behaviour for p in plan[:100]] == ["POINT"] * 50 + ["WAVE"] * 50  # the paper's clips come first
+
+
+def test_guide_targets_lie_ahead_and_to_the_side_and_raises_use_the_wave_grid(plan):
+    for arm in skeleton.ARMS:
+        sign = 1.0 if arm == "LEFT" else -1.0
+        guides = [p for p in plan if p.spec.behaviour == "GUIDE" and p.spec.arm == arm]
+        offsets = np.array([p.spec.target for p in guides]) - skeleton.shoulder_rest_position(arm)
+        distance = np.linalg.norm(offsets, axis=1)
+        assert np.all((distance >= 1.5 - 1e-3) & (distance <= 5.0 + 1e-3))
+        direction = offsets / distance[:, None]
+        assert np.all(direction[:, 2] < np.sin(np.radians(12.5))) and direction[:, 2].min() < -0.4
+        assert (sign * direction[:, 0]).min() < -0.3 and (sign * direction[:, 0]).max() > 0.8
+        raises = [p for p in plan if p.spec.behaviour == "RAISE_HAND" and p.spec.arm == arm]
+        waves = [p for p in plan if p.spec.behaviour == "WAVE" and p.spec.arm == arm]
+        assert [p.spec.exaggeration for p in raises] == [p.spec.exaggeration for p in waves]
+        assert [p.split for p in raises] == [p.split for p in waves]
 
 
 def test_test_waves_use_exaggerations_no_training_clip_has(plan):
@@ -81,12 +99,12 @@ def test_committed_manifest_matches_the_plan_and_the_files(plan):
         total += path.stat().st_size
         assert (entry["behaviour"], entry["arm"], entry["split"], entry["fps"]) == (
             spec.behaviour, spec.arm, planned.split, 30)
-        if spec.behaviour == "POINT":
+        if spec.behaviour in ("POINT", "GUIDE"):
             assert entry["exaggeration"] is None and entry["target"] == list(spec.target)
             np.testing.assert_allclose(entry["direction"], spaces.pointing_direction(spec.arm, spec.target), atol=1e-6)
         else:
             assert entry["target"] is None and entry["direction"] is None and entry["exaggeration"] == spec.exaggeration
-    assert total < 20e6
+    assert total < 40e6
     # Frame counts are those the generator makes (checked on a few, for speed).
     for planned in plan[::17]:
         assert entries[planned.file]["frames"] == synthesise(planned.spec).frames

@@ -1,4 +1,4 @@
-"""Procedural pointing and waving clips on the canonical rig, in plain numpy.
+"""Procedural pointing, waving, guiding ("this way") and hand-raising clips on the canonical rig, in plain numpy.
 
 A gesture spec (behaviour, arm, target or exaggeration, style seed) becomes per-frame local rotation
 vectors, at 30 fps, for the 15 action joints and the finger bones. The motion is built the way an
@@ -19,11 +19,11 @@ Pointing contract: at the hold the index-finger base lies on the ray from the ar
 joint along `spaces.pointing_direction(arm, target)`, and the finger (Index1 head -> Index4 head)
 runs along that ray, so its line passes through the target at any distance.
 """
-from .clips import MAX_WAVING, GestureClip, synthesise
+from .clips import GUIDE, MAX_WAVING, POINT, RAISE_HAND, SYNTHESISERS, WAVE, GestureClip, synthesise
 from .pose import ANIMATED_BONES, FINGER_BONES, FPS
 from .arms import neutral_pose
 from .style import GestureSpec, Style, draw_style
 from .timing import keyed_progress
 
-__all__ = ["ANIMATED_BONES", "FINGER_BONES", "FPS", "MAX_WAVING", "GestureClip", "GestureSpec", "Style", "draw_style",
-           "keyed_progress", "neutral_pose", "synthesise"]
+__all__ = ["ANIMATED_BONES", "FINGER_BONES", "FPS", "GUIDE", "MAX_WAVING", "POINT", "RAISE_HAND", "SYNTHESISERS", "WAVE",
+           "GestureClip", "GestureSpec", "Style", "draw_style", "keyed_progress", "neutral_pose", "synthesise"]

@@ -4,19 +4,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, skeleton
+from rlanimate_addon.core import skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import matrix_to_rotvec
 
 from .arms import arm_keys, arm_prefix, move_arm, neutral_body
+from .guiding import guide_heading, guide_hold
 from .pointing import pointing_geometry, pointing_hold
 from .pose import ANIMATED_BONES, FINGERS, FPS, OTHER_ARM, Pose
+from .raising import raised_hand_pose
 from .style import GestureSpec, draw_style
 from .timing import blend_rotation, keyed_progress
 from .waving import wave_pose
 
 
 MAX_WAVING = 1.7  # s of oscillation at most, so no clip runs past 4.5 s
+
+#: The behaviours the generator makes: the paper's two and two more (docs/CLIPS.md).
+POINT, WAVE, GUIDE, RAISE_HAND = "POINT", "WAVE", "GUIDE", "RAISE_HAND"
 
 _GROUPS = {  # body part -> bones whose timing it sets (the other arm's bones stay neutral)
     "torso": ("Spine", "Spine1", "Spine2"),
@@ -78,16 +83,14 @@ def _assemble(spec, end, progress, times, phases, fold=0.0):
     return GestureClip(spec, rotvecs, phases)
 
 
-def _synthesise_point(spec, style):
-    target = np.asarray(spec.target, dtype=np.float64)
-    _, azimuth, elevation, _ = pointing_geometry(spec.arm, target)
-    hold = pointing_hold(spec.arm, target, style)
+def _held_gesture(spec, style, end, stroke, hold, phase_names=("stroke", "hold", "return"), fold=0.05):
+    """Out to the `end` pose in `stroke` s (tempo included), held still for `hold` s (before tempo), and
+    back: the timing of a point, shared by every gesture that holds one pose."""
     k = style.tempo
     lead, wind, settle = style.lead_in, 0.22 * k, 0.28 * k
-    stroke = (0.62 + 0.1 * max(elevation, 0.0) + 0.1 * max(-azimuth, 0.0)) * k
     back, back_settle, rest = 0.85 * k, 0.3 * k, 0.3
     t1 = lead + wind + stroke
-    t2 = t1 + settle + style.hold * k
+    t2 = t1 + settle + hold * k
     total = t2 + back + back_settle + rest
     times = np.arange(int(round(total * FPS)) + 1) / FPS
     overshoot = style.overshoot
@@ -100,9 +103,30 @@ def _synthesise_point(spec, style):
                  (t2 + 0.05 + back, 0)],
     }
     progress = {g: keyed_progress(times, kn) for g, kn in knots.items()}
-    return _assemble(spec, hold, progress, times,
-                     {"stroke": (lead + wind, t1), "hold": (t1 + settle, t2), "return": (t2, t2 + back)},
-                     fold=0.05)
+    out, held, back_name = phase_names
+    return _assemble(spec, end, progress, times,
+                     {out: (lead + wind, t1), held: (t1 + settle, t2), back_name: (t2, t2 + back)}, fold=fold)
+
+
+def _synthesise_point(spec, style):
+    target = np.asarray(spec.target, dtype=np.float64)
+    _, azimuth, elevation, _ = pointing_geometry(spec.arm, target)
+    stroke = (0.62 + 0.1 * max(elevation, 0.0) + 0.1 * max(-azimuth, 0.0)) * style.tempo
+    return _held_gesture(spec, style, pointing_hold(spec.arm, target, style), stroke, style.hold)
+
+
+def _synthesise_guide(spec, style):
+    target = np.asarray(spec.target, dtype=np.float64)
+    _, azimuth, _ = guide_heading(spec.arm, target)
+    stroke = (0.65 + 0.1 * max(-azimuth, 0.0) + 0.05 * abs(azimuth)) * style.tempo
+    return _held_gesture(spec, style, guide_hold(spec.arm, target, style), stroke, style.hold + 0.15)
+
+
+def _synthesise_raise(spec, style):
+    e = float(spec.exaggeration)
+    stroke = (0.65 + 0.1 * e) * style.tempo
+    return _held_gesture(spec, style, raised_hand_pose(spec.arm, e, style), stroke, style.hold + 0.1 + 0.15 * e,
+                         ("raise", "hold", "lower"), fold=0.1)
 
 
 def _synthesise_wave(spec, style):
@@ -133,17 +157,20 @@ def _synthesise_wave(spec, style):
                      fold=0.08)
 
 
+#: {behaviour: (kind, synthesiser)}: a target behaviour needs spec.target, an intensity one spec.exaggeration.
+SYNTHESISERS = {POINT: ("target", _synthesise_point), WAVE: ("intensity", _synthesise_wave),
+                GUIDE: ("target", _synthesise_guide), RAISE_HAND: ("intensity", _synthesise_raise)}
+
+
 def synthesise(spec):
     """GestureClip for a GestureSpec; raises RLAnimateError for an unusable spec."""
-    if spec.behaviour not in behaviours.KNOWN_KINDS:
-        raise RLAnimateError(f"The generator has no {spec.behaviour!r} gesture: use POINT or WAVE.")
+    if spec.behaviour not in SYNTHESISERS:
+        raise RLAnimateError(f"Unknown behaviour {spec.behaviour!r}: use {', '.join(SYNTHESISERS)}.")
     if spec.arm not in skeleton.ARMS:
         raise RLAnimateError(f"Unknown arm {spec.arm!r}: use LEFT or RIGHT.")
-    style = draw_style(spec.seed)
-    if spec.behaviour == behaviours.POINT:
-        if spec.target is None or np.shape(spec.target) != (3,):
-            raise RLAnimateError("A pointing gesture needs a target (x, y, z) in the character frame.")
-        return _synthesise_point(spec, style)
-    if spec.exaggeration is None or not 0.0 <= float(spec.exaggeration) <= 1.0:
-        raise RLAnimateError("A wave needs an exaggeration between 0 and 1.")
-    return _synthesise_wave(spec, style)
+    kind, synthesiser = SYNTHESISERS[spec.behaviour]
+    if kind == "target" and (spec.target is None or np.shape(spec.target) != (3,)):
+        raise RLAnimateError(f"A {spec.behaviour.lower()} gesture needs a target (x, y, z) in the character frame.")
+    if kind == "intensity" and (spec.exaggeration is None or not 0.0 <= float(spec.exaggeration) <= 1.0):
+        raise RLAnimateError(f"A {spec.behaviour.lower()} gesture needs an exaggeration between 0 and 1.")
+    return synthesiser(spec, draw_style(spec.seed))

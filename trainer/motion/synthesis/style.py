@@ -7,8 +7,9 @@ import numpy as np
 
 @dataclass(frozen=True)
 class GestureSpec:
-    """What to perform. `target` (3,) in the character frame for POINT; `exaggeration` in [0, 1]
-    for WAVE. `seed` picks the style (timing and posture variation)."""
+    """What to perform. `target` (3,) in the character frame for a target behaviour (POINT, GUIDE);
+    `exaggeration` in [0, 1] for an intensity one (WAVE, RAISE_HAND). `seed` picks the style (timing and
+    posture variation)."""
     behaviour: str
     arm: str
     target: tuple = None

@@ -60,7 +60,9 @@ def test_every_clip_starts_and_ends_in_the_shared_neutral_pose():
     neutral = gs.neutral_pose()
     rng = np.random.default_rng()
     clips = [point("LEFT", random_target(rng, "LEFT"), 3), point("RIGHT", random_target(rng, "RIGHT"), 4),
-             wave("LEFT", 0.1, 5), wave("RIGHT", 0.9, 6)]
+             wave("LEFT", 0.1, 5), wave("RIGHT", 0.9, 6),
+             gs.synthesise(gs.GestureSpec("GUIDE", "LEFT", target=(1.5, -2.0, 0.5), seed=7)),
+             gs.synthesise(gs.GestureSpec("RAISE_HAND", "RIGHT", exaggeration=0.6, seed=8))]
     for clip in clips:
         assert set(clip.rotvecs) == set(gs.ANIMATED_BONES)
         for name, rotvecs in clip.rotvecs.items():
@@ -219,6 +221,8 @@ def test_blend_follows_a_great_circle_and_reaches_both_ends():
     gs.GestureSpec("WAVE", "MIDDLE", exaggeration=0.5),
     gs.GestureSpec("WAVE", "LEFT", exaggeration=1.5),
     gs.GestureSpec("POINT", "LEFT"),
+    gs.GestureSpec("GUIDE", "LEFT", exaggeration=0.5),
+    gs.GestureSpec("RAISE_HAND", "RIGHT", target=(0.0, -2.0, 1.0)),
 ])
 def test_unusable_specs_raise_the_domain_error(spec):
     with pytest.raises(RLAnimateError):
