@@ -32,7 +32,7 @@ from trainer.agent.models import RLAnimateAgent
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
-from trainer.motion.clip import library_space
+from trainer.motion.clip import training_space
 from trainer.motion.manifest import manifest_path
 from trainer.paths import DEFAULT_MANIFEST
 from trainer.reporting import plots
@@ -181,8 +181,8 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     saved = checkpoint.load(output / checkpoint.FILENAME) if settings.resume else None
     settings = _resolved(settings, saved)
     agent_config, train_config = load_preset(settings.preset)
-    space = library_space(session.train_clips)
-    trained = behaviours.training_set(settings.behaviour, space.names)
+    space = training_space(session.train_clips, settings.behaviour)
+    trained = space.names
     epochs = settings.epochs or (train_config.epochs_both if len(trained) > 1 else train_config.epochs_single)
 
     seed_everything(settings.seed)

@@ -45,6 +45,14 @@ def library_space(clips):
     return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 
+def training_space(clips, training_set):
+    """The ObjectiveSpace an agent trained on `clips` with the training set `training_set` ("all", "both", keys:
+    behaviours.training_set) declares: its own behaviours only, so point and wave taken from a library with
+    more behaviours keep the paper's objective, as the shipped agent has it."""
+    trained = behaviours.training_set(training_set, library_space(clips).names)
+    return library_space([clip for clip in clips if clip.behaviour in trained])
+
+
 @dataclass
 class ClipSet:
     """Labelled clips of a manifest, and the problems of the files that could not be used."""
