@@ -177,6 +177,8 @@ def realmocap_markdown(results):
              f"{', '.join(str(seed) for seed in results['seeds'])} (the tables but the last are seed "
              f"{results['seeds'][0]}'s). "
              f"Regenerate: `{results['command']}`.", "",
+             *([f"**One seed only (seed {results['seeds'][0]}): no spread over seeds is given, and one seed's "
+                "agent can sit a few points either side of the mean.**", ""] if len(results["seeds"]) == 1 else []),
              "## Auto-labels per style (one-arm waves: takes 001-010 and 021-036)", "",
              *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
                               "arm detected"], label_rows),
