@@ -57,7 +57,7 @@ def main(argv=None):
     (out / "realmocap.json").write_text(json.dumps(results, indent=2) + "\n")
     (out / "realmocap.md").write_text(realmocap_markdown(results))
     write_baselines_results(out, "real motion capture",
-                  "Agents trained on the real waves (takes 001-008, or 5 styles); pointing agent from "
+                  "Agents trained on the real waves (takes 001-008 and 021-036, or 5 styles); pointing agent from "
                   f"the sample library for the guide clips. Regenerate: `{results['command']}`.",
                   baseline_sets(results))
     print(realmocap_markdown(results))
