@@ -26,6 +26,7 @@ import report  # noqa: E402  (benchmarks/report.py)
 from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip_directory, import_into_cache  # noqa: E402
 from trainer.cluster import connect  # noqa: E402
 from trainer.experiments.paper import COLUMNS, PaperSettings, run_folder, train_all  # noqa: E402
+from trainer.motion.realmocap_takes import take_paths  # noqa: E402
 from trainer.paths import DEFAULT_MANIFEST, REALMOCAP_DIR  # noqa: E402
 
 HEADING = "## Ray workers"
@@ -54,7 +55,7 @@ def import_seconds(workers, folder):
 def realmocap_seconds(workers, folder):
     """Wall seconds to import every real take (wave/, bye/, guide/) into a fresh cache with `workers` Blenders
     (one Blender in this process when `workers` is 1); and the number of takes."""
-    files = [(p, EXPECTED_FPS) for sub in ("wave", "bye", "guide") for p in sorted((REALMOCAP_DIR / sub).glob("*.bvh"))]
+    files = [(p, EXPECTED_FPS) for sub in ("wave", "bye", "guide") for p in take_paths(REALMOCAP_DIR / sub)]
     start = time.perf_counter()
     if workers == 1:
         from trainer.blender_io.clip_import import import_clip

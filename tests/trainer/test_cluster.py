@@ -1,13 +1,15 @@
 """Ray tasks (trainer/cluster.py) give what the serial code gives: a training run on a Ray worker is bit for
-bit the run trained in this process, and clips imported by two Blenders at once are the serial import's,
-in the same cache."""
+bit the run trained in this process (on the sample library and on real capture), and clips imported by two
+Blenders at once are the serial import's, in the same cache."""
 import numpy as np
 import pytest
 
 from trainer.blender_io.clip_import import import_clip_directory
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect
+from trainer.experiments import realmocap
 from trainer.experiments.run import RunSettings, train, train_runs
+from trainer.paths import REALMOCAP_DIR
 
 ray = pytest.importorskip("ray", reason="Ray is a trainer dependency: pip install ray")
 
@@ -28,10 +30,37 @@ def test_a_run_on_a_ray_worker_equals_the_run_in_this_process(tiny_library, tmp_
     [(settings, report)] = list(train_runs([run(tmp_path / "ray")]))
     assert settings.output == str(tmp_path / "ray") and report["epochs"] == 2
     assert "clips:" in (tmp_path / "ray" / "train.log").read_text()  # the worker's output went to the run's log
-    with np.load(tmp_path / "serial" / "agent.npz") as serial, np.load(tmp_path / "ray" / "agent.npz") as remote:
-        weights = [name for name in serial.files if serial[name].dtype.kind == "f"]
-        assert len(weights) > 10 and sorted(serial.files) == sorted(remote.files)
-        assert all(np.array_equal(serial[name], remote[name]) for name in weights)
+    assert _agents_equal(tmp_path / "serial", tmp_path / "ray")
+
+
+def _agents_equal(folder_a, folder_b):
+    with np.load(folder_a / "agent.npz") as a, np.load(folder_b / "agent.npz") as b:
+        weights = [name for name in a.files if a[name].dtype.kind == "f"]
+        return len(weights) > 10 and sorted(a.files) == sorted(b.files) and all(
+            np.array_equal(a[name], b[name]) for name in weights)
+
+
+@pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
+                    reason=f"real motion capture not found at {REALMOCAP_DIR} (../shared/realmocap/ beside the repository)")
+def test_a_real_capture_run_on_a_ray_worker_equals_the_run_in_this_process(tmp_path, local_ray):
+    wave = REALMOCAP_DIR / "wave"
+    train_takes = tuple(str(wave / f"dataset-2_wave-left-hand_{name}.bvh") for name in ("feminine_001", "active_021"))
+    test_takes = (str(wave / "dataset-2_wave-left-hand_normal_009.bvh"),)
+
+    def run(output):
+        settings = RunSettings(output=str(output), behaviour="wave", clips="realmocap:tiny", epochs=2, seed=3,
+                               preset="debug", variant="rlanimate", eval_every=0, progress=False)
+        return realmocap.RealRun(settings, train_takes, test_takes, str(tmp_path / "cache"))
+
+    serial = run(tmp_path / "serial")
+    report, _ = train(serial.settings, realmocap.real_session(serial.train_takes, serial.test_takes, serial.cache))
+    reports = realmocap.train_real_runs([run(tmp_path / "ray")])
+    remote = reports[str(tmp_path / "ray")]
+    assert remote["episodes"] == report["episodes"] == 2 and remote["held_out"]["score"] == report["held_out"]["score"]
+    assert (tmp_path / "ray" / "train.log").is_file()  # the worker's output went to the run's log
+    assert _agents_equal(tmp_path / "serial", tmp_path / "ray")
+    # A finished run is not trained again: its report is read back.
+    assert realmocap.train_real_runs([run(tmp_path / "ray")]) == reports
 
 
 def test_clips_imported_by_two_blenders_are_the_serial_import_in_the_same_cache(tiny_library, tmp_path, local_ray):

@@ -12,8 +12,8 @@ ProceduralIK     Blender's IK constraint on the sample rig (trainer/blender_io/p
 
 Nearest clip and procedural IK start from and return to `mean_start_pose(clips)` (15, 3), the pose
 the training clips start in.
-AgentMethod (an exported .npz, numpy runtime) and TrainedAgentMethod (a trainer's torch agent) put
-RLAnimate behind the same generate() interface, so all are scored by one code path.
+AgentMethod (an exported .npz, numpy runtime: what the add-on plays) puts RLAnimate behind the same
+generate() interface, so all are scored by one code path.
 """
 from collections.abc import Sequence
 from pathlib import Path
@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rlanimate_addon.core import behaviours, rhythm, rotations, spaces
+from rlanimate_addon.core import behaviours, rotations, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 from trainer.motion.clip import MotionClip
@@ -110,29 +110,6 @@ class ClassMean:
         quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
         mean = quats.mean(axis=0)
         return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
-
-
-class TrainedAgentMethod:
-    """A torch RLAnimate agent behind the baselines' generate() interface: the deterministic rollout
-    that trainer.evaluation.scoring scores, decoded to rotations with the trainer's bounds."""
-
-    def __init__(self, trainer, path):
-        self.agent, self.bounds, self.path = trainer.played_agent, trainer.bounds, Path(path)
-        self.rhythm_model = trainer.rhythm_model
-
-    def generate(self, behaviour, arm, attributes, frame_count, seed=None):
-        """Deterministic without `seed`; with one, a sampled rollout from a generator seeded with it (and
-        a wave's rhythm drawn with it, core/rhythm.py)."""
-        import torch
-
-        from trainer.agent.algorithm import rollout_actions
-        self.agent.eval()
-        generator = None if seed is None else torch.Generator().manual_seed(int(seed))
-        signals = (rhythm.signals(self.rhythm_model.draw(attributes, seed), frame_count)
-                   if behaviour == behaviours.WAVE and self.rhythm_model is not None else None)
-        objectives = self.agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
-        actions = rollout_actions(self.agent, objectives, deterministic=seed is None, generator=generator)
-        return spaces.decode_action(actions, self.bounds)
 
 
 class AgentMethod:

@@ -19,7 +19,7 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.evaluation import behaviour, scoring
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.evaluation.harder_split import harder_clips
-from trainer.experiments.run import RunSettings, train_runs
+from trainer.experiments.run import RunSettings, is_finished, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, seed_folder
 from trainer.reporting import plots
@@ -57,11 +57,6 @@ def run_folder(settings, seed, variant, column):
 
 def planned_epochs(settings, column):
     return max(1, int(round(PAPER_EPOCHS[column] * settings.epoch_scale)))
-
-
-def is_finished(folder, epochs):
-    report = folder / "report.json"
-    return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
 
 
 def run_settings(settings: PaperSettings, seed: int, variant: str, column: str) -> RunSettings:

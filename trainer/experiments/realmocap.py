@@ -6,19 +6,24 @@ docs/REALMOCAP.md). Each BVH goes through trainer/blender_io/clip_import.py (Ble
 the canonicalisation); the capture has no fingers, so the synthesised clips' relaxed hand (motion/realmocap_takes.py)
 is put on, and labels come from the motion (trainer/motion/autolabel.py).
 
-Experiments, each trained with trainer.experiments.run.train on a session of real clips (runs/realmocap/<name>/,
-and runs/realmocap_seed<N>/<name>/ for each further seed):
-    wave      wave agent on takes 001-008 of the 7 styles x 2 arms (112 clips), tested on takes
+Experiments, each seed's agent trained as a Ray task (trainer/cluster.py; `train_real`: the worker builds the
+session of real clips from the import cache and runs trainer.experiments.run.train) into runs/realmocap/<name>/,
+and runs/realmocap_seed<N>/<name>/ for each further seed:
+    wave      wave agent on takes 001-008 and 021-036 of the 7 styles x 2 arms (249 clips), tested on takes
               009-010 (28) and on the 14 goodbye waves of dataset 1 (other actor takes, other styles)
-    holdout   the same on all takes of 5 styles (100 clips), tested on the 2 unseen styles (40 clips)
+    holdout   the same on every take of 5 styles, tested on takes 001-010 of the 2 unseen styles (40 clips)
     guide     the right-arm directing gestures as pointing: the pointing agent is given the direction
               in which the actor held the arm, and we report the angle between the generated and the
               real forearm (elbow -> wrist) at each one's hold
-Both baselines (trainer/evaluation/baselines.py) answer the same requests. The first seed's agents give
-the full tables and the figure; every seed's agents are scored on the wave sets ("seeds"). Writes docs/results/realmocap.json and
-.md, the real-data section of docs/results/baselines.json and .md, and
-docs/results/realmocap_frames.png (generated and real frames side by side).
+Takes 011-020 are never read (motion/realmocap_takes.py, WITHHELD_TAKES). Both baselines
+(trainer/evaluation/baselines.py) answer the same requests, retrieval from the same training clips; the
+agents are scored through their exported agent.npz (the numpy runtime the add-on plays). The first seed's
+agents give the full tables and the figure; every seed's agents are scored on the wave sets ("seeds").
+Writes docs/results/realmocap.json and .md, the real-data section of docs/results/baselines.json and .md,
+and docs/results/realmocap_frames.png (generated and real frames side by side).
 """
+import functools
+import json
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,12 +39,13 @@ from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
+from trainer.cluster import connect, run_tasks
 from trainer.evaluation import baselines, scoring
-from trainer.experiments.run import RunSettings, train
+from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
-                                            style_holdout_split, wave_split)
+                                            style_holdout_split, take_paths, wave_split)
 from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
                            shown)
 from trainer.reporting.realmocap_report import frames_figure, seed_summary
@@ -59,9 +65,10 @@ def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache"):
 
 
 def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_cache", import_workers=1):
-    """Every clip of root/folder ('wave', 'bye' or 'guide'), sorted by name; import_workers > 1: the takes
-    the cache lacks are imported by that many Ray tasks first (clip_import.import_into_cache)."""
-    paths = sorted((require_realmocap(root) / folder).glob("*.bvh"))
+    """Every clip of root/folder ('wave', 'bye' or 'guide') but the withheld takes, sorted by name;
+    import_workers > 1: the takes the cache lacks are imported by that many Ray tasks first
+    (clip_import.import_into_cache)."""
+    paths = take_paths(require_realmocap(root) / folder)
     if import_workers > 1:
         import_into_cache([(p, EXPECTED_FPS) for p in paths], Path(cache_dir), import_workers)
     return [import_real_clip(p, cache_dir) for p in paths]
@@ -109,14 +116,51 @@ def guide_angles(method, clips, env):
             "median_forearm_angle_deg": float(np.median([r["forearm_angle_deg"] for r in rows])), "clips": rows}
 
 
-def train_agent(session, name, behaviour, epochs, preset, seed, runs=REALMOCAP_RUNS):
-    """Train on `session` into runs/<name>/ (resumed when a checkpoint is there); (report, method)."""
-    output = Path(runs) / name
-    settings = RunSettings(output=str(output), behaviour=behaviour, clips=f"realmocap:{name}", epochs=epochs,
-                           seed=seed, preset=preset, variant="rlanimate", eval_every=0,
-                           resume=(output / checkpoint.FILENAME).is_file(), progress=False)
-    report, trainer = train(settings, session)
-    return report, baselines.TrainedAgentMethod(trainer, output / "agent.npz")
+@dataclass(frozen=True)
+class RealRun:
+    """One training run on real takes, as a Ray task gets it: its settings, and the takes (BVH paths, in
+    the session's order) its worker reads from the import cache."""
+    settings: RunSettings
+    train_takes: tuple[str, ...]
+    test_takes: tuple[str, ...]
+    cache: str
+
+
+def real_run(name, train_clips, test_clips, seed, settings):
+    """The RealRun of experiment `name` ('wave' or 'holdout') with `seed`, into <runs>[_seed<N>]/<name>/
+    (resumed when a checkpoint is there)."""
+    output = seed_folder(settings.runs, seed) / name
+    run = RunSettings(output=str(output), behaviour=behaviours.key(behaviours.WAVE), clips=f"realmocap:{name}",
+                      epochs=settings.epochs, seed=seed, preset=settings.preset, variant="rlanimate", eval_every=0,
+                      resume=(output / checkpoint.FILENAME).is_file(), progress=False)
+    return RealRun(run, tuple(c.source for c in train_clips), tuple(c.source for c in test_clips),
+                   str(Path(settings.runs) / "import_cache"))
+
+
+def real_session(train_takes, test_takes, cache):
+    """A RealSession of the takes, imported (or read from the cache `cache`) in this process's Blender."""
+    new_empty_scene()
+    with blender_output():
+        train_clips, test_clips = ([import_real_clip(path, cache) for path in paths] for paths in (train_takes, test_takes))
+        env = FKEnvironment()
+    return RealSession(env, ClipReferences(env), train_clips, test_clips)
+
+
+def train_real(run: RealRun) -> dict:
+    """Train `run` on a session its own process builds, its output in train.log; the report. A Ray task:
+    pinned to one torch thread, it is bit for bit the run `train` makes on the same takes in this process."""
+    return train_logged(run.settings, functools.partial(real_session, run.train_takes, run.test_takes, run.cache))
+
+
+def train_real_runs(runs, address=None, workers=None):
+    """Train the unfinished RealRuns as Ray tasks (trainer/cluster.py); {output folder: its report.json}
+    of every run."""
+    pending = [run for run in runs if not is_finished(Path(run.settings.output), run.settings.epochs)]
+    if pending:
+        connect(address, workers)
+        for run, _ in run_tasks(train_real, pending):
+            print(f"realmocap: trained {shown(run.settings.output)}", flush=True)
+    return {run.settings.output: json.loads((Path(run.settings.output) / "report.json").read_text()) for run in runs}
 
 
 def compare(methods, clips, env, references):
@@ -163,8 +207,13 @@ def point_agent_and_library(point_agent, runs, epochs, seed):
                 return installed, clips
         except RLAnimateError as error:
             print(f"realmocap: not using the installed agent: {error}", file=sys.stderr)
-        return train_agent(library, "sample_point", behaviours.key(behaviours.POINT), epochs, "default", seed,
-                           runs)[1], clips
+        output = Path(runs) / "sample_point"
+        if not is_finished(output, epochs):
+            list(train_runs([RunSettings(output=str(output), behaviour=behaviours.key(behaviours.POINT),
+                                         clips=str(DEFAULT_MANIFEST), epochs=epochs, seed=seed, preset="default",
+                                         variant="rlanimate", eval_every=0,
+                                         resume=(output / checkpoint.FILENAME).is_file(), progress=False)]))
+        point_agent = output / "agent.npz"
     return baselines.AgentMethod(point_agent), clips
 
 
@@ -184,6 +233,8 @@ class RealMocapSettings:
     runs: str = str(REALMOCAP_RUNS)
     results: str = str(RESULTS_DIR)  # where realmocap_frames.png goes
     import_workers: int = 1  # import the takes the cache lacks with this many Blenders at once (Ray tasks)
+    address: str | None = None  # a Ray cluster to join ("auto", "ray://HOST:PORT"); None: a local Ray
+    workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
 
 
 def run_experiments(settings: RealMocapSettings) -> dict:
@@ -194,6 +245,8 @@ def run_experiments(settings: RealMocapSettings) -> dict:
     root = require_realmocap(settings.realmocap)
     Path(settings.results).mkdir(parents=True, exist_ok=True)
     cache = Path(settings.runs) / "import_cache"
+    if settings.address is not None:  # the import's Ray tasks, if any, and the training runs go to the cluster
+        connect(settings.address)
     with blender_output():
         waves, byes, guides = (load_folder(f, root, cache, settings.import_workers) for f in ("wave", "bye", "guide"))
         env = FKEnvironment()
@@ -209,11 +262,12 @@ def run_experiments(settings: RealMocapSettings) -> dict:
                "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
 
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
+    runs = {(name, seed): real_run(name, train_clips, test_clips, seed, settings)
+            for name, (train_clips, test_clips) in experiments.items() for seed in seeds}
+    reports = train_real_runs(runs.values(), settings.address, settings.workers)
     for name, (train_clips, test_clips) in experiments.items():
-        session = RealSession(env, references, train_clips, test_clips)
-        agents = {seed: train_agent(session, name, behaviours.key(behaviours.WAVE), settings.epochs, settings.preset,
-                                    seed, seed_folder(settings.runs, seed)) for seed in seeds}
-        report, agent = agents[seeds[0]]
+        agents = {seed: baselines.AgentMethod(Path(runs[name, seed].settings.output) / "agent.npz") for seed in seeds}
+        report, agent = reports[runs[name, seeds[0]].settings.output], agents[seeds[0]]
         methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
                    "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
         sets = {"test": test_clips} if name == "holdout" else {"test": test_clips, "bye": byes}
@@ -225,7 +279,7 @@ def run_experiments(settings: RealMocapSettings) -> dict:
             entry[set_name] = compare(methods, clips, env, references)
             entry[f"{set_name}_seeds"] = {str(seeds[0]): seed_summary(entry[set_name]["rlanimate"])}
             for seed in seeds[1:]:
-                result = compare({"rlanimate": agents[seed][1]}, clips, env, references)["rlanimate"]
+                result = compare({"rlanimate": agents[seed]}, clips, env, references)["rlanimate"]
                 entry[f"{set_name}_seeds"][str(seed)] = seed_summary(result)
         results[name] = entry
         if name == "wave":

@@ -12,7 +12,7 @@ import os
 import random
 import sys
 import tempfile
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -257,13 +257,21 @@ def _agent_metadata(report, trainer):
                 "held_out_score": report["held_out"]["score"], "held_out_smoothness": report["held_out"]["smoothness"]}}
 
 
-def train_logged(settings: RunSettings) -> dict:
-    """`train` on a LibrarySession of `settings.clips`, everything it prints (Blender's too) going to
-    train.log in the run's folder; returns the report. What a Ray task of `train_runs` runs."""
+def train_logged(settings: RunSettings, make_session: Callable[[], Any] | None = None) -> dict:
+    """`train` on make_session() (None: a LibrarySession of `settings.clips`), everything both print
+    (Blender's too) going to train.log in the run's folder; returns the report. What a Ray task of
+    `train_runs` (or of the real-capture experiment) runs."""
     output = Path(settings.output)
     output.mkdir(parents=True, exist_ok=True)
     with _output_to(output / "train.log"):
-        return train(settings, LibrarySession(settings.clips))[0]
+        session = LibrarySession(settings.clips) if make_session is None else make_session()
+        return train(settings, session)[0]
+
+
+def is_finished(folder: Path, epochs: int) -> bool:
+    """Whether the run in `folder` has trained its `epochs` and written its report."""
+    report = Path(folder) / "report.json"
+    return report.is_file() and json.loads(report.read_text())["epochs"] == epochs
 
 
 def train_runs(runs: Iterable[RunSettings], address: str | None = None,

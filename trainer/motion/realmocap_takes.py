@@ -13,8 +13,13 @@ from trainer.motion.synthesis import FINGER_BONES, neutral_pose
 from trainer.paths import REALMOCAP_DIR
 
 STYLES = ("active", "elderly", "exhausted", "feminine", "masculine", "normal", "youthful")
-TRAIN_TAKES = tuple(f"{k:03d}" for k in range(1, 9))
+#: Takes 001-008 and 021-036 (the later takes exist for some styles and arms only; README there).
+TRAIN_TAKES = tuple(f"{k:03d}" for k in (*range(1, 9), *range(21, 37)))
 TEST_TAKES = ("009", "010")
+#: Takes 011-020 are held out for evaluation outside the project: never read, even where present.
+WITHHELD_TAKES = tuple(f"{k:03d}" for k in range(11, 21))
+#: The takes every style and arm has: the unseen styles are tested on these (40 clips, as before 021-036).
+FIRST_TAKES = tuple(f"{k:03d}" for k in range(1, 11))
 #: Styles the hold-out agent never sees: the two whose labels fall between the trained ones
 #: (exaggeration ~0.3 and ~0.55 against 0.1 feminine and 0.75-1 for the rest), as the paper's unseen
 #: waves are exaggerations between the training ones.
@@ -31,6 +36,12 @@ def require_realmocap(root=REALMOCAP_DIR):
         raise RLAnimateError(f"The real motion capture is not at {root}: put the Bandai Namco clips "
                              "(wave/, bye/, guide/) there, as ../shared/realmocap/README.md describes.")
     return root
+
+
+def take_paths(folder):
+    """The .bvh takes in `folder`, sorted by name, without the withheld ones (WITHHELD_TAKES), which are
+    never opened."""
+    return [path for path in sorted(Path(folder).glob("*.bvh")) if parse_name(path)["take"] not in WITHHELD_TAKES]
 
 
 def parse_name(path):
@@ -63,10 +74,12 @@ def relaxed_hand(clip):
 
 
 def wave_split(clips):
-    """(train, test): takes 001-008 and 009-010 of the one-arm waves."""
+    """(train, test): takes 001-008 and 021-036, and takes 009-010, of the one-arm waves."""
     return [c for c in clips if c.take in TRAIN_TAKES], [c for c in clips if c.take in TEST_TAKES]
 
 
 def style_holdout_split(clips, held_out=HOLDOUT_STYLES):
-    """(train, test): every take of the other styles, and of the held-out ones."""
-    return [c for c in clips if c.style not in held_out], [c for c in clips if c.style in held_out]
+    """(train, test): every take of the other styles (but the withheld ones), and takes 001-010 of the
+    held-out ones."""
+    return ([c for c in clips if c.style not in held_out and c.take in TRAIN_TAKES + TEST_TAKES],
+            [c for c in clips if c.style in held_out and c.take in FIRST_TAKES])

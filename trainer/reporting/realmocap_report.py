@@ -47,40 +47,85 @@ def frames_figure(env, rows, path, times=(0.15, 0.35, 0.5, 0.65, 0.85)):
     plt.close(figure)
 
 
-def per_style_rows(set_label, methods):
-    """Rows of the per-style table for one test set: {method: result with per-clip 'clips'} -> per style
-    and method, the mean score and DTW score, the median swing and frequency ratios and the waves accepted."""
+#: The per-style table's measures: (key of style_summaries' entries, decimals).
+STYLE_METRICS = (("score", 1), ("aligned_score", 1), ("swing_ratio", 2), ("frequency_ratio", 2),
+                 ("elevation_last_error", 1), ("accepted", 0))
+
+
+def style_summaries(result):
+    """{style: {takes, score, aligned_score (means), swing_ratio, frequency_ratio, elevation_last_error
+    (medians; degrees), accepted (waves core.behaviour_metrics accepts)}} of one method's scoring on a wave
+    set, its takes grouped by the style in their file names."""
+    by_style = defaultdict(list)
+    for clip in result["clips"]:
+        by_style[parse_name(clip["name"])["style"]].append(clip)
+    summaries = {}
+    for style, clips in sorted(by_style.items()):
+        def values(key):
+            return np.array([clip[key] for clip in clips], dtype=np.float64)
+        summaries[style] = {"takes": len(clips), "score": float(values("score").mean()),
+                            "aligned_score": float(values("aligned_score").mean()),
+                            "swing_ratio": _median_of_defined(values("swing_ratio")),
+                            "frequency_ratio": _median_of_defined(values("frequency_ratio")),
+                            "elevation_last_error": float(np.median(values("elevation_last_error"))),
+                            "accepted": int(values("wave_accepted").sum())}
+    return summaries
+
+
+def _median_of_defined(values):
+    """The median of the values that are not NaN (a ratio to a reference without swing); NaN when none is."""
+    defined = values[~np.isnan(values)]
+    return float(np.median(defined)) if len(defined) else float("nan")
+
+
+def _spread(values, digits):
+    """'mean ± sd' of per-seed values (sd with ddof 1), at least one decimal."""
+    values = np.asarray(values, dtype=np.float64)
+    digits = max(digits, 1)
+    return f"{values.mean():.{digits}f} ± {values.std(ddof=1):.{digits}f}"
+
+
+def per_style_rows(set_label, methods, seeds):
+    """Rows of the per-style table for one test set: per style, RLAnimate (each seed's agent, from `seeds`
+    {seed: seed_summary}: their mean ± sd when there are several), then the other methods of `methods`
+    ({method: scoring result with per-clip 'clips'})."""
+    per_seed = [summary["by_style"] for summary in seeds.values()]
+    others = {method: style_summaries(result) for method, result in methods.items() if method != "rlanimate"}
     rows = []
-    for method, result in methods.items():
-        by_style = defaultdict(list)
-        for clip in result["clips"]:
-            by_style[parse_name(clip["name"])["style"]].append(clip)
-        for style, clips in by_style.items():
-            def values(key):
-                return np.array([clip[key] for clip in clips], dtype=np.float64)
-            rows.append((style, method, [set_label, style, METHOD_LABELS[method], len(clips),
-                                         f"{values('score').mean():.1f}", f"{values('aligned_score').mean():.1f}",
-                                         f"{np.median(values('swing_ratio')):.2f}",
-                                         f"{np.median(values('frequency_ratio')):.2f}",
-                                         f"{int(values('wave_accepted').sum())}/{len(clips)}"]))
-    return [row for _, _, row in sorted(rows, key=lambda item: (item[0], list(methods).index(item[1])))]
+    for style in sorted(per_seed[0]):
+        takes = per_seed[0][style]["takes"]
+        if len(per_seed) > 1:
+            cells = [_spread([entry[style][key] for entry in per_seed], digits) for key, digits in STYLE_METRICS]
+            label = f"RLAnimate, mean ± sd of {len(per_seed)} seeds"
+        else:
+            cells = [f"{per_seed[0][style][key]:.{digits}f}" for key, digits in STYLE_METRICS]
+            label = f"RLAnimate, seed {next(iter(seeds))}"
+        rows.append([set_label, style, label, takes, *cells[:-1], f"{cells[-1]} / {takes}"])
+        for method, summaries in others.items():
+            entry = summaries[style]
+            cells = [f"{entry[key]:.{digits}f}" for key, digits in STYLE_METRICS]
+            rows.append([set_label, style, METHOD_LABELS[method], takes, *cells[:-1], f"{cells[-1]} / {takes}"])
+    return rows
 
 
 SEED_SETS = (("wave", "test", "takes 009-010"), ("wave", "bye", "goodbye waves"), ("holdout", "test", "unseen styles"))
 #: The seeds table's columns and their decimals (the mean ± sd row keeps at least one).
 SEED_METRICS = (("score", 1), ("aligned_score", 1), ("swing_ratio_median", 2), ("frequency_ratio_median", 2),
-                ("accepted", 0))
+                ("elevation_last_error_median", 1), ("accepted", 0))
 
 
 def seed_summary(result):
     """One method's (for RLAnimate, one seed's agent's) scoring on one wave set: clips, score, smoothness,
-    label error, DTW score, median swing and frequency ratios, and the waves `core.behaviour_metrics` accepts."""
+    label error, DTW score, median swing and frequency ratios and last-frame elevation error, the waves
+    `core.behaviour_metrics` accepts, and the same per style (style_summaries)."""
     wave = result["by_behaviour"]["wave"]
     return {"clips": len(result["clips"]),
             **{key: result[key] for key in ("score", "smoothness", "label_error") if key in result},
             "aligned_score": wave["aligned_score"], "swing_ratio_median": wave["swing_ratio_median"],
             "frequency_ratio_median": wave["frequency_ratio_median"],
-            "accepted": int(round(wave["accepted_share"] * len(result["clips"])))}
+            "elevation_last_error_median": wave["elevation_last_error_median"],
+            "accepted": int(round(wave["accepted_share"] * len(result["clips"]))),
+            "by_style": style_summaries(result)}
 
 
 def seed_rows(results):
@@ -94,11 +139,8 @@ def seed_rows(results):
         per_seed = results[name][f"{set_name}_seeds"]
         rows += [[label, f"RLAnimate, seed {seed}", *cells(summary)] for seed, summary in per_seed.items()]
         if len(per_seed) > 1:
-            spread = []
-            for key, digits in SEED_METRICS:
-                values = np.array([summary[key] for summary in per_seed.values()], dtype=np.float64)
-                digits = max(digits, 1)
-                spread.append(f"**{values.mean():.{digits}f} ± {values.std(ddof=1):.{digits}f}**")
+            spread = [f"**{_spread([summary[key] for summary in per_seed.values()], digits)}**"
+                      for key, digits in SEED_METRICS]
             rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}", *spread])
         rows.append([label, METHOD_LABELS["nearest_clip"], *cells(seed_summary(results[name][set_name]["nearest_clip"]))])
     return rows
@@ -110,8 +152,9 @@ def realmocap_markdown(results):
                    f"{row['stroke_arm_lengths']:.2f}", f"{row['arm_correct']}/{row['clips']}"]
                   for style, row in results["labels"]["wave"].items()]
     score_rows, behaviour_rows, style_rows = [], [], []
-    for name, label in (("wave", "wave agent, takes 001-008 (112 clips)"),
-                        ("holdout", f"wave agent, 5 styles (100 clips; unseen: {', '.join(HOLDOUT_STYLES)})")):
+    for name, label in (("wave", f"wave agent, takes 001-008 and 021-036 ({results['wave']['train_clips']} clips)"),
+                        ("holdout", f"wave agent, 5 styles ({results['holdout']['train_clips']} clips; unseen: "
+                                    f"{', '.join(HOLDOUT_STYLES)})")):
         entry = results[name]
         for set_name in ("test", "bye"):
             for method, result in entry.get(set_name, {}).items():
@@ -122,10 +165,10 @@ def realmocap_markdown(results):
                                        f"{wave['aligned_score']:.2f}", f"{wave['swing_ratio_median']:.2f}",
                                        f"{wave['frequency_ratio_median']:.2f}", f"{wave['cycles_median']:.0f}",
                                        f"{round(wave['accepted_share'] * len(result['clips']))}/{len(result['clips'])}"])
-        if "test" in entry:
-            style_rows += per_style_rows("takes 009-010" if name == "wave" else "unseen styles", entry["test"])
-        score_rows.append([label, "seen (10 training clips)", "RLAnimate", f"{entry['seen']['score']:.2f}",
-                           f"{entry['seen']['smoothness']:.2f}", ""])
+        style_rows += per_style_rows("takes 009-010" if name == "wave" else "unseen styles", entry["test"],
+                                     entry["test_seeds"])
+        score_rows.append([label, f"seen ({entry['seen']['clips']} training clips)", "RLAnimate",
+                           f"{entry['seen']['score']:.2f}", f"{entry['seen']['smoothness']:.2f}", ""])
     bye = results["labels"]["bye"].items()
     lines = ["# Learning from real motion capture", "",
              f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the "
@@ -134,7 +177,9 @@ def realmocap_markdown(results):
              f"{', '.join(str(seed) for seed in results['seeds'])} (the tables but the last are seed "
              f"{results['seeds'][0]}'s). "
              f"Regenerate: `{results['command']}`.", "",
-             "## Auto-labels per style (one-arm waves, 20 clips each)", "",
+             *([f"**One seed only (seed {results['seeds'][0]}): no spread over seeds is given, and one seed's "
+                "agent can sit a few points either side of the mean.**", ""] if len(results["seeds"]) == 1 else []),
+             "## Auto-labels per style (one-arm waves: takes 001-010 and 021-036)", "",
              *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
                               "arm detected"], label_rows),
              "", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), "",
@@ -149,15 +194,18 @@ def realmocap_markdown(results):
              *markdown_table(["experiment", "test set", "method", "DTW score", "swing ratio", "frequency ratio",
                               "cycles", "accepted"], behaviour_rows),
              "", "### Per style", "",
-             "Mean score and DTW score, median swing and frequency ratios over a style's test takes (takes "
-             "009-010: two takes x two arms; unseen styles: ten takes x two arms).", "",
+             "Over a style's test takes (takes 009-010: two takes x two arms; unseen styles: takes 001-010 x two "
+             "arms): mean score and DTW score; median swing and frequency ratios (issue 26 asks 0.75-1.33 and "
+             "0.8-1.25 in every style) and last-frame arm elevation error (degrees; asked: at most 4); waves "
+             "accepted. RLAnimate: mean ± sd over the seeds' agents when there are several.", "",
              *markdown_table(["test set", "style", "method", "takes", "score", "DTW score", "swing ratio",
-                              "frequency ratio", "accepted"], style_rows),
+                              "frequency ratio", "last-frame elevation error (deg)", "accepted"], style_rows),
              "", "### Seeds", "",
              "RLAnimate trained with each seed, on the same sets: mean score and DTW score, median swing and "
-             "frequency ratios, waves accepted (the mean ± sd row is over the seeds).", "",
+             "frequency ratios and last-frame elevation error, waves accepted (the mean ± sd row is over the "
+             "seeds).", "",
              *markdown_table(["test set", "method", "score", "DTW score", "swing ratio", "frequency ratio",
-                              "accepted"], seed_rows(results)),
+                              "last-frame elevation error (deg)", "accepted"], seed_rows(results)),
              "", f"Training: wave agent {results['wave']['episodes']} episodes, "
              f"{results['wave']['train_seconds']:.0f} s; hold-out agent {results['holdout']['episodes']} episodes, "
              f"{results['holdout']['train_seconds']:.0f} s (1 torch thread).", "",

@@ -2,8 +2,10 @@
 real-data section of docs/results/baselines.json and .md, docs/results/realmocap_frames.png.
 
     nice -n 15 python -m trainer.scripts.realmocap [--epochs 50] [--seeds 0 1 2] [--point-agent PATH]
+                                                   [--workers N | --address auto]
 
-Finished runs are reused: seed 0's in runs/realmocap/, seed N's in runs/realmocap_seed<N>/.
+Each (experiment, seed) trains as a Ray task (trainer/cluster.py). Finished runs are reused: seed 0's in
+runs/realmocap/, seed N's in runs/realmocap_seed<N>/.
 """
 import argparse
 import json
@@ -32,6 +34,11 @@ def build_parser():
     parser.add_argument("--results", default=DEFAULTS.results)
     parser.add_argument("--import-workers", type=int, default=DEFAULTS.import_workers,
                         help="import the takes the cache lacks with N Blenders at once (Ray tasks; default 1)")
+    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
+                        help="a local Ray's training runs at a time (default: one per CPU)")
+    parser.add_argument("--address", default=DEFAULTS.address,
+                        help="join a Ray cluster: auto (started on this machine by ray start) or ray://HOST:PORT "
+                             "(default: a local Ray, no set-up)")
     return parser
 
 
@@ -40,7 +47,7 @@ def parse_settings(argv=None):
     args = build_parser().parse_args(script_args(argv))
     return RealMocapSettings(realmocap=args.realmocap, epochs=args.epochs, preset=args.preset, seeds=tuple(args.seeds),
                              point_agent=args.point_agent, runs=args.runs, results=args.results,
-                             import_workers=args.import_workers)
+                             import_workers=args.import_workers, workers=args.workers, address=args.address)
 
 
 def main(argv=None):
@@ -50,7 +57,7 @@ def main(argv=None):
     (out / "realmocap.json").write_text(json.dumps(results, indent=2) + "\n")
     (out / "realmocap.md").write_text(realmocap_markdown(results))
     write_baselines_results(out, "real motion capture",
-                  "Agents trained on the real waves (takes 001-008, or 5 styles); pointing agent from "
+                  "Agents trained on the real waves (takes 001-008 and 021-036, or 5 styles); pointing agent from "
                   f"the sample library for the guide clips. Regenerate: `{results['command']}`.",
                   baseline_sets(results))
     print(realmocap_markdown(results))

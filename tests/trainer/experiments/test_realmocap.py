@@ -8,6 +8,8 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
 from trainer.evaluation import baselines
 from trainer.experiments import realmocap
+from trainer.experiments.realmocap import RealMocapSettings
+from trainer.experiments.run import train as train_run
 from trainer.motion import autolabel
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import wave_split
@@ -45,10 +47,11 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     env = FKEnvironment(instances=4)
     references = ClipReferences(env)
     session = realmocap.RealSession(env, references, train, test)
-    report, agent = realmocap.train_agent(session, "tiny", "wave", 1, "debug", 0, runs=tmp_path)
-    assert agent.path.is_file() and report["episodes"] == 1
-    exported = baselines.AgentMethod(agent.path).generate("WAVE", "LEFT", 0.4, 40)
-    np.testing.assert_allclose(exported, agent.generate("WAVE", "LEFT", 0.4, 40), atol=1e-4)
+    run = realmocap.real_run("wave", train, test, 0, RealMocapSettings(epochs=1, preset="debug", runs=str(tmp_path)))
+    assert run.settings.output == str(tmp_path / "wave") and run.train_takes == tuple(c.source for c in train)
+    report, _ = train_run(run.settings, session)
+    agent = baselines.AgentMethod(tmp_path / "wave" / "agent.npz")
+    assert report["episodes"] == 1 and agent.agent.metadata["training"]["clips"].endswith("realmocap:wave")
     methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train),
                "procedural_ik": ProceduralIK(baselines.mean_start_pose(train))}
     comparison = realmocap.compare(methods, test, env, references)

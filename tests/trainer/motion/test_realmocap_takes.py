@@ -11,6 +11,9 @@ from trainer.motion.clip import MotionClip
 
 WAVE_NAMES = [f"dataset-2_wave-{side}-hand_{style}_{take:03d}.bvh" for side in ("left", "right")
               for style in realmocap_takes.STYLES for take in range(1, 11)]
+#: Takes 021-036 exist for some styles and arms only: two here.
+LATER_NAMES = [f"dataset-2_wave-{side}-hand_{style}_{take:03d}.bvh" for side in ("left", "right")
+               for style in realmocap_takes.STYLES for take in (21, 36)]
 
 
 def test_parse_name_reads_content_arm_style_and_take():
@@ -23,13 +26,25 @@ def test_parse_name_reads_content_arm_style_and_take():
 
 
 def test_splits_match_the_experiments():
-    clips = [SimpleNamespace(**realmocap_takes.parse_name(name)) for name in WAVE_NAMES]
+    clips = [SimpleNamespace(**realmocap_takes.parse_name(name)) for name in WAVE_NAMES + LATER_NAMES]
     train, test = realmocap_takes.wave_split(clips)
-    assert (len(train), len(test)) == (112, 28)
-    assert {c.take for c in test} == {"009", "010"}
+    assert (len(train), len(test)) == (112 + 28, 28)
+    assert {c.take for c in test} == {"009", "010"} and {"021", "036"} <= {c.take for c in train}
     train, test = realmocap_takes.style_holdout_split(clips)
-    assert (len(train), len(test)) == (100, 40)
+    assert (len(train), len(test)) == (100 + 20, 40)  # the unseen styles are tested on takes 001-010
     assert not {c.style for c in train} & {c.style for c in test}
+    assert {c.take for c in test} == {f"{k:03d}" for k in range(1, 11)}
+
+
+def test_take_selection_never_reads_the_withheld_takes_011_to_020(tmp_path):
+    withheld = [f"dataset-2_wave-left-hand_normal_{take:03d}.bvh" for take in range(11, 21)]
+    for name in WAVE_NAMES[:12] + LATER_NAMES[:2] + withheld:
+        (tmp_path / name).write_text("not read")  # names only: the selection must not open a file
+    chosen = [path.name for path in realmocap_takes.take_paths(tmp_path)]
+    assert chosen == sorted(WAVE_NAMES[:12] + LATER_NAMES[:2])
+    assert not set(chosen) & set(withheld)
+    taken = [SimpleNamespace(**realmocap_takes.parse_name(name)) for name in withheld]
+    assert realmocap_takes.wave_split(taken) == realmocap_takes.style_holdout_split(taken) == ([], [])
 
 
 def test_relaxed_hand_curls_the_fingers_towards_the_palm():

@@ -1,35 +1,54 @@
 """docs/results/realmocap.md's per-style table (takes grouped by the style in their file names) and
 seeds table (each seed, their mean ± sd, and retrieval)."""
-from trainer.reporting.realmocap_report import per_style_rows, seed_rows
+import numpy as np
+
+from trainer.reporting.realmocap_report import per_style_rows, seed_rows, style_summaries
 
 
-def _clip(style, take, score, swing, accepted):
+def _clip(style, take, score, swing, accepted, elevation=2.0):
     return {"name": f"dataset-2_wave-left-hand_{style}_{take:03d}", "score": score, "aligned_score": score + 5.0,
-            "swing_ratio": swing, "frequency_ratio": 1.0, "wave_accepted": float(accepted)}
+            "swing_ratio": swing, "frequency_ratio": 1.0, "elevation_last_error": elevation,
+            "wave_accepted": float(accepted)}
 
 
-def test_per_style_rows_group_takes_by_style_and_keep_the_methods_order():
-    methods = {
-        "rlanimate": {"clips": [_clip("normal", 9, 60.0, 0.5, False), _clip("active", 9, 40.0, 0.2, False),
-                                _clip("normal", 10, 80.0, 0.9, True)]},
-        "nearest_clip": {"clips": [_clip("normal", 9, 70.0, 1.0, True), _clip("active", 9, 50.0, 1.1, True),
-                                   _clip("normal", 10, 90.0, 1.2, True)]},
-    }
-    rows = per_style_rows("takes 009-010", methods)
-    assert [row[1:3] for row in rows] == [["active", "RLAnimate"], ["active", "Nearest clip"],
-                                          ["normal", "RLAnimate"], ["normal", "Nearest clip"]]
-    normal_agent = rows[2]
-    assert normal_agent[3:] == [2, "70.0", "75.0", "0.70", "1.00", "1/2"]
+def test_style_summaries_group_takes_by_the_style_in_their_names():
+    summaries = style_summaries({"clips": [_clip("normal", 9, 60.0, 0.5, False, 12.0), _clip("active", 9, 40.0, 0.2, False),
+                                           _clip("normal", 10, 80.0, 0.9, True, 4.0)]})
+    assert list(summaries) == ["active", "normal"]
+    undefined = style_summaries({"clips": [_clip("elderly", 1, 50.0, float("nan"), False)]})["elderly"]
+    assert np.isnan(undefined["swing_ratio"]) and undefined["frequency_ratio"] == 1.0
+    assert summaries["normal"] == {"takes": 2, "score": 70.0, "aligned_score": 75.0, "swing_ratio": 0.7,
+                                   "frequency_ratio": 1.0, "elevation_last_error": 8.0, "accepted": 1}
+
+
+def test_per_style_rows_give_rlanimate_over_seeds_then_the_baselines():
+    agent = [_clip("normal", 9, 60.0, 0.5, False, 12.0), _clip("active", 9, 40.0, 0.2, False),
+             _clip("normal", 10, 80.0, 0.9, True, 4.0)]
+    other_seed = [dict(clip, score=clip["score"] + 10.0, swing_ratio=1.0) for clip in agent]
+    methods = {"rlanimate": {"clips": agent},
+               "nearest_clip": {"clips": [_clip("normal", 9, 70.0, 1.0, True), _clip("active", 9, 50.0, 1.1, True),
+                                          _clip("normal", 10, 90.0, 1.2, True)]}}
+    seeds = {"0": {"by_style": style_summaries({"clips": agent})},
+             "1": {"by_style": style_summaries({"clips": other_seed})}}
+    rows = per_style_rows("takes 009-010", methods, seeds)
+    assert [row[1:3] for row in rows] == [["active", "RLAnimate, mean ± sd of 2 seeds"], ["active", "Nearest clip"],
+                                          ["normal", "RLAnimate, mean ± sd of 2 seeds"], ["normal", "Nearest clip"]]
+    assert rows[2][3:] == [2, "75.0 ± 7.1", "75.0 ± 0.0", "0.85 ± 0.21", "1.00 ± 0.00", "8.0 ± 0.0", "1.0 ± 0.0 / 2"]
+    assert rows[3][3:] == [2, "80.0", "85.0", "1.10", "1.00", "2.0", "2 / 2"]
+    one_seed = per_style_rows("takes 009-010", methods, {"0": seeds["0"]})
+    assert one_seed[2][2:] == ["RLAnimate, seed 0", 2, "70.0", "75.0", "0.70", "1.00", "8.0", "1 / 2"]
 
 
 def _seed(score, aligned, swing, accepted):
     return {"clips": 2, "score": score, "smoothness": 99.0, "aligned_score": aligned, "swing_ratio_median": swing,
-            "frequency_ratio_median": 1.0, "accepted": accepted}
+            "frequency_ratio_median": 1.0, "elevation_last_error_median": 3.0, "accepted": accepted}
 
 
 def _retrieval(aligned):
-    wave = {"aligned_score": aligned, "swing_ratio_median": 1.0, "frequency_ratio_median": 1.0, "accepted_share": 0.5}
-    return {"clips": [{}, {}], "score": 70.0, "smoothness": 99.5, "by_behaviour": {"wave": wave}}
+    wave = {"aligned_score": aligned, "swing_ratio_median": 1.0, "frequency_ratio_median": 1.0,
+            "elevation_last_error_median": 2.0, "accepted_share": 0.5}
+    return {"clips": [_clip("normal", 9, 70.0, 1.0, True), _clip("normal", 10, 70.0, 1.0, False)], "score": 70.0,
+            "smoothness": 99.5, "by_behaviour": {"wave": wave}}
 
 
 def test_seed_rows_give_each_seed_then_their_mean_and_sd_then_retrieval():
@@ -45,6 +64,6 @@ def test_seed_rows_give_each_seed_then_their_mean_and_sd_then_retrieval():
                                              ["takes 009-010", "RLAnimate, mean ± sd of 2"],
                                              ["takes 009-010", "Nearest clip"]]
     assert rows[2][2:5] == ["**62.0 ± 2.8**", "**82.0 ± 2.8**", "**1.00 ± 0.14**"]
-    assert rows[3][3] == "81.0" and rows[3][6] == "1"
+    assert rows[2][6] == "**3.0 ± 0.0**" and rows[3][3] == "81.0" and rows[3][6:] == ["2.0", "1"]
     # One seed: no mean row.
     assert [row[1] for row in rows[4:6]] == ["RLAnimate, seed 0", "Nearest clip"]
