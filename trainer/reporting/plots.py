@@ -100,14 +100,19 @@ def wave_hand_paths(panels, path):
         over_time.set_title(f"{title}: wrist side to side (grey: reference hand up)", fontsize=9)
         over_time.set_xlabel("frame")
         over_time.set_ylabel("cm from shoulder")
-        frontal.set_title(f"{title}: wrist path, front view", fontsize=9)
-        frontal.set_xlabel("side (cm)")
-        frontal.set_ylabel("up (cm)")
-        frontal.set_aspect("equal", adjustable="datalim")
+        _front_view(frontal, title)
         over_time.legend(fontsize=7, loc="upper left")
     figure.tight_layout()
     figure.savefig(path, dpi=100)
     plt.close(figure)
+
+
+def _front_view(axis, title):
+    """Titles and scales a wrist path seen from the front, in cm at equal scale."""
+    axis.set_title(f"{title}: wrist path, front view", fontsize=9)
+    axis.set_xlabel("side (cm)")
+    axis.set_ylabel("up (cm)")
+    axis.set_aspect("equal", adjustable="datalim")
 
 
 def gesture_hand_paths(panels, path):
@@ -138,11 +143,8 @@ def gesture_hand_paths(panels, path):
         above.set_title(f"{title}: wrist path from above", fontsize=9)
         above.set_xlabel("side (cm, + character's left)")
         above.set_ylabel("forward (cm)")
-        frontal.set_title(f"{title}: wrist path, front view", fontsize=9)
-        frontal.set_xlabel("side (cm)")
-        frontal.set_ylabel("up (cm)")
-        for axis in (above, frontal):
-            axis.set_aspect("equal", adjustable="datalim")
+        _front_view(frontal, title)
+        above.set_aspect("equal", adjustable="datalim")
         over_time.legend(fontsize=7, loc="upper left")
         above.legend(fontsize=7, loc="best")
     figure.tight_layout()

@@ -25,14 +25,20 @@ def test_plan_has_the_papers_hundred_clips_and_split_then_guides_and_raised_hand
     assert [p.spec.behaviour for p in plan[:100]] == ["POINT"] * 50 + ["WAVE"] * 50  # the paper's clips come first
 
 
+def _targets(plan, behaviour, arm, farthest):
+    """The planned clips of a target behaviour on `arm`, and their unit directions from the rest shoulder;
+    asserts the targets lie 1.5 m to `farthest` away."""
+    clips = [p for p in plan if p.spec.behaviour == behaviour and p.spec.arm == arm]
+    offsets = np.array([p.spec.target for p in clips]) - skeleton.shoulder_rest_position(arm)
+    distance = np.linalg.norm(offsets, axis=1)
+    assert np.all((distance >= 1.5 - 1e-3) & (distance <= farthest + 1e-3))
+    return clips, offsets / distance[:, None]
+
+
 def test_guide_targets_lie_ahead_and_to_the_side_and_raises_use_the_wave_grid(plan):
     for arm in skeleton.ARMS:
         sign = 1.0 if arm == "LEFT" else -1.0
-        guides = [p for p in plan if p.spec.behaviour == "GUIDE" and p.spec.arm == arm]
-        offsets = np.array([p.spec.target for p in guides]) - skeleton.shoulder_rest_position(arm)
-        distance = np.linalg.norm(offsets, axis=1)
-        assert np.all((distance >= 1.5 - 1e-3) & (distance <= 5.0 + 1e-3))
-        direction = offsets / distance[:, None]
+        _, direction = _targets(plan, "GUIDE", arm, farthest=5.0)
         assert np.all(direction[:, 2] < np.sin(np.radians(12.5))) and direction[:, 2].min() < -0.4
         assert (sign * direction[:, 0]).min() < -0.3 and (sign * direction[:, 0]).max() > 0.8
         raises = [p for p in plan if p.spec.behaviour == "RAISE_HAND" and p.spec.arm == arm]
@@ -54,12 +60,8 @@ def test_test_waves_use_exaggerations_no_training_clip_has(plan):
 def test_point_targets_cover_the_front_hemisphere_at_1_5_to_4_m(plan):
     for arm in skeleton.ARMS:
         sign = 1.0 if arm == "LEFT" else -1.0
-        points = [p for p in plan if p.spec.behaviour == "POINT" and p.spec.arm == arm]
-        offsets = np.array([p.spec.target for p in points]) - skeleton.shoulder_rest_position(arm)
-        distance = np.linalg.norm(offsets, axis=1)
-        assert np.all((distance >= 1.5 - 1e-3) & (distance <= 4.0 + 1e-3))
+        points, direction = _targets(plan, "POINT", arm, farthest=4.0)
         assert np.all(np.array([p.spec.target for p in points])[:, 2] >= library_plan.LOWEST_TARGET - 1e-9)
-        direction = offsets / distance[:, None]
         assert np.all(direction[:, 1] < 0.1)  # in front (or beside), never behind
         assert direction[:, 2].max() > 0.6 and direction[:, 2].min() < -0.4  # high and low
         assert (sign * direction[:, 0]).min() < -0.6 and (sign * direction[:, 0]).max() > 0.8  # across, out
