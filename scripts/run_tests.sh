@@ -9,11 +9,16 @@ PARALLEL=(-n "${PYTEST_WORKERS:-auto}" --dist loadfile)
 python -m pytest -q "${PARALLEL[@]}" "$@"
 if [ -x .venv-bpy42/bin/python ]; then
     echo "== Blender 4.2 LTS: extension tests =="
-    # Blender 4.2 as a module can crash in its glTF importer once the rig-variant tests have run in the
-    # same process, so those run in a process of their own.
+    # Blender 4.2 as a module can crash (a segfault in create_bones) in its glTF importer once other
+    # extension tests have run in the same process, so each file that imports glTF runs in a process
+    # of its own.
+    OWN_PROCESS=(tests/addon/test_rig_variants.py tests/addon/test_real_rigs.py tests/addon/test_real_finger.py
+                 tests/addon/test_vrm_characters.py)
     .venv-bpy42/bin/python -m pytest -q "${PARALLEL[@]}" tests/addon -p no:cacheprovider \
-        --ignore=tests/addon/test_rig_variants.py
-    .venv-bpy42/bin/python -m pytest -q tests/addon/test_rig_variants.py -p no:cacheprovider
+        "${OWN_PROCESS[@]/#/--ignore=}"
+    for test_file in "${OWN_PROCESS[@]}"; do
+        .venv-bpy42/bin/python -m pytest -q "$test_file" -p no:cacheprovider
+    done
 else
     echo "scripts/run_tests.sh: .venv-bpy42 is missing; run scripts/setup.sh to test Blender 4.2 too" >&2
     exit 1
