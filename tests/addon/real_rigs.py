@@ -275,6 +275,17 @@ def deformed_joints(rig, settings, arm):
     return at, arm_length
 
 
+def played_joints(rig, settings, arm, start, frames):
+    """deformed_joints over the `frames` frames from `start`: ((F, 4, 3) positions, the arm's rest length)."""
+    at, arm_length = deformed_joints(rig, settings, arm)
+    return np.array([at(f) for f in range(start, start + frames)]), arm_length
+
+
+def wrist_travel(joints, arm_length):
+    """The deformed wrist's greatest travel from its first position, in arm lengths (joints: played_joints')."""
+    return float(np.linalg.norm(joints[:, 0] - joints[0, 0], axis=1).max() / arm_length)
+
+
 def measured_bones_deform(rig, settings, arm):
     """The wrist and the finger base the measures read are bones the mesh deforms with (no stand-in)."""
     found = roles(rig, settings)
@@ -321,16 +332,14 @@ def point(rig, settings, arm, target, start, frames=120, exact=True, mute=False)
                        frame_count=frames, exact_aim=exact)
     if result != {"FINISHED"}:
         return result, np.nan, np.nan
-    at, arm_length = deformed_joints(rig, settings, arm)
-    joints = np.array([at(f) for f in range(start, start + frames)])  # (F, 4, 3)
+    joints, arm_length = played_joints(rig, settings, arm, start, frames)
     base, finger = joints[:, 1], joints[:, 2] - joints[:, 1]
     angles = behaviour_metrics.pointing_angles(base, finger, np.asarray(target))
     render = bpy.context.scene.render
     hold = behaviour_metrics.hold_frames(base, _shoulder_width(rig, settings), render.fps / render.fps_base)
     miss = (np.median(angles[hold[0]:hold[1] + 1]) if hold is not None
             else angles[int(np.argmax(np.linalg.norm(base - base[0], axis=1)))])
-    travel = np.linalg.norm(joints[:, 0] - joints[0, 0], axis=1).max() / arm_length
-    return result, float(miss), float(travel)
+    return result, float(miss), wrist_travel(joints, arm_length)
 
 
 def point_misses(rig, settings, count, exact, seed):
@@ -362,13 +371,11 @@ def wave(rig, settings, arm, start, frames=150, exaggeration=0.8, mute=False):
                        start_frame=start, frame_count=frames)
     if result != {"FINISHED"}:
         return result, 0, np.nan
-    at, arm_length = deformed_joints(rig, settings, arm)
-    joints = np.array([at(f) for f in range(start, start + frames)])
+    joints, arm_length = played_joints(rig, settings, arm, start, frames)
     frame, _ = _character_frame(rig, settings)
     to_character = frame @ np.linalg.inv(np.array(rig.matrix_world)[:3, :3])
     lateral = (joints[:, 0] - joints[:, 3]) @ to_character.T[:, 0] / arm_length
-    travel = np.linalg.norm(joints[:, 0] - joints[0, 0], axis=1).max() / arm_length
-    return result, _strokes(lateral), float(travel)
+    return result, _strokes(lateral), wrist_travel(joints, arm_length)
 
 
 def arm_drop(rig, settings, arm, frame):

@@ -90,9 +90,7 @@ def test_a_new_gesture_from_fbx_clips_trains_and_bakes_from_the_panel(tmp_path):
         placed = gestures.placed_gestures(rig)[0]
         assert (placed.record["behaviour"], placed.record["kind"]) == ("RAISE_HAND", "intensity")
         assert placed.action.name.startswith("RLAnimate Raise Hand Right")
-        joints_at, arm_length = real_rigs.deformed_joints(rig, settings, "RIGHT")
-        wrists = np.array([joints_at(frame)[0] for frame in range(start, start + count)])
-        travel = np.linalg.norm(wrists - wrists[0], axis=1).max() / arm_length
+        travel = real_rigs.wrist_travel(*real_rigs.played_joints(rig, settings, "RIGHT", start, count))
         assert travel > 0.1, f"the deformed hand moves ({travel:.2f} arm lengths)"
     finally:
         addon_helpers.disable_addon()
