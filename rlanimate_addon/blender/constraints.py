@@ -10,6 +10,12 @@ driver whose expression is `frame`, so the influence follows the scene frame wha
 later gestures multiply in over their own frames, and it shows as an editable curve in the Drivers
 editor. Outside the gestures the constraint works as before, and at their ends the pose is the one
 the constraint made, so nothing jumps.
+
+On a still rig whose constraints follow controls at rest (a control rig's deform bones copying its
+unposed DRV_ twins: the bind T-pose), the gesture starts and ends in the standing pose as on any still
+rig, and the constraints are held muted (`follow_rest`, `mute(hold=True)`): influence 0 on every frame
+of the gesture, held beyond them as the gesture's own keys are, so the rig stands there too rather than
+snapping back to the T-pose at the gesture's ends.
 """
 from contextlib import contextmanager
 
@@ -199,11 +205,52 @@ def _is_frame_curve(curve):
         and not driver.variables and not curve.modifiers and curve.extrapolation == "CONSTANT"
 
 
-def mute(obj, found, start, end):
-    """Mute each constraint found over frames start-end, faded with the gesture's blend (see the module).
-    Returns {influence path: [its influence at each of the frames before the mute]}, for `unmute`."""
+def follow_rest(obj, found):
+    """Whether the constraints found follow only bones of obj standing at rest: their targets, those
+    bones' parents and the targets of their own constraints, recursively, each with a rest basis (a
+    control rig's unposed controls). A target on another object, or a posed control, is a pose the
+    animator set: the gesture then fades into and out of the pose the constraints make."""
+    seen, stack = set(), [t for _, c in found for t in _targets(c)]
+    while stack:
+        target, bone = stack.pop()
+        if target is not obj or not bone or bone not in obj.pose.bones:
+            return False
+        if bone in seen:
+            continue
+        seen.add(bone)
+        pose_bone = obj.pose.bones[bone]
+        if not _at_rest(pose_bone):
+            return False
+        if pose_bone.parent is not None:
+            stack.append((obj, pose_bone.parent.name))
+        stack += [t for c in pose_bone.constraints if not c.mute and c.is_valid for t in _targets(c)]
+    return True
+
+
+def _targets(constraint):
+    """[(object, bone name or "")] the constraint follows: its target and pole target (an Armature
+    constraint's targets)."""
+    found = [(getattr(constraint, kind), getattr(constraint, sub, "")) for kind, sub in
+             (("target", "subtarget"), ("pole_target", "pole_subtarget")) if getattr(constraint, kind, None)]
+    return found + [(t.target, t.subtarget) for t in getattr(constraint, "targets", ()) if t.target is not None]
+
+
+def _at_rest(pose_bone):
+    """Whether the bone's basis is its rest: no rotation (within gesture.AT_REST), location or scale."""
+    basis = np.array(pose_bone.matrix_basis)
+    rotation = np.array(pose_bone.matrix_basis.to_quaternion())
+    return (np.linalg.norm(rotation[1:]) < gesture.AT_REST and np.abs(basis[:3, 3]).max() <= gesture.AT_REST
+            * pose_bone.bone.length and np.abs(np.linalg.norm(basis[:3, :3], axis=0) - 1.0).max() < gesture.AT_REST)
+
+
+def mute(obj, found, start, end, hold=False):
+    """Mute each constraint found over frames start-end, faded with the gesture's blend (see the module);
+    with hold, muted on every frame (influence 0 on the gesture's frames and on the curve's other keys:
+    what a replaced held gesture's `unmute` gave back, or a later gesture's fade of a held 0). Returns
+    {influence path: [its influence at each of the frames before the mute]}, for `unmute`."""
     frames = np.arange(start, end + 1)
-    keep = 1.0 - gesture.blend_weights(len(frames))  # (N,) the influence's share left on each frame
+    # (N,) the influence's share left on each frame
+    keep = np.zeros(len(frames)) if hold else 1.0 - gesture.blend_weights(len(frames))
     before = {}
     for _, constraint in found:
         curve = influence_curve(obj, constraint)
@@ -218,7 +265,7 @@ def mute(obj, found, start, end):
         else:
             kept, evaluate = {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}, curve.evaluate
         values = before[constraint.path_from_id("influence")] = [float(evaluate(float(f))) for f in frames]
-        _key_frames(curve, kept, start, [v * k for v, k in zip(values, keep)])
+        _key_frames(curve, dict.fromkeys(kept, 0.0) if hold else kept, start, [v * k for v, k in zip(values, keep)])
     return before
 
 

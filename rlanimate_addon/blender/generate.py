@@ -108,6 +108,7 @@ class _Plan:
         self.previous = None  # the gesture it replaces (blender/gestures.py)
         self.under = {}  # {bone: channel values} of keyed bones that stand still underneath
         self.worst = 0.0
+        self.hold = False  # the constraints it mutes stay muted beyond its frames (constraints.follow_rest)
 
 
 def _check(obj, settings, start, end, mute_constraints):
@@ -165,6 +166,8 @@ def _compute(context, plan, settings, agent, frames):
         if target is not None:
             plan.target, plan.target_bone, plan.targets = target, bone, targets
         plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
+        # A still rig held at rest by its constraints stands as any still rig does: they stay muted.
+        plan.hold = bool(plan.overriding) and not rig.animated and constraints.follow_rest(obj, plan.overriding)
         if plan.ik_share is not None:
             plan.properties = rigify.switch_keys(obj, settings.arm, switch, plan.blend_type, rig.animated)
         plan.under = {bone: below_values[bone][0] for bone in plan.bones if not np.ptp(below_values[bone], axis=0).any()}
@@ -269,10 +272,14 @@ def _write(plan, agent, scene):
                                            plan.properties)
     if plan.ik_share is not None:
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
-    influence_before = constraints.mute(plan.obj, plan.overriding, start, end)
+    influence_before = constraints.mute(plan.obj, plan.overriding, start, end, plan.hold)
     gestures.record(action, gestures.snapshot(settings), kind, start, end, plan.under, plan.targets,
                     digest.hexdigest(), influence_before, plan.rig.animated)
-    muted = f" (muted {constraints.describe(plan.overriding)} over its frames)" if plan.overriding else ""
+    muted = ""
+    if plan.overriding:
+        held = (", held muted beyond them: they hold the rig at rest, so it stands as a still rig does"
+                if plan.hold else "")
+        muted = f" (muted {constraints.describe(plan.overriding)} over its frames{held})"
     layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
     editable = ""
     if settings.editable_keys:

@@ -8,6 +8,7 @@ import bpy
 import numpy as np
 import pytest
 import real_rigs
+import test_generate
 
 from rlanimate_addon.blender import armature_io
 from rlanimate_addon.core import rig_roles
@@ -129,3 +130,44 @@ def test_a_generated_rigify_rig_gestures_in_fk_and_ik(settings, arm_mode, export
         for frame, value in ((1299, 0.0), (1375, 1.0), (1450, 0.0), (1460, 0.0)):
             bpy.context.scene.frame_set(frame)
             assert switch["IK_FK"] == pytest.approx(value), frame
+
+
+def test_a_still_control_rig_stands_as_a_still_rig_does_through_a_muted_gesture(settings, tmp_path):
+    """The UE control rig, still: its deform bones copy DRV_ controls at rest, the bind T-pose. Generated with
+    its constraints muted, the gesture starts and ends in the standing pose, as on any still rig, and the
+    constraints stay muted beyond its frames, as the gesture's keys hold there (before, they faded back in:
+    every gesture started and ended in the T-pose, the upper arm 0.4 degrees below horizontal). Measured on
+    the deformed bones: no frame about the gesture's ends moves the wrist by more than a fraction of the
+    gesture's own largest step; Regenerate gives the same keys and leaves no T-pose behind."""
+    rig = _shared("ue_control_rig", tmp_path)
+    start, count = 101, 150
+    end = start + count - 1
+    result, strokes, _ = real_rigs.wave(rig, settings, "RIGHT", start, count, mute=True)
+    assert result == {"FINISHED"} and strokes >= 4
+
+    def assert_stands(frames):
+        for frame in frames:
+            drop = real_rigs.arm_drop(rig, settings, "RIGHT", frame)
+            assert drop > 60.0, f"at frame {frame} the upper arm is {drop:.1f} degrees below horizontal"
+
+    assert_stands((1, start, end, end + 30))
+    joints, arm_length = real_rigs.played_joints(rig, settings, "RIGHT", start - 10, count + 20)
+    steps = np.linalg.norm(np.diff(joints[:, 0], axis=0), axis=1) / arm_length  # (count + 19,) a frame
+    own, edges = steps[10:9 + count].max(), np.r_[steps[:20], steps[-20:]]
+    # Measured: 0.013 arm lengths at most about the ends against the wave's 0.196 (fading back to the
+    # T-pose: 0.070).
+    assert edges.max() < 0.2 * own, (edges.max(), own)
+
+    path = rig.pose.bones["upperarm_r"].constraints[0].path_from_id("influence")
+
+    def keys():
+        action = next(a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Right"))
+        influence = rig.animation_data.drivers.find(path).keyframe_points
+        return test_generate._keys(action), [tuple(p.co) for p in influence]
+
+    first = keys()
+    assert real_rigs.wave(rig, settings, "RIGHT", start, count, mute=True)[0] == {"FINISHED"}
+    assert keys() == first and len(bpy.data.actions) == 1
+    # Regenerated later, the frames it left stand too: the muted influence is not given back there alone.
+    assert real_rigs.wave(rig, settings, "RIGHT", start + 10, count, mute=True)[0] == {"FINISHED"}
+    assert_stands((start, start + 10, end + 10))
