@@ -245,9 +245,10 @@ def _at_rest(pose_bone):
 
 def mute(obj, found, start, end, hold=False):
     """Mute each constraint found over frames start-end, faded with the gesture's blend (see the module);
-    with hold, muted on every frame (influence 0 on the gesture's frames and on the curve's other keys:
-    what a replaced held gesture's `unmute` gave back, or a later gesture's fade of a held 0). Returns
-    {influence path: [its influence at each of the frames before the mute]}, for `unmute`."""
+    with hold, muted on every frame: influence 0 on the gesture's frames and on the curve's other keys
+    (a later gesture's fade of a held 0, or what `unmute` gave back of a held gesture it replaces).
+    Returns {influence path: {frame: its influence there before the mute}} of every frame it keyed, for
+    `unmute`."""
     frames = np.arange(start, end + 1)
     # (N,) the influence's share left on each frame
     keep = np.zeros(len(frames)) if hold else 1.0 - gesture.blend_weights(len(frames))
@@ -263,27 +264,34 @@ def mute(obj, found, start, end, hold=False):
             curve.extrapolation = "CONSTANT"  # 5.0 makes new driver curves linear: the ends' values hold
             kept, evaluate = {}, (lambda frame, value=value: value)
         else:
-            kept, evaluate = {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}, curve.evaluate
-        values = before[constraint.path_from_id("influence")] = [float(evaluate(float(f))) for f in frames]
-        _key_frames(curve, dict.fromkeys(kept, 0.0) if hold else kept, start, [v * k for v, k in zip(values, keep)])
+            kept, evaluate = _keys(curve), curve.evaluate
+        prior = {int(f): float(evaluate(float(f))) for f in frames}
+        keys = {**kept, **{f: v * k for (f, v), k in zip(prior.items(), keep)}}
+        if hold:
+            prior = {**kept, **prior}
+            keys = dict.fromkeys(keys, 0.0)
+        before[constraint.path_from_id("influence")] = prior
+        _write(curve, keys)
     return before
 
 
-def unmute(obj, before, start):
-    """Undo a replaced gesture's `mute` from frame start on: before is what that mute returned. A curve
-    no longer Generate's (removed, or made something else by hand) is left alone."""
+def unmute(obj, before):
+    """Undo a replaced gesture's `mute`: before is what that mute returned. A curve no longer Generate's
+    (removed, or made something else by hand) is left alone."""
     data = obj.animation_data
-    for path, values in before.items():
+    for path, prior in before.items():
         curve = None if data is None else data.drivers.find(path)
         if curve is not None and _is_frame_curve(curve):
-            _key_frames(curve, {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}, start, values)
+            _write(curve, {**_keys(curve), **prior})
 
 
-def _key_frames(curve, kept, start, values):
-    """Key the frame curve with `values` on the frames from start on, and the kept {frame: value} keys elsewhere."""
-    end = start + len(values) - 1
-    keys = {f: v for f, v in kept.items() if not start <= f <= end}
-    keys.update({start + k: v for k, v in enumerate(values)})
+def _keys(curve):
+    """{frame: value} of the frame curve's keys."""
+    return {int(round(p.co[0])): p.co[1] for p in curve.keyframe_points}
+
+
+def _write(curve, keys):
+    """Key the frame curve with {frame: value}, linear, in place of its keys."""
     ordered = sorted(keys)
     curve.keyframe_points.clear()
     action_adapter.write_keys(curve, np.array(ordered, dtype=np.float64), np.array([keys[f] for f in ordered]))

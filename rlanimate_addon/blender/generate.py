@@ -262,7 +262,7 @@ def _write(plan, agent, scene):
         note += " (the agent's own aim: Exact Aim is off)"
     digest = action_adapter.KeyDigest()
     if plan.previous is not None:  # its constraints' fade undone first, so the new one applies once
-        constraints.unmute(plan.obj, gestures.influence_before(plan.previous), plan.previous.record["start"])
+        constraints.unmute(plan.obj, gestures.influence_before(plan.previous))
         action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type, digest,
                                   plan.properties)
         note += " (replaced the previous gesture)"

@@ -154,21 +154,24 @@ def record(action, settings, kind, start, end, under, aimed_at, keys, influence_
     behaviour's, behaviours.TARGET or INTENSITY), under
     ({bone: channel values} of bones that stand still underneath), aimed_at ((N, 3) armature-space
     targets per frame, or None), keys (the hex KeyDigest of the keys written), influence_before
-    ({influence path: values per frame} of the constraints it muted, before it muted them:
-    constraints.mute), animated (whether it was baked over animation, not on a still rig)."""
+    ({influence path: {frame: value}} of the constraints it muted, before it muted them, on every frame
+    it keyed: constraints.mute), animated (whether it was baked over animation, not on a still rig)."""
     action[RECORD] = {
         "behaviour": settings["behaviour"], "kind": kind, "arm": settings["arm"], "start": int(start),
         "end": int(end),
         "settings": settings, "under": {bone: list(map(float, values)) for bone, values in under.items()},
         "aimed_at": [] if aimed_at is None else np.asarray(aimed_at, dtype=np.float64).ravel().tolist(),
-        "keys": keys, "note": "", "animated": bool(animated), "influence_before": [{"path": path, "values": list(map(float, values))}
-                                                       for path, values in (influence_before or {}).items()]}
+        "keys": keys, "note": "", "animated": bool(animated), "influence_before": [
+            {"path": path, "frames": [int(f) for f in prior], "values": [float(v) for v in prior.values()]}
+            for path, prior in (influence_before or {}).items()]}
 
 
 def influence_before(gesture):
-    """{influence path: values per frame} the gesture's mute faded (`record`; none in a record made before
-    Generate kept them)."""
-    return {item["path"]: list(item["values"]) for item in gesture.record.get("influence_before", [])}
+    """{influence path: {frame: value}} the gesture's mute overwrote (`record`; none in a record made before
+    Generate kept them; a record made before it kept their frames holds values from the gesture's start)."""
+    start = gesture.record["start"]
+    return {item["path"]: dict(zip(item.get("frames", range(start, start + len(item["values"]))), item["values"]))
+            for item in gesture.record.get("influence_before", [])}
 
 
 def edited_by_hand(gesture):

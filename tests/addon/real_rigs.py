@@ -84,11 +84,13 @@ def roles(rig, settings):
     return armature_io.rig_roles_of(rig, settings.bone_map_file)[1]
 
 
-def load_shared(name, folder):
+def load_shared(name, folder, still=False):
     """Bring a ../shared/rigs file into the current scene as a user would (Blender's importer with its
     defaults; a .blend's objects appended); returns its armature. A .vrm is imported by glTF's importer,
     which takes it under a .glb name only: copied into `folder`, which the armature's VRM file path then
-    names (kept, for Generate to read the VRM map from). Skips the test when the file is absent."""
+    names (kept, for Generate to read the VRM map from). With `still`, the armature's animation (active
+    action, NLA tracks) is taken off and its bones put at rest, as a rig with no animation stands.
+    Skips the test when the file is absent."""
     path = require(name)
     before = set(bpy.data.objects)
     if path.suffix == ".blend":
@@ -102,10 +104,21 @@ def load_shared(name, folder):
     else:
         import_gltf(path, folder)
     armature = next(o for o in bpy.data.objects if o not in before and o.type == "ARMATURE")
-    if name in ACTIONS:  # Blender 4.2's glTF importer names an action after its armature too: Idle_Armature
+    if still:
+        stand_still(armature)
+    elif name in ACTIONS:  # Blender 4.2's glTF importer names an action after its armature too: Idle_Armature
         armature.animation_data.action = next(action for action in bpy.data.actions
                                               if action.name in (ACTIONS[name], f"{ACTIONS[name]}_{armature.name}"))
     return helpers.activate(armature)
+
+
+def stand_still(armature):
+    """Take the armature's animation off (actions, NLA tracks, drivers) and put its bones at rest, as a
+    rig with no animation stands: a gesture then starts and ends in the standing pose."""
+    armature.animation_data_clear()
+    for pose_bone in armature.pose.bones:
+        pose_bone.matrix_basis = pose_bone.matrix_basis.Identity(4)
+    bpy.context.view_layer.update()
 
 
 def import_gltf(path, folder):

@@ -24,9 +24,8 @@ def _shared(name, folder):
     return real_rigs.load_shared(name, folder)
 
 
-def _assert_gestures(rig, settings, mute=False, seed=5, least_travel=0.5):
-    """Points with both arms, Exact Aim on and off, and a wave, all meeting the issue's bars (least_travel:
-    the wrist's least travel in arm lengths)."""
+def _assert_gestures(rig, settings, mute=False, seed=5):
+    """Points with both arms, Exact Aim on and off, and a wave, all meeting the issue's bars."""
     rng = np.random.default_rng(seed)
     exact, own, travel = [], [], []
     for k, arm in enumerate(("RIGHT", "LEFT", "RIGHT", "LEFT")):
@@ -44,7 +43,7 @@ def _assert_gestures(rig, settings, mute=False, seed=5, least_travel=0.5):
           f"travel {np.round(travel, 2)} arm lengths")
     assert np.median(exact) <= 1.0 and max(exact) <= 3.0, exact
     assert np.median(own) <= 5.0 and max(own) <= 12.0, own
-    assert strokes >= 4 and min(travel) >= least_travel, travel
+    assert strokes >= 4 and min(travel) >= 0.5, travel
 
 
 @pytest.mark.parametrize("name", list(CLAIMED))
@@ -78,12 +77,14 @@ def test_a_rig_outside_the_families_is_refused_with_the_bone_map_fix_and_then_wo
 
 def test_fk_and_ik_duplicate_chains_are_not_called_rigify_and_gesture_with_the_bone_map_fix(settings, tmp_path):
     """GDQuest's robot has upperarm_FK.L / hand_IK.L chains: not Rigify's controls. Its mesh follows a third
-    chain hanging from the torso, with no collar bone (a fake shoulder pad sits beside it), measured over its
-    Idle (real_rigs.ACTIONS). Refused naming
-    the bone-map fix; with a map naming that chain (no Shoulder: the collar's turn goes to the upper arm)
-    and root as Hips: its hips hang below its torso) it gestures on its deformed bones. A map giving the
-    shoulder pad the Shoulder role bakes keys the arm does not follow: the bake check undoes it; one giving
-    Hips to the bone named hips is refused naming root."""
+    chain hanging from the torso, with no collar bone (a fake shoulder pad sits beside it). Over its Idle
+    (real_rigs.ACTIONS): refused naming the bone-map fix; a map giving the shoulder pad the Shoulder role
+    bakes keys the arm does not follow: the bake check undoes it; one giving Hips to the bone named hips is
+    refused naming root. With a map naming that chain (no Shoulder: the collar's turn goes to the upper arm)
+    and root as Hips (its hips hang below its torso) it gestures on its deformed bones, measured still, as
+    the other rigs are (over its Idle, whose arms hang 51 degrees down, a point at a target 21 degrees
+    below the shoulder lifts the arm to the same pointing pose but the wrist travels 0.47 arm lengths:
+    docs/BENCHMARKS.md, "Real rigs", gdbot_own)."""
     rig = _shared("gdbot", tmp_path)
     family, _ = armature_io.rig_roles_of(rig)
     assert family != rig_roles.RIGIFY.name
@@ -99,9 +100,8 @@ def test_fk_and_ik_duplicate_chains_are_not_called_rigify_and_gesture_with_the_b
                                            r"map Hips to the bone the spine hangs from, 'root'"):
         helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
     settings.bone_map_file = real_rigs.write_bone_map("gdbot", tmp_path)
-    # Over its Idle, whose arms hang 51 degrees down (the standing pose: 75), a point at a low target
-    # turns the arm 27 degrees: the wrist moves 0.47 arm lengths, short of the issue's 0.5.
-    _assert_gestures(rig, settings, least_travel=0.45)
+    real_rigs.stand_still(rig)
+    _assert_gestures(rig, settings)
 
 
 @pytest.mark.parametrize("arm_mode, export", [("FK", False), ("IK", False), ("IK", True)])
@@ -171,3 +171,11 @@ def test_a_still_control_rig_stands_as_a_still_rig_does_through_a_muted_gesture(
     # Regenerated later, the frames it left stand too: the muted influence is not given back there alone.
     assert real_rigs.wave(rig, settings, "RIGHT", start + 10, count, mute=True)[0] == {"FINISHED"}
     assert_stands((start, start + 10, end + 10))
+    # A control the animator posed (the right hand's IK control) is a pose of theirs: the gesture fades
+    # from and back to it, and every frame the held mutes keyed gets its influence back.
+    rig.pose.bones["CTRL_Arm_R"].location = (0.0, 0.0, 0.1)
+    assert real_rigs.wave(rig, settings, "RIGHT", start, count, mute=True)[0] == {"FINISHED"}
+    copy = rig.pose.bones["upperarm_r"].constraints[0]
+    for frame, value in ((1, 1.0), (start, 1.0), (start + count // 2, 0.0), (end, 1.0), (end + 10, 1.0)):
+        bpy.context.scene.frame_set(frame)
+        assert copy.influence == pytest.approx(value, abs=1e-6), frame
