@@ -7,7 +7,8 @@ now sits elsewhere than the gesture aimed at on the current frame, and re-bakes 
 recorded settings, replacing it in place. Re-bakes are throttled: one runs at once, later moves
 within THROTTLE seconds wait for a timer that re-bakes once for the last position. A gesture whose
 keys were edited by hand since it was baked is never re-baked: following it stops, with a note on
-the gesture that the panel shows, until Generate bakes it again.
+the gesture that the panel shows, until Generate bakes it again. A gesture baked with Generate, Muting
+Constraints is re-baked muting them again.
 """
 import time
 from types import SimpleNamespace
@@ -68,7 +69,9 @@ def follow(scene, moved=None):
                            "Generate it again to follow its target")
             continue
         try:
-            generate.bake(bpy.context, [(obj, _gesture_settings(gesture.record))])
+            # A gesture baked muting constraints had the animator's consent to mute them: it still has.
+            generate.bake(bpy.context, [(obj, _gesture_settings(gesture.record))],
+                          mute_constraints=bool(gesture.record.get("influence_before")))
         except RLAnimateError as error:
             _stop(gesture, str(error))
             continue

@@ -4,9 +4,11 @@ import time
 
 import bpy
 import numpy as np
+import pytest
 
 import addon_helpers as helpers
 from rlanimate_addon.blender import action_adapter, follow_target, gestures
+from test_constraints import _ik_rig
 from test_generate import MAX_APEX_ANGLE_DEG, apex, finger_angles
 
 OLD, NEW = (-1.2, -2.5, 1.7), (0.8, -2.8, 0.9)
@@ -98,3 +100,21 @@ def test_a_re_bake_records_its_settings_and_follows_again(settings):
     _move(target, OLD)
     to_old, to_new = _apex_angles(rig)
     assert to_old <= MAX_APEX_ANGLE_DEG < to_new, "a second move is followed too"
+
+
+def test_a_gesture_baked_muting_constraints_follows_muting_them_again(settings):
+    rig, _, ik = _ik_rig()
+    target = helpers.add_empty("Target", OLD)
+    settings.follow_target = True
+    settings.behaviour, settings.arm, settings.target, settings.start_frame, settings.frame_count = \
+        "POINT", "RIGHT", target, 1, 100
+    helpers.activate(rig)
+    assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    _move(target, NEW)
+    gesture = gestures.last_targeted(rig)
+    assert gesture.record["note"] == "", gesture.record["note"]
+    to_old, to_new = _apex_angles(rig)
+    assert to_new <= MAX_APEX_ANGLE_DEG < to_old, f"the arm does not follow: {to_new:.1f} deg off the new position"
+    assert len([a for a in bpy.data.actions if gestures.RECORD in a]) == 1, "re-baked in place"
+    bpy.context.scene.frame_set(150)
+    assert ik.influence == pytest.approx(0.7), "outside the gesture the constraint works as before"
