@@ -9,76 +9,99 @@ from numpy.typing import ArrayLike
 _SMALL = 1e-8
 
 
+def _components(values, size):
+    """(size, M) contiguous rows of the last axis's components of (..., size) values, M their count: the
+    conversions below work on whole rows, which numpy runs many times faster than strided columns."""
+    return np.ascontiguousarray(np.reshape(values, (-1, size)).T)
+
+
+def _length(*components):
+    """Euclidean length of vectors given as component rows, summed in np.linalg.norm's order."""
+    total = components[0] * components[0]
+    for c in components[1:]:
+        total += c * c
+    return np.sqrt(total)
+
+
+def _joined(rows, batch):
+    """(..., K) array of K component rows (M,) with leading shape `batch`."""
+    return np.stack(rows, axis=-1).reshape(tuple(batch) + (len(rows),))
+
+
 def quat_to_rotvec(quat: ArrayLike) -> np.ndarray:
     """(..., 4) unit quaternions -> (..., 3) rotation vectors, on the short arc (angle <= pi)."""
     q = np.asarray(quat, dtype=np.float64)
-    q = np.where(q[..., :1] < 0.0, -q, q)  # same rotation, w >= 0 gives angle <= pi
-    w = np.clip(q[..., 0], -1.0, 1.0)
-    xyz = q[..., 1:]
-    sin_half = np.linalg.norm(xyz, axis=-1)
+    w, x, y, z = _components(q, 4)
+    flip = w < 0.0  # same rotation, w >= 0 gives angle <= pi
+    w, x, y, z = (np.where(flip, -c, c) for c in (w, x, y, z))
+    w = np.clip(w, -1.0, 1.0)
+    sin_half = _length(x, y, z)
     angle = 2.0 * np.arctan2(sin_half, w)
     # angle / sin(angle/2), with its limit 2 (+ angle^2 / 12) near zero
     scale = np.where(sin_half > _SMALL, angle / np.maximum(sin_half, _SMALL), 2.0 + angle**2 / 12.0)
-    return xyz * scale[..., None]
+    return _joined([x * scale, y * scale, z * scale], q.shape[:-1])
 
 
 def rotvec_to_quat(rotvec: ArrayLike) -> np.ndarray:
     """(..., 3) rotation vectors -> (..., 4) unit quaternions with w >= 0."""
     r = np.asarray(rotvec, dtype=np.float64)
-    angle = np.linalg.norm(r, axis=-1)
+    x, y, z = _components(r, 3)
+    angle = _length(x, y, z)
     half = 0.5 * angle
     # sin(angle/2) / angle, with its limit 1/2 (- angle^2 / 48) near zero
     scale = np.where(angle > _SMALL, np.sin(half) / np.maximum(angle, _SMALL), 0.5 - angle**2 / 48.0)
-    return np.concatenate([np.cos(half)[..., None], r * scale[..., None]], axis=-1)
+    return _joined([np.cos(half), x * scale, y * scale, z * scale], r.shape[:-1])
 
 
 def quat_to_matrix(quat: ArrayLike) -> np.ndarray:
     """(..., 4) quaternions -> (..., 3, 3) rotation matrices (columns are the rotated axes)."""
     q = np.asarray(quat, dtype=np.float64)
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
-    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    m = np.stack([
-        1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-        2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-        2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
-    ], axis=-1)
+    w, x, y, z = _components(q, 4)
+    length = _length(w, x, y, z)
+    w, x, y, z = w / length, x / length, y / length, z / length
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
+    m = _joined([
+        1 - 2 * (yy + zz), 2 * (xy - wz), 2 * (xz + wy),
+        2 * (xy + wz), 1 - 2 * (xx + zz), 2 * (yz - wx),
+        2 * (xz - wy), 2 * (yz + wx), 1 - 2 * (xx + yy),
+    ], q.shape[:-1])
     return m.reshape(q.shape[:-1] + (3, 3))
+
+
+def _picked(picks, options):
+    """Per element, options[0], or options[k + 1] where picks[k] (masks that never overlap)."""
+    out = options[0].copy()
+    for pick, option in zip(picks, options[1:]):
+        np.copyto(out, option, where=pick)
+    return out
 
 
 def matrix_to_quat(matrix: ArrayLike) -> np.ndarray:
     """(..., 3, 3) rotation matrices -> (..., 4) unit quaternions with w >= 0 (Shepperd's method)."""
     m = np.asarray(matrix, dtype=np.float64)
-    batch = m.shape[:-2]
-    m = m.reshape(-1, 3, 3)
-    trace = np.trace(m, axis1=1, axis2=2)
-    # Pick the numerically largest of w, x, y, z per matrix and derive the rest from it.
-    candidates = np.stack([trace, m[:, 0, 0], m[:, 1, 1], m[:, 2, 2]], axis=1)
-    choice = np.argmax(candidates, axis=1)
-    q = np.empty((m.shape[0], 4))
-    for k in range(4):
-        sel = choice == k
-        if not np.any(sel):
-            continue
-        s = m[sel]
-        if k == 0:
-            r = np.sqrt(1.0 + trace[sel]) * 2.0
-            q[sel] = np.stack([0.25 * r, (s[:, 2, 1] - s[:, 1, 2]) / r,
-                               (s[:, 0, 2] - s[:, 2, 0]) / r, (s[:, 1, 0] - s[:, 0, 1]) / r], axis=1)
-        elif k == 1:
-            r = np.sqrt(1.0 + s[:, 0, 0] - s[:, 1, 1] - s[:, 2, 2]) * 2.0
-            q[sel] = np.stack([(s[:, 2, 1] - s[:, 1, 2]) / r, 0.25 * r,
-                               (s[:, 0, 1] + s[:, 1, 0]) / r, (s[:, 0, 2] + s[:, 2, 0]) / r], axis=1)
-        elif k == 2:
-            r = np.sqrt(1.0 + s[:, 1, 1] - s[:, 0, 0] - s[:, 2, 2]) * 2.0
-            q[sel] = np.stack([(s[:, 0, 2] - s[:, 2, 0]) / r, (s[:, 0, 1] + s[:, 1, 0]) / r,
-                               0.25 * r, (s[:, 1, 2] + s[:, 2, 1]) / r], axis=1)
-        else:
-            r = np.sqrt(1.0 + s[:, 2, 2] - s[:, 0, 0] - s[:, 1, 1]) * 2.0
-            q[sel] = np.stack([(s[:, 1, 0] - s[:, 0, 1]) / r, (s[:, 0, 2] + s[:, 2, 0]) / r,
-                               (s[:, 1, 2] + s[:, 2, 1]) / r, 0.25 * r], axis=1)
-    q = np.where(q[:, :1] < 0.0, -q, q)
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    return q.reshape(batch + (4,))
+    m00, m01, m02, m10, m11, m12, m20, m21, m22 = _components(m, 9)
+    trace = m00 + m11 + m22
+    # Pick the numerically largest of w, x, y, z per matrix (the first on a tie) and derive the rest from it.
+    picks = []
+    largest = trace
+    for diagonal in (m00, m11, m22):
+        picks.append(diagonal > largest)
+        largest = np.where(picks[-1], diagonal, largest)
+    for k in range(2, -1, -1):  # a later pick wins over the ones before it
+        for later in picks[k + 1:]:
+            picks[k] &= ~later
+    r = np.sqrt(_picked(picks, [1.0 + trace, 1.0 + m00 - m11 - m22, 1.0 + m11 - m00 - m22,
+                                1.0 + m22 - m00 - m11])) * 2.0
+    quarter = 0.25 * r
+    d0, d1, d2 = (m21 - m12) / r, (m02 - m20) / r, (m10 - m01) / r
+    s01, s02, s12 = (m01 + m10) / r, (m02 + m20) / r, (m12 + m21) / r
+    q = [_picked(picks, [quarter, d0, d1, d2]), _picked(picks, [d0, quarter, s01, s02]),
+         _picked(picks, [d1, s01, quarter, s12]), _picked(picks, [d2, s02, s12, quarter])]
+    flip = q[0] < 0.0
+    q = [np.where(flip, -c, c) for c in q]
+    length = _length(*q)
+    return _joined([c / length for c in q], m.shape[:-2])
 
 
 def rotvec_to_matrix(rotvec: ArrayLike) -> np.ndarray:

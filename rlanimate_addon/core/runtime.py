@@ -29,12 +29,9 @@ def load_agent(path: str | Path) -> "GestureAgent":
     return GestureAgent(weights, metadata)
 
 
-def _softplus(x):
-    return np.logaddexp(0.0, x)
-
-
-def _sigmoid(x):
-    return 0.5 * (1.0 + np.tanh(0.5 * x))
+def _softplus_(x, out):
+    """softplus(x) = log(1 + e^x) into out."""
+    return np.logaddexp(0.0, x, out=out)
 
 
 def _mlp_arrays(weights, name, layers):
@@ -57,22 +54,60 @@ def _gru_arrays(weights, name, suffix=""):
             weights[f"{name}.bias_ih{suffix}"], weights[f"{name}.bias_hh{suffix}"])
 
 
-def _gru_step(input_gates, hidden_gates, h):
-    """torch's GRU update from W_ih x + b_ih and W_hh h + b_hh (3H,) each: h' = (1 - z) n + z h."""
+def _gru_step(input_gates, hidden_gates, h, gates, candidate):
+    """torch's GRU update h' = (1 - z) n + z h, written into h (H,), from W_ih x + b_ih and W_hh h + b_hh (3H,)
+    each; gates (2H,) and candidate (H,) are scratch. In place, in the order of torch's formula: the
+    per-frame loops are bound by numpy's cost per call, not by arithmetic."""
     H = len(h)
-    reset_update = _sigmoid(input_gates[:2 * H] + hidden_gates[:2 * H])
-    candidate = np.tanh(input_gates[2 * H:] + reset_update[:H] * hidden_gates[2 * H:])
-    return candidate + reset_update[H:] * (h - candidate)
+    np.add(input_gates[:2 * H], hidden_gates[:2 * H], out=gates)
+    _sigmoid_(gates)
+    reset, update = gates[:H], gates[H:]
+    np.multiply(reset, hidden_gates[2 * H:], out=candidate)
+    candidate += input_gates[2 * H:]
+    np.tanh(candidate, out=candidate)
+    np.subtract(h, candidate, out=h)
+    h *= update
+    h += candidate
+
+
+def _sigmoid_(x):
+    """x -> its logistic sigmoid 0.5 (1 + tanh(x / 2)), in place."""
+    x *= 0.5
+    np.tanh(x, out=x)
+    x += 1.0
+    x *= 0.5
+
+
+def _mlp_tail_(layers, x, spare, out):
+    """`_mlp_tail` in preallocated arrays: x (the first pre-activation) and spare, of the hidden width, are
+    overwritten; the result goes into out, which is returned."""
+    if len(layers) == 1:
+        np.copyto(out, x)
+        return out
+    for weight, bias in layers[1:-1]:
+        np.tanh(x, out=x)
+        np.matmul(x, weight, out=spare)
+        spare += bias
+        x, spare = spare, x
+    np.tanh(x, out=x)
+    np.matmul(x, layers[-1][0], out=out)
+    out += layers[-1][1]
+    return out
 
 
 def _gru_sequence(inputs, gru):
     """(N, in) -> (N, H) states of a GRU from h_0 = 0."""
     input_weight, hidden_weight, input_bias, hidden_bias = gru
     input_gates = inputs @ input_weight + input_bias  # (N, 3H)
-    h = np.zeros(hidden_weight.shape[0])
-    states = np.empty((len(inputs), len(h)))
+    H = hidden_weight.shape[0]
+    h, hidden_gates = np.zeros(H), np.empty(3 * H)
+    gates, candidate = np.empty(2 * H), np.empty(H)
+    states = np.empty((len(inputs), H))
     for t in range(len(inputs)):
-        h = states[t] = _gru_step(input_gates[t], h @ hidden_weight + hidden_bias, h)
+        np.matmul(h, hidden_weight, out=hidden_gates)
+        hidden_gates += hidden_bias
+        _gru_step(input_gates[t], hidden_gates, h, gates, candidate)
+        states[t] = h
     return states
 
 
@@ -171,21 +206,39 @@ class GestureAgent:
         if self._uses_task_state:
             animation_inputs = animation_inputs + task @ self._animation_task  # (N, hidden)
         gates, belief_end = 3 * E, 3 * E + len(self._belief[0][1])
-        e = np.zeros(E)
-        hidden_gates = self._cell_hidden_bias  # W_hh e_0 + b_hh with e_0 = 0
-        recurrent_gates = np.full(A, agent_file.INITIAL_ACTION) @ self._from_a  # W_z z_0 + W_a a_0 with z_0 = 0
+        hidden = len(self._belief[0][1])
+        e, e_gates, e_candidate = np.zeros(E), np.empty(2 * E), np.empty(E)
+        input_gates, hidden_gates = np.empty(3 * E), self._cell_hidden_bias.copy()  # W_hh e_0 + b_hh, e_0 = 0
+        from_e, from_z = np.empty(self._from_e.shape[1]), np.empty(self._from_z.shape[1])
+        from_a = np.full(A, agent_file.INITIAL_ACTION) @ self._from_a  # W_a a_0 (3E,)
+        recurrent_gates = from_a.copy()  # W_z z_0 + W_a a_0 with z_0 = 0
+        belief_x, animation_x, layer = np.empty(hidden), np.empty(hidden), np.empty(hidden)
+        belief, out = np.empty(len(self._belief[-1][1])), np.empty(2 * A)
+        spread = np.empty(Z)
         actions = np.empty((count, A))
         for t in range(count):
-            e = _gru_step(cell_inputs[t] + recurrent_gates, hidden_gates, e)
-            from_e = e @ self._from_e
-            hidden_gates = from_e[:gates] + self._cell_hidden_bias
-            belief = _mlp_tail(self._belief, from_e[gates:belief_end] + belief_inputs[t])
+            np.add(cell_inputs[t], recurrent_gates, out=input_gates)
+            _gru_step(input_gates, hidden_gates, e, e_gates, e_candidate)
+            np.matmul(e, self._from_e, out=from_e)
+            np.add(from_e[:gates], self._cell_hidden_bias, out=hidden_gates)
+            np.add(from_e[gates:belief_end], belief_inputs[t], out=belief_x)
+            _mlp_tail_(self._belief, belief_x, layer, belief)
             z = belief[:Z]
             if noise is not None:
-                z = z + (_softplus(belief[Z:]) + self._min_std) * noise
-            from_z = z @ self._from_z
-            out = _mlp_tail(self._animation, animation_inputs[t] + from_e[belief_end:] + from_z[gates:])
-            concentrations = self._floor + self._concentration_scale * _softplus(out)  # (90,): alpha, beta
-            a = actions[t] = concentrations[:A] / (concentrations[:A] + concentrations[A:])
-            recurrent_gates = from_z[:gates] + a @ self._from_a
+                _softplus_(belief[Z:], spread)
+                spread += self._min_std
+                spread *= noise
+                z = z + spread
+            np.matmul(z, self._from_z, out=from_z)
+            np.add(animation_inputs[t], from_e[belief_end:], out=animation_x)
+            animation_x += from_z[gates:]
+            _mlp_tail_(self._animation, animation_x, layer, out)
+            _softplus_(out, out)
+            out *= self._concentration_scale
+            concentrations = np.add(self._floor, out, out=out)  # (90,): alpha, beta
+            a = actions[t]
+            np.add(concentrations[:A], concentrations[A:], out=a)
+            np.divide(concentrations[:A], a, out=a)
+            np.matmul(a, self._from_a, out=from_a)
+            np.add(from_z[:gates], from_a, out=recurrent_gates)
         return actions
