@@ -12,7 +12,7 @@ import numpy as np
 
 from . import skeleton
 from .gesture import blend_weights, finger_line_bones
-from .rig import inverse
+from .rig import each_frame, inverse
 from .rotations import quat_to_matrix
 
 #: The deformed hand may sit this far (metres of the scene) from where the gesture put it ...
@@ -43,7 +43,7 @@ def planned_pose(rig, arm, bones, keyed):
     columns = [rig.skeleton.index[b] for b in bones]
     under = rig.under_at(count)
     basis = under.copy()
-    scale = np.linalg.norm(under[:, columns, :3, :3], axis=-2, keepdims=True)  # (N, D, 1, 3)
+    scale = each_frame(lambda u: np.linalg.norm(u[:, columns, :3, :3], axis=-2, keepdims=True), under)  # (N, D, 1, 3)
     basis[:, columns, :3, :3] = quat_to_matrix(np.asarray(keyed, dtype=np.float64)) * scale
     return rig.skeleton.pose_after(rig.under_pose_at(count), under, basis, columns, only=measured_bones(rig.roles, arm))
 

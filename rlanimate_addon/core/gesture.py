@@ -28,7 +28,7 @@ import numpy as np
 
 from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
-from .rig import RigSkeleton, inverse
+from .rig import RigSkeleton, each_frame, inverse
 from .rotations import (matrix_to_quat, matrix_to_rotvec, quat_to_matrix, quat_to_rotvec, rotvec_to_matrix,
                         rotvec_to_quat)
 
@@ -319,6 +319,8 @@ def fold_missing(rotvecs, joints, present):
     Returns (joints kept, rotations).
     """
     out = rotvecs.copy()
+    rotations = rotvec_to_matrix(rotvecs)  # (N, J, 3, 3), each as it would be converted alone
+    keepers, turns = [], []
     for chain in FOLDED_CHAINS:
         have = [j for j in chain if j in present]
         if not have:  # an arm the rig lacks
@@ -331,9 +333,12 @@ def fold_missing(rotvecs, joints, present):
             turn = np.eye(3)
             for j in members:  # chain order: parents first
                 frame = _CANONICAL_FRAMES[j]
-                turn = turn @ frame @ rotvec_to_matrix(rotvecs[:, joints.index(j)]) @ frame.T
+                turn = turn @ frame @ np.ascontiguousarray(rotations[:, joints.index(j)]) @ frame.T
             frame = _CANONICAL_FRAMES[keeper]
-            out[:, joints.index(keeper)] = matrix_to_rotvec(frame.T @ turn @ frame)
+            keepers.append(joints.index(keeper))
+            turns.append(frame.T @ turn @ frame)
+    if keepers:
+        out[:, keepers] = matrix_to_rotvec(np.stack(turns, axis=1))
     kept = [i for i, j in enumerate(joints) if j in present]
     return [joints[i] for i in kept], out[:, kept]
 
@@ -547,8 +552,8 @@ def gesture_rotations(agent, request, rig):
     parents = [_parent_role(n, rig.roles) for n in names]
     parent_swings = np.array([np.eye(3) if p is None else swings[p] for p in parents])
     parent_conversions = retarget_matrices(names, frames, to_character, parent_swings)
-    under_basis = rig.under_at(request.frame_count).copy()
-    under = matrix_to_quat(under_basis[:, columns, :3, :3])  # (N, D, 4)
+    under_basis = rig.under_at(request.frame_count)
+    under = each_frame(lambda basis: matrix_to_quat(basis[:, columns, :3, :3]), under_basis)  # (N, D, 4)
     start = under
     if not rig.animated:  # bones at rest start from the standing pose, not the bind pose
         standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions,
@@ -561,8 +566,8 @@ def gesture_rotations(agent, request, rig):
         phase = aim.pointing_phase(phase_base)
         targets = np.broadcast_to(request.targets, (request.frame_count, 3))
         basis = under_basis.copy()
-        basis[:, columns, :3, :3] = quat_to_matrix(keyed) * np.linalg.norm(basis[:, columns, :3, :3], axis=-2,
-                                                                          keepdims=True)
+        basis[:, columns, :3, :3] = quat_to_matrix(keyed) * each_frame(
+            lambda basis: np.linalg.norm(basis[:, columns, :3, :3], axis=-2, keepdims=True), under_basis)
         if request.exact_aim and request.behaviour == behaviours.POINT:
             arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
             aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
@@ -574,8 +579,9 @@ def gesture_rotations(agent, request, rig):
             looking = look_at(rig, basis, columns, eye_bones, to_character, targets, phase)  # (N, E, 4)
             bones += eye_bones
             keyed = np.concatenate([keyed, looking], axis=1)
-            under = np.concatenate([under, matrix_to_quat(
-                under_basis[:, [rig.skeleton.index[b] for b in eye_bones], :3, :3])], axis=1)
+            eye_columns = [rig.skeleton.index[b] for b in eye_bones]
+            under = np.concatenate([under, each_frame(
+                lambda basis: matrix_to_quat(basis[:, eye_columns, :3, :3]), under_basis)], axis=1)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
     broken = [bone for bone, ok in zip(bones, finite) if not ok]

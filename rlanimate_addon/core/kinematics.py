@@ -33,9 +33,10 @@ def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] 
     batch = np.shape(next(iter(local_rotvecs.values())))[:-1] if local_rotvecs else ()
     evaluated = range(len(_PARENT)) if only is None else _with_ancestors(only)
     basis = np.broadcast_to(np.eye(4), batch + (len(skeleton.BONES), 4, 4)).copy()
-    for name, rotvec in local_rotvecs.items():
-        if _INDEX[name] in evaluated:
-            basis[..., _INDEX[name], :3, :3] = rotvec_to_matrix(rotvec)
+    posed = [name for name in local_rotvecs if _INDEX[name] in evaluated]
+    if posed:  # converted at once: each rotation as it would be alone
+        rotations = rotvec_to_matrix(np.stack([local_rotvecs[name] for name in posed], axis=-2))  # (..., J, 3, 3)
+        basis[..., [_INDEX[name] for name in posed], :3, :3] = rotations
     pose = np.full_like(basis, np.nan)
     for i in evaluated:
         local = _REST_LOCAL[i] @ basis[..., i, :, :]

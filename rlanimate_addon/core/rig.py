@@ -35,12 +35,19 @@ def inverse(matrices):
     return out
 
 
+def each_frame(function, values):
+    """function(values) of (N, ...) per-frame values whose result is per frame too; when the frames are one
+    frame broadcast (a rig standing still: stride 0) it runs on that frame once and its result is broadcast."""
+    if len(values) > 1 and values.strides[0] == 0:
+        once = function(values[:1])
+        return np.broadcast_to(once, (len(values),) + once.shape[1:])
+    return function(values)
+
+
 def _frames_inverse(matrices, bones):
-    """(N, len(bones), 4, 4) `inverse` of (N, B, 4, 4) matrices' bones at indices `bones`, frame by frame;
-    taken once and repeated when the frames are one frame broadcast (a rig standing still)."""
-    if matrices.strides[0] == 0:
-        return np.repeat(inverse(matrices[:1, bones]), len(matrices), axis=0)
-    return inverse(matrices[:, bones])
+    """(N, len(bones), 4, 4) `inverse` of (N, B, 4, 4) matrices' bones at indices `bones`, frame by frame
+    (`each_frame`), laid out frame after frame as the products that read them expect."""
+    return np.ascontiguousarray(each_frame(lambda m: inverse(m[:, bones]), matrices))
 
 
 class RigSkeleton:
