@@ -136,13 +136,12 @@ def verify(scene, plan):
     deformed = deformed_bones(obj)
     carriers = [stand_in(obj, bone, deformed) for bone in measured]
     scale = float(np.cbrt(abs(np.linalg.det(np.array(obj.matrix_world.to_3x3())))))
-    rest_points = bake_measure.rest_points(rig, arm)
+    rest_points, carrier_rests = bake_measure.rest_points(rig, arm), _rest_matrices(obj, carriers)
     start = int(plan.settings.start_frame)
     for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0]):
         frame = start + index
         scene.frame_set(frame)
-        played = bake_measure.carried(_armature_matrices(obj, carriers)[None], _rest_matrices(obj, carriers),
-                                      rest_points)
+        played = bake_measure.carried(_armature_matrices(obj, carriers)[None], carrier_rests, rest_points)
         distance, angle = (float(v[0]) for v in bake_measure.misses(planned[index:index + 1], played, scale))
         if distance > bake_measure.HAND_TOLERANCE or angle > bake_measure.FINGER_TOLERANCE_DEG:
             cause = _cause(obj, rig, pose[index], measured, carriers, plan.bones)

@@ -86,11 +86,11 @@ def _mlp_tail_(layers, x, spare, out):
         return out
     for weight, bias in layers[1:-1]:
         np.tanh(x, out=x)
-        np.matmul(x, weight, out=spare)
+        np.dot(x, weight, out=spare)
         spare += bias
         x, spare = spare, x
     np.tanh(x, out=x)
-    np.matmul(x, layers[-1][0], out=out)
+    np.dot(x, layers[-1][0], out=out)
     out += layers[-1][1]
     return out
 
@@ -104,7 +104,7 @@ def _gru_sequence(inputs, gru):
     gates, candidate = np.empty(2 * H), np.empty(H)
     states = np.empty((len(inputs), H))
     for t in range(len(inputs)):
-        np.matmul(h, hidden_weight, out=hidden_gates)
+        np.dot(h, hidden_weight, out=hidden_gates)
         hidden_gates += hidden_bias
         _gru_step(input_gates[t], hidden_gates, h, gates, candidate)
         states[t] = h
@@ -219,7 +219,7 @@ class GestureAgent:
         for t in range(count):
             np.add(cell_inputs[t], recurrent_gates, out=input_gates)
             _gru_step(input_gates, hidden_gates, e, e_gates, e_candidate)
-            np.matmul(e, self._from_e, out=from_e)
+            np.dot(e, self._from_e, out=from_e)
             np.add(from_e[:gates], self._cell_hidden_bias, out=hidden_gates)
             np.add(from_e[gates:belief_end], belief_inputs[t], out=belief_x)
             _mlp_tail_(self._belief, belief_x, layer, belief)
@@ -229,7 +229,7 @@ class GestureAgent:
                 spread += self._min_std
                 spread *= noise
                 z = z + spread
-            np.matmul(z, self._from_z, out=from_z)
+            np.dot(z, self._from_z, out=from_z)
             np.add(animation_inputs[t], from_e[belief_end:], out=animation_x)
             animation_x += from_z[gates:]
             _mlp_tail_(self._animation, animation_x, layer, out)
@@ -239,6 +239,6 @@ class GestureAgent:
             a = actions[t]
             np.add(concentrations[:A], concentrations[A:], out=a)
             np.divide(concentrations[:A], a, out=a)
-            np.matmul(a, self._from_a, out=from_a)
+            np.dot(a, self._from_a, out=from_a)
             np.add(from_z[:gates], from_a, out=recurrent_gates)
         return actions
