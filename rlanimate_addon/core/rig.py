@@ -97,6 +97,7 @@ class RigSkeleton:
         bones = self._evaluation_order(only)
         slot = {i: k for k, i in enumerate(bones)}
         pose_inverse, basis_inverse = _frames_inverse(pose, bones), _frames_inverse(basis, bones)  # (N, len(bones), 4, 4)
+        still = pose.strides[0] == 0 and basis.strides[0] == 0  # one frame broadcast: a rig standing still
         out = np.array(pose, dtype=np.float64)
         moved = np.zeros(len(self.names), dtype=bool)
         for i in bones:
@@ -105,7 +106,8 @@ class RigSkeleton:
             if i not in changed and not follows:
                 continue
             local = basis[:, i] if i not in changed else new_basis[:, i]
-            placed = pose[:, i] @ basis_inverse[:, slot[i]] @ local
+            offset = pose[:1 if still else None, i] @ basis_inverse[:1 if still else None, slot[i]]  # pose @ basis^-1
+            placed = np.broadcast_to(offset, local.shape) @ local
             out[:, i] = out[:, parent] @ pose_inverse[:, slot[parent]] @ placed if follows else placed
             moved[i] = True
         return out
