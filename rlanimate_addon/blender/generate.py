@@ -120,9 +120,8 @@ def _check(obj, settings, start, end, mute_constraints):
     check_nla(obj)
     check_inherited_rotation(obj, roles)
     armature_io.check_hips(obj, roles)
-    rig_scale.check_nonzero_scale(obj.name, obj.matrix_world, {  # the gesture's bones and their parents
-        p.name: tuple(p.scale) for b in constraints.driven_bones(roles, settings.behaviour, settings.arm)
-        for p in (obj.pose.bones[b], *obj.pose.bones[b].parent_recursive)})
+    rig_scale.check_nonzero_scale(obj.name, obj.matrix_world,
+                                  _scales(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm)))
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
@@ -131,6 +130,18 @@ def _check(obj, settings, start, end, mute_constraints):
     overriding = constraints.against_gesture(obj, driven)
     constraints.check(obj, overriding, start, end, mute_constraints)
     return _Plan(obj, family, roles, overriding, ik_share)
+
+
+def _scales(obj, names):
+    """{bone: its pose scale (3,)} of the named bones and their parents, each read once (bone, parents, next
+    bone ...)."""
+    scales = {}
+    for name in names:
+        bone = obj.pose.bones[name]
+        while bone is not None and bone.name not in scales:  # a bone read before had its parents read too
+            scales[bone.name] = tuple(bone.scale)
+            bone = bone.parent
+    return scales
 
 
 def _compute(context, plan, settings, agent, frames):
