@@ -168,7 +168,7 @@ def _matrices(collection, field, names):
     """(len(names), 4, 4) float64 matrices `field` of the named items of a bone collection, read at once."""
     flat = np.empty(16 * len(collection), dtype=np.float32)
     collection.foreach_get(field, flat)
-    order = {item.name: k for k, item in enumerate(collection)}
+    order = {name: k for k, name in enumerate(collection.keys())}
     return flat.reshape(-1, 4, 4).transpose(0, 2, 1)[[order[name] for name in names]].astype(np.float64)
 
 
@@ -184,6 +184,12 @@ def _rotation(mode, values):
 
 def _rotation_path(mode):
     return {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}.get(mode, "rotation_euler")
+
+
+def _standing(pose_bone, path, count):
+    """(count, C) the channel `path`'s value as the bone stands now, on every frame (read-only)."""
+    value = np.array(getattr(pose_bone, path), dtype=np.float64)
+    return np.broadcast_to(value, (count, len(value)))
 
 
 def sample(obj, names, frames):
@@ -211,7 +217,7 @@ def sample(obj, names, frames):
             if key is None or key[0] not in in_chain:
                 continue
             if key not in channels:  # starts at the bone's own value; each layer replaces what it keys
-                channels[key] = np.tile(np.array(getattr(pose_bones[key[0]], key[1]), dtype=np.float64), (count, 1))
+                channels[key] = _standing(pose_bones[key[0]], key[1], count).copy()
                 covered[key] = np.zeros(count, dtype=bool)
             if fcurve.array_index < channels[key].shape[1]:
                 curves.append((fcurve, key))
@@ -243,7 +249,7 @@ def sample(obj, names, frames):
         if name in keyed:
             pose_bone = pose_bones[name]
             path = _rotation_path(pose_bone.rotation_mode)
-            value = {p: channels.get((name, p), np.tile(np.array(getattr(pose_bone, p)), (count, 1)))
+            value = {p: channels[name, p] if (name, p) in channels else _standing(pose_bone, p, count)
                      for p in ("location", "scale", path)}
             basis[:, column, :3, :3] = _rotation(pose_bone.rotation_mode, value[path]) * value["scale"][:, None, :]
             basis[:, column, :3, 3] = value["location"]
@@ -253,5 +259,5 @@ def sample(obj, names, frames):
     values = {}
     for name in names:
         path = _rotation_path(pose_bones[name].rotation_mode)
-        values[name] = channels.get((name, path), np.tile(np.array(getattr(pose_bones[name], path)), (count, 1)))
+        values[name] = channels[name, path] if (name, path) in channels else _standing(pose_bones[name], path, count)
     return basis[:, columns], pose[:, columns], values
