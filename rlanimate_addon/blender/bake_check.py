@@ -36,7 +36,7 @@ class BakeUndo:
         self.tracks = {t.as_pointer() for t in data.nla_tracks} if data else set()
         self.actions = {a.as_pointer() for a in bpy.data.actions}
         self.influences = [(c, c.influence, _saved_keys(constraints.influence_curve(obj, c))) for _, c in found]
-        self.channels = {pb.name: [tuple(getattr(pb, p)) for p in _CHANNELS] for pb in obj.pose.bones}
+        self.channels = {path: _channel_values(obj.pose.bones, path, size) for path, size in _CHANNELS.items()}
         self.properties = [(pb, key, pb[key]) for pb, key in switches]
 
     def restore(self):
@@ -61,15 +61,23 @@ class BakeUndo:
             obj.animation_data_clear()
         for action in [a for a in bpy.data.actions if a.as_pointer() not in self.actions]:
             bpy.data.actions.remove(action)
-        for pose_bone in obj.pose.bones:
-            for path, value in zip(_CHANNELS, self.channels[pose_bone.name]):
-                setattr(pose_bone, path, value)
+        for k, pose_bone in enumerate(obj.pose.bones):
+            for path, values in self.channels.items():
+                setattr(pose_bone, path, tuple(values[k]))
         for pose_bone, key, value in self.properties:
             pose_bone[key] = value
 
 
-_CHANNELS = ("location", "rotation_quaternion", "rotation_euler", "rotation_axis_angle", "scale")
+#: The pose channels a bake may change, with their sizes.
+_CHANNELS = {"location": 3, "rotation_quaternion": 4, "rotation_euler": 3, "rotation_axis_angle": 4, "scale": 3}
 _KEY_FIELDS = ("co", "handle_left", "handle_right", "interpolation", "handle_left_type", "handle_right_type")
+
+
+def _channel_values(pose_bones, path, size):
+    """(P, size) float32 values of channel `path` of every pose bone, in their order, read at once."""
+    values = np.empty((len(pose_bones), size), dtype=np.float32)
+    pose_bones.foreach_get(path, values.ravel())
+    return values
 
 
 def _saved_keys(curve):
