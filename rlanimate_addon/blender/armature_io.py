@@ -29,7 +29,7 @@ def rig_roles_of(obj, bone_map_path=""):
     detected from its bone names. RLAnimateError when obj is not an armature."""
     if obj is None or obj.type != "ARMATURE":
         raise RLAnimateError("The active object is not an armature: select the character's armature.")
-    names = [bone.name for bone in obj.data.bones]
+    names = obj.data.bones.keys()
     if bone_map_path:
         path = Path(bpy.path.abspath(bone_map_path))
         try:

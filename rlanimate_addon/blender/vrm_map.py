@@ -17,7 +17,7 @@ from ..core.errors import RLAnimateError
 def roles_of(obj):
     """{role: bone name} from the VRM add-on's map on the armature (kept up to date as bones are
     renamed), else from its VRM file, or None when it has neither."""
-    names = [bone.name for bone in obj.data.bones]
+    names = obj.data.bones.keys()
     roles = addon_roles(obj.data, set(names))
     path = obj.rlanimate.vrm_file
     if roles or not path:
