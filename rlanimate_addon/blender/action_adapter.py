@@ -110,6 +110,12 @@ def read_digest(fcurves):
     return digest
 
 
+def _stored(enum_values):
+    """Keyframe enum values (interpolation, handle types) as the bytes Blender stores them in: foreach_set
+    then copies them straight in, 3 to 6 times quicker than from int32 (4.2 and 5.0 alike)."""
+    return np.asarray(enum_values, dtype=np.uint8)
+
+
 def write_keys(fcurve, frames, values, digest=None):
     """Bulk-write keys (frames (N,), values (N,)) into an empty F-curve, linear between frames, fed to
     the KeyDigest given.
@@ -123,7 +129,7 @@ def write_keys(fcurve, frames, values, digest=None):
     co[:, 0], co[:, 1] = frames, values
     interpolation = np.full(count, _LINEAR, dtype=np.int32)
     points.foreach_set("co", co.ravel())
-    points.foreach_set("interpolation", interpolation)
+    points.foreach_set("interpolation", _stored(interpolation))
     if digest is not None:
         digest.add(fcurve, co, interpolation)
 
@@ -149,7 +155,7 @@ def write_bezier_keys(fcurve, frames, values, tangents, digest=None):
     for name, data in written.items():
         points.foreach_set(name, data.ravel())
     for name, value in (("interpolation", _BEZIER), ("handle_left_type", _FREE), ("handle_right_type", _FREE)):
-        points.foreach_set(name, np.full(count, value, dtype=np.int32))
+        points.foreach_set(name, _stored(np.full(count, value)))
     if digest is not None:
         digest.add(fcurve, written["co"], np.full(count, _BEZIER, dtype=np.int32),
                    (written["handle_left"], written["handle_right"]))
