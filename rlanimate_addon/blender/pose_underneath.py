@@ -102,9 +102,7 @@ def _fcurve_keys(fcurve):
         values = np.empty(2 * count, dtype=np.float32)
         points.foreach_get(field, values)
         arrays.append(values.reshape(count, 2).astype(np.float64))
-    interpolation = np.empty(count, dtype=np.int32)
-    points.foreach_get("interpolation", interpolation)
-    return (*arrays, interpolation)
+    return (*arrays, action_adapter.read_enum(points, "interpolation"))
 
 
 def _numpy_evaluable(fcurve, interpolation):
