@@ -251,7 +251,8 @@ def sample(obj, names, frames):
                      for p in ("location", "scale", path)}
             basis[:, column, :3, :3] = _rotation(pose_bone.rotation_mode, value[path]) * value["scale"][:, None, :]
             basis[:, column, :3, 3] = value["location"]
-        local = offsets[column] @ basis[:None if name in keyed else 1, column]  # unkeyed: the same every frame
+        frames = slice(None) if name in keyed else slice(0, 1)  # an unkeyed bone's basis is the same every frame
+        local = offsets[column] @ basis[frames, column]
         pose[:, column] = local if parent < 0 else pose[:, parent] @ local
     columns = [index[name] for name in names]
     values = {}

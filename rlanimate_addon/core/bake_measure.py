@@ -42,11 +42,12 @@ def planned_pose(rig, arm, bones, keyed):
     count = len(keyed)
     measured = measured_bones(rig.roles, arm)
     chain = {i for bone in measured for i in rig.skeleton.ancestors(bone)}
-    picked = [k for k, bone in enumerate(bones) if rig.skeleton.index[bone] in chain]  # the others move nothing measured
+    picked = [k for k, bone in enumerate(bones) if rig.skeleton.index[bone] in chain]  # others move nothing measured
     columns = [rig.skeleton.index[bones[k]] for k in picked]
     under = rig.under_at(count)
     basis = under.copy()
-    scale = each_frame(lambda u: np.linalg.norm(u[:, columns, :3, :3], axis=-2, keepdims=True), under)  # (N, D, 1, 3)
+    scale = each_frame(lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True),
+                       under)  # (N, D, 1, 3)
     basis[:, columns, :3, :3] = quat_to_matrix(np.asarray(keyed, dtype=np.float64)[:, picked]) * scale
     return rig.skeleton.pose_after(rig.under_pose_at(count), under, basis, columns, only=measured)
 

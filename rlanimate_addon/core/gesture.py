@@ -553,7 +553,7 @@ def gesture_rotations(agent, request, rig):
     parent_swings = np.array([np.eye(3) if p is None else swings[p] for p in parents])
     parent_conversions = retarget_matrices(names, frames, to_character, parent_swings)
     under_basis = rig.under_at(request.frame_count)
-    under = each_frame(lambda basis: matrix_to_quat(basis[:, columns, :3, :3]), under_basis)  # (N, D, 4)
+    under = each_frame(lambda frames: matrix_to_quat(frames[:, columns, :3, :3]), under_basis)  # (N, D, 4)
     start = under
     if not rig.animated:  # bones at rest start from the standing pose, not the bind pose
         standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions,
@@ -567,7 +567,7 @@ def gesture_rotations(agent, request, rig):
         targets = np.broadcast_to(request.targets, (request.frame_count, 3))
         basis = under_basis.copy()
         basis[:, columns, :3, :3] = quat_to_matrix(keyed) * each_frame(
-            lambda basis: np.linalg.norm(basis[:, columns, :3, :3], axis=-2, keepdims=True), under_basis)
+            lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True), under_basis)
         if request.exact_aim and request.behaviour == behaviours.POINT:
             arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
             aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
@@ -581,7 +581,7 @@ def gesture_rotations(agent, request, rig):
             keyed = np.concatenate([keyed, looking], axis=1)
             eye_columns = [rig.skeleton.index[b] for b in eye_bones]
             under = np.concatenate([under, each_frame(
-                lambda basis: matrix_to_quat(basis[:, eye_columns, :3, :3]), under_basis)], axis=1)
+                lambda frames: matrix_to_quat(frames[:, eye_columns, :3, :3]), under_basis)], axis=1)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
     broken = [bone for bone, ok in zip(bones, finite) if not ok]

@@ -106,7 +106,8 @@ class RigSkeleton:
             if i not in changed and not follows:
                 continue
             local = basis[:, i] if i not in changed else new_basis[:, i]
-            offset = pose[:1 if still else None, i] @ basis_inverse[:1 if still else None, slot[i]]  # pose @ basis^-1
+            frames = slice(0, 1) if still else slice(None)  # a still rig's offset is the same every frame
+            offset = pose[frames, i] @ basis_inverse[frames, slot[i]]  # pose @ basis^-1
             placed = np.broadcast_to(offset, local.shape) @ local
             out[:, i] = out[:, parent] @ pose_inverse[:, slot[parent]] @ placed if follows else placed
             moved[i] = True
