@@ -32,14 +32,15 @@ def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] 
     """
     batch = np.shape(next(iter(local_rotvecs.values())))[:-1] if local_rotvecs else ()
     evaluated = range(len(_PARENT)) if only is None else _with_ancestors(only)
-    basis = np.broadcast_to(np.eye(4), batch + (len(skeleton.BONES), 4, 4)).copy()
     posed = [name for name in local_rotvecs if _INDEX[name] in evaluated]
+    basis = np.broadcast_to(np.eye(4), batch + (len(posed), 4, 4)).copy()  # the posed bones' only
     if posed:  # converted at once: each rotation as it would be alone
-        rotations = rotvec_to_matrix(np.stack([local_rotvecs[name] for name in posed], axis=-2))  # (..., J, 3, 3)
-        basis[..., [_INDEX[name] for name in posed], :3, :3] = rotations
-    pose = np.full_like(basis, np.nan)
+        basis[..., :3, :3] = rotvec_to_matrix(np.stack([local_rotvecs[name] for name in posed], axis=-2))
+    column = {_INDEX[name]: k for k, name in enumerate(posed)}
+    at_rest = np.broadcast_to(np.eye(4), batch + (4, 4))
+    pose = np.full(batch + (len(skeleton.BONES), 4, 4), np.nan)
     for i in evaluated:
-        local = _REST_LOCAL[i] @ basis[..., i, :, :]
+        local = _REST_LOCAL[i] @ (basis[..., column[i], :, :] if i in column else at_rest)
         parent = _PARENT[i]
         pose[..., i, :, :] = local if parent < 0 else pose[..., parent, :, :] @ local
     return pose
