@@ -25,7 +25,7 @@ and docs/results/realmocap_frames.png (generated and real frames side by side).
 import functools
 import json
 import sys
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -44,34 +44,43 @@ from trainer.evaluation import baselines, scoring
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel
 from trainer.motion.fk import ClipReferences
-from trainer.motion.realmocap_takes import (HOLDOUT_STYLES, parse_name, relaxed_hand, require_realmocap,
-                                            style_holdout_split, take_paths, wave_split)
+from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, parse_name,
+                                            relaxed_hand, require_realmocap, style_holdout_split, take_paths,
+                                            wave_split)
 from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
                            shown)
 from trainer.reporting.realmocap_report import frames_figure, seed_summary
 
 
-def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache"):
+def import_real_clip(path, cache_dir=REALMOCAP_RUNS / "import_cache", labels=PAPER_LABELS):
     """A real clip on the canonical rig with a relaxed hand and labels derived from its motion.
 
-    wave/ and bye/ clips are WAVE (arm and exaggeration from autolabel.label_wave); guide/ clips are
-    POINT (arm and held direction from autolabel.label_point). `.style` and `.take` come from the name.
+    `labels` ({folder: Behaviour}, realmocap_takes.PAPER_LABELS or GESTURE_LABELS) says what the take
+    performs: an intensity behaviour's arm and exaggeration come from autolabel.label_wave, a target
+    behaviour's arm and held direction from autolabel.label_point (and, beside point, a target
+    GUIDE_TARGET_DISTANCE along it). `.style` and `.take` come from the name.
     """
     info = parse_name(path)
     clip = relaxed_hand(import_clip(path, cache_dir=cache_dir))
-    autolabel.label_clip(clip, behaviours.POINT if info["content"] == "guide" else behaviours.WAVE)
+    behaviour = labels[info["content"]]
+    autolabel.label_clip(clip, behaviours.POINT if behaviour.kind == behaviours.TARGET else behaviours.WAVE)
+    if behaviour.name not in behaviours.KNOWN_KINDS:
+        clip.behaviour, clip.kind = behaviour.name, behaviour.kind
+        if behaviour.kind == behaviours.TARGET:
+            clip.target = tuple(skeleton.shoulder_rest_position(clip.arm) + GUIDE_TARGET_DISTANCE * clip.attributes)
     clip.content, clip.style, clip.take, clip.named_arm = info["content"], info["style"], info["take"], info["arm"]
     return clip
 
 
-def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_cache", import_workers=1):
-    """Every clip of root/folder ('wave', 'bye' or 'guide') but the withheld takes, sorted by name;
-    import_workers > 1: the takes the cache lacks are imported by that many Ray tasks first
-    (clip_import.import_into_cache)."""
+def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_cache", import_workers=1,
+                labels=PAPER_LABELS):
+    """Every clip of root/folder ('wave', 'bye' or 'guide') but the withheld takes, sorted by name, labelled
+    as `labels` says (import_real_clip); import_workers > 1: the takes the cache lacks are imported by that
+    many Ray tasks first (clip_import.import_into_cache)."""
     paths = take_paths(require_realmocap(root) / folder)
     if import_workers > 1:
         import_into_cache([(p, EXPECTED_FPS) for p in paths], Path(cache_dir), import_workers)
-    return [import_real_clip(p, cache_dir) for p in paths]
+    return [import_real_clip(p, cache_dir, labels) for p in paths]
 
 
 class RealSession:
@@ -118,30 +127,35 @@ def guide_angles(method, clips, env):
 
 @dataclass(frozen=True)
 class RealRun:
-    """One training run on real takes, as a Ray task gets it: its settings, and the takes (BVH paths, in
-    the session's order) its worker reads from the import cache."""
+    """One training run on real takes, as a Ray task gets it: its settings, the takes (BVH paths, in
+    the session's order) its worker reads from the import cache, and what each folder's takes perform
+    (import_real_clip's `labels`)."""
     settings: RunSettings
     train_takes: tuple[str, ...]
     test_takes: tuple[str, ...]
     cache: str
+    labels: dict = field(default_factory=lambda: PAPER_LABELS)
 
 
-def real_run(name, train_clips, test_clips, seed, settings):
-    """The RealRun of experiment `name` ('wave' or 'holdout') with `seed`, into <runs>[_seed<N>]/<name>/
-    (resumed when a checkpoint is there)."""
+def real_run(name, train_clips, test_clips, seed, settings, labels=PAPER_LABELS, training_set=behaviours.WAVE):
+    """The RealRun of experiment `name` ('wave', 'holdout', 'gestures') with `seed`, training the behaviours
+    `training_set` names (behaviours.training_set), into <runs>[_seed<N>]/<name>/ (resumed when a checkpoint
+    is there)."""
     output = seed_folder(settings.runs, seed) / name
-    run = RunSettings(output=str(output), behaviour=behaviours.key(behaviours.WAVE), clips=f"realmocap:{name}",
+    run = RunSettings(output=str(output), behaviour=behaviours.key(training_set), clips=f"realmocap:{name}",
                       epochs=settings.epochs, seed=seed, preset=settings.preset, variant="rlanimate", eval_every=0,
                       resume=(output / checkpoint.FILENAME).is_file(), progress=False)
     return RealRun(run, tuple(c.source for c in train_clips), tuple(c.source for c in test_clips),
-                   str(Path(settings.runs) / "import_cache"))
+                   str(Path(settings.runs) / "import_cache"), labels)
 
 
-def real_session(train_takes, test_takes, cache):
-    """A RealSession of the takes, imported (or read from the cache `cache`) in this process's Blender."""
+def real_session(train_takes, test_takes, cache, labels=PAPER_LABELS):
+    """A RealSession of the takes, imported (or read from the cache `cache`) in this process's Blender and
+    labelled as `labels` says."""
     new_empty_scene()
     with blender_output():
-        train_clips, test_clips = ([import_real_clip(path, cache) for path in paths] for paths in (train_takes, test_takes))
+        train_clips, test_clips = ([import_real_clip(path, cache, labels) for path in paths]
+                                   for paths in (train_takes, test_takes))
         env = FKEnvironment()
     return RealSession(env, ClipReferences(env), train_clips, test_clips)
 
@@ -149,7 +163,8 @@ def real_session(train_takes, test_takes, cache):
 def train_real(run: RealRun) -> dict:
     """Train `run` on a session its own process builds, its output in train.log; the report. A Ray task:
     pinned to one torch thread, it is bit for bit the run `train` makes on the same takes in this process."""
-    return train_logged(run.settings, functools.partial(real_session, run.train_takes, run.test_takes, run.cache))
+    return train_logged(run.settings,
+                        functools.partial(real_session, run.train_takes, run.test_takes, run.cache, run.labels))
 
 
 def train_real_runs(runs, address=None, workers=None):

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import skeleton
+from rlanimate_addon.core import behaviours, skeleton
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.motion.synthesis import FINGER_BONES, neutral_pose
 from trainer.paths import REALMOCAP_DIR
@@ -24,6 +24,24 @@ FIRST_TAKES = tuple(f"{k:03d}" for k in range(1, 11))
 #: (exaggeration ~0.3 and ~0.55 against 0.1 feminine and 0.75-1 for the rest), as the paper's unseen
 #: waves are exaggerations between the training ones.
 HOLDOUT_STYLES = ("elderly", "exhausted")
+#: The 14 styles of dataset 1's guide and bye takes (one take, 001, each; licenses/dataset-1_style_label.txt
+#: but "not-confident", which has neither).
+GESTURE_STYLES = ("active", "angry", "childish", "chimpira", "feminine", "giant", "happy", "masculinity", "musical",
+                  "normal", "old", "proud", "sad", "tired")
+#: The guide and bye styles the gesture experiment tests on and never trains on: the same 4 for both, drawn
+#: with this seed before any agent was trained (gesture_test_styles()).
+GESTURE_SPLIT_SEED = 27
+GESTURE_TEST_COUNT = 4
+#: What each folder's takes perform, {folder: Behaviour}: as the paper's pair (the wave experiments: goodbye
+#: waves tested as waves, guide takes as pointing), and as behaviours of their own beside the waves (the
+#: gesture experiment): "this way" a target behaviour like point (the direction the arm is held in), a
+#: goodbye wave an intensity one like wave (the exaggeration autolabel reads from the motion).
+PAPER_LABELS = {"wave": behaviours.PAPER[1], "bye": behaviours.PAPER[1], "guide": behaviours.PAPER[0]}
+GESTURE_LABELS = {"wave": behaviours.PAPER[1], "bye": behaviours.Behaviour("BYE", behaviours.INTENSITY),
+                  "guide": behaviours.Behaviour("GUIDE", behaviours.TARGET)}
+#: How far ahead along the held direction a guide take's target is put, metres (the sample library's
+#: guiding targets are 1.5-5 m away): the guide metrics read its heading from the shoulder.
+GUIDE_TARGET_DISTANCE = 3.0
 
 _NAME = re.compile(r"dataset-(?P<dataset>\d)_(?P<content>[a-z]+)(?:-(?P<side>left|right)-hand)?"
                    r"_(?P<style>[a-z-]+)_(?P<take>\d{3})$")
@@ -83,3 +101,17 @@ def style_holdout_split(clips, held_out=HOLDOUT_STYLES):
     held-out ones."""
     return ([c for c in clips if c.style not in held_out and c.take in TRAIN_TAKES + TEST_TAKES],
             [c for c in clips if c.style in held_out and c.take in FIRST_TAKES])
+
+
+def gesture_test_styles(seed=GESTURE_SPLIT_SEED, count=GESTURE_TEST_COUNT):
+    """The guide and bye styles held out of training, sorted: `count` of GESTURE_STYLES drawn with `seed`
+    (27, 4: active, childish, feminine, musical)."""
+    return tuple(sorted(np.random.default_rng(seed).choice(GESTURE_STYLES, count, replace=False).tolist()))
+
+
+def gesture_split(clips, test_styles=None):
+    """(train, test) of the guide and bye takes among `clips` (other takes are in neither list): the takes of
+    the styles not in `test_styles` (default gesture_test_styles()), and those of the styles in it."""
+    test_styles = gesture_test_styles() if test_styles is None else tuple(test_styles)
+    gestures = [c for c in clips if c.content in ("guide", "bye")]
+    return ([c for c in gestures if c.style not in test_styles], [c for c in gestures if c.style in test_styles])

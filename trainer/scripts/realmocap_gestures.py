@@ -1,0 +1,67 @@
+"""Train one agent on the real waves, guide and goodbye takes and compare it with retrieval:
+docs/results/realmocap_guide_bye.json and .md, docs/results/realmocap_guide_bye_paths.png.
+
+    nice -n 15 python -m trainer.scripts.realmocap_gestures [--epochs 50] [--seed 0]
+
+An experiment on CC BY-NC capture: the agent stays in runs/realmocap/gestures/ (reused when finished) and
+never ships.
+"""
+import argparse
+import json
+from pathlib import Path
+
+from trainer.experiments.realmocap_gestures import GestureSettings, run_experiment
+from trainer.reporting.realmocap_gestures_report import gestures_markdown, paths_figure
+from trainer.scripts.cli import run_main, script_args
+
+DEFAULTS = GestureSettings()
+RESULT = "realmocap_guide_bye"
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.realmocap_gestures",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
+    parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs, help="iterations of Algorithm 1 (paper: 50)")
+    parser.add_argument("--preset", default=DEFAULTS.preset)
+    parser.add_argument("--seed", type=int, default=DEFAULTS.seed)
+    parser.add_argument("--runs", default=DEFAULTS.runs)
+    parser.add_argument("--results", default=DEFAULTS.results)
+    parser.add_argument("--import-workers", type=int, default=DEFAULTS.import_workers,
+                        help="import the takes the cache lacks with N Blenders at once (Ray tasks; default 1)")
+    parser.add_argument("--address", default=DEFAULTS.address,
+                        help="join a Ray cluster (auto or ray://HOST:PORT; default: a local Ray)")
+    return parser
+
+
+def parse_settings(argv=None):
+    """GestureSettings from the command line."""
+    args = build_parser().parse_args(script_args(argv))
+    return GestureSettings(realmocap=args.realmocap, epochs=args.epochs, preset=args.preset, seed=args.seed,
+                           runs=args.runs, results=args.results, import_workers=args.import_workers,
+                           address=args.address)
+
+
+def wave_only_summary(results_dir):
+    """The wave-only agent's seed-0 summary on takes 009-010 from realmocap.json, or None without it."""
+    path = Path(results_dir) / "realmocap.json"
+    if not path.is_file():
+        return None
+    return json.loads(path.read_text())["wave"]["test_seeds"].get("0")
+
+
+def main(argv=None):
+    settings = parse_settings(argv)
+    results, scored = run_experiment(settings)
+    out = Path(settings.results)
+    out.mkdir(parents=True, exist_ok=True)
+    paths_figure(scored["env"], scored["methods"], scored["sets"], out / f"{RESULT}_paths.png")
+    (out / f"{RESULT}.json").write_text(json.dumps(results, indent=2) + "\n")
+    page = gestures_markdown(results, wave_only_summary(out))
+    (out / f"{RESULT}.md").write_text(page)
+    print(page)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))
