@@ -19,7 +19,6 @@ as a wave).
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-import numpy as np
 import torch
 
 from rlanimate_addon.core import behaviours
@@ -35,7 +34,6 @@ from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 NAME = "gestures"
 BYE = GESTURE_LABELS["bye"].name
 GUIDE = GESTURE_LABELS["guide"].name
-METHODS = ("rlanimate", "nearest_clip")
 
 
 @dataclass(frozen=True)
@@ -100,7 +98,8 @@ def run_experiment(settings: GestureSettings) -> tuple[dict, dict]:
                "command": command, "epochs": settings.epochs, "preset": settings.preset, "seed": settings.seed,
                "behaviours": {b.name: b.kind for b in GESTURE_LABELS.values()},
                "test_styles": list(gesture_test_styles()),
-               "train_clips": {behaviours.key(b): sum(c.behaviour == b for c in train) for b in (behaviours.WAVE, GUIDE, BYE)},
+               "train_clips": {behaviours.key(b): sum(c.behaviour == b for c in train)
+                               for b in (behaviours.WAVE, GUIDE, BYE)},
                "train_styles": sorted({c.style for c in train if c.behaviour in (GUIDE, BYE)}),
                "episodes": report["episodes"], "train_seconds": report["train_seconds"],
                "sets": {name: {"clips": [c.name for c in clips],
