@@ -9,8 +9,9 @@ guide and bye, so their test is on styles: the same 4 of the 14 held out for bot
 (realmocap_takes.gesture_test_styles, seeded), the other 10 train. Waves split as the wave experiment
 does (takes 001-008 and 021-036 train, 009-010 test; 011-020 never read).
 
-One agent (seed and epochs from the settings) trains on every training take as a Ray task
-(realmocap.train_real) into runs/realmocap/gestures/. Retrieval answers the same requests from the same
+One agent per seed (epochs from the settings) trains on every training take as a Ray task
+(realmocap.train_real) into runs/realmocap/gestures/ (seed 0) or runs/realmocap_seed<N>/gestures/. The first
+seed's agent gives the full tables and the figure; every seed's is scored on the held-out sets ("seeds"). Retrieval answers the same requests from the same
 training clips. Each test set is scored as realmocap.md scores the waves (score, DTW score), with the
 behaviour's metrics: a guide take with the guide metrics towards a target along its held direction
 (realmocap_takes.GUIDE_TARGET_DISTANCE), a goodbye wave with the wave metrics (generated as BYE, measured
@@ -30,6 +31,7 @@ from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import (GESTURE_LABELS, gesture_split, gesture_test_styles, require_realmocap,
                                             wave_split)
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
+from trainer.reporting.realmocap_gestures_report import held_out_summary
 
 NAME = "gestures"
 BYE = GESTURE_LABELS["bye"].name
@@ -42,7 +44,7 @@ class GestureSettings:
     realmocap: str = str(REALMOCAP_DIR)
     epochs: int = 50  # iterations of Algorithm 1 (the wave experiment's 50)
     preset: str = "default"
-    seed: int = 0
+    seeds: tuple[int, ...] = (0,)  # one agent each, trained one after another; the first gives the full tables
     runs: str = str(REALMOCAP_RUNS)
     results: str = str(RESULTS_DIR)
     import_workers: int = 1
@@ -75,9 +77,13 @@ def score(method, clips, env):
     return scoring.score_motions(env, motions, measured, ClipReferences(env))
 
 
+#: The held-out sets, scored for every seed's agent.
+HELD_OUT_SETS = ("waves", "guide_test", "bye_test")
+
+
 def run_experiment(settings: GestureSettings) -> tuple[dict, dict]:
-    """Train (or reuse) the agent and score it and retrieval on every set: (results dict, {'env', 'methods',
-    'sets'} for the figure)."""
+    """Train (or reuse) the agents and score them and retrieval: every set for the first seed's agent, the
+    held-out sets for every seed's; (results dict, {'env', 'methods', 'sets'} for the figure)."""
     torch.set_num_threads(1)
     new_empty_scene()
     root = require_realmocap(settings.realmocap)
@@ -87,15 +93,17 @@ def run_experiment(settings: GestureSettings) -> tuple[dict, dict]:
                                for f in ("wave", "bye", "guide"))
         env = FKEnvironment()
     train, sets = gesture_sets(waves, byes, guides)
-    held_out = sets["waves"] + sets["guide_test"] + sets["bye_test"]
-    run = real_run(NAME, train, held_out, settings.seed, settings, GESTURE_LABELS, behaviours.ALL)
-    report = train_real_runs([run], settings.address, settings.workers)[run.settings.output]
-    methods = {"rlanimate": baselines.AgentMethod(Path(run.settings.output) / "agent.npz"),
-               "nearest_clip": baselines.NearestClip(train)}
+    held_out = [c for name in HELD_OUT_SETS for c in sets[name]]
+    seeds = list(dict.fromkeys(settings.seeds))
+    runs = [real_run(NAME, train, held_out, seed, settings, GESTURE_LABELS, behaviours.ALL) for seed in seeds]
+    reports = train_real_runs(runs, settings.address, settings.workers)
+    agents = [baselines.AgentMethod(Path(run.settings.output) / "agent.npz") for run in runs]
+    report = reports[runs[0].settings.output]
+    methods = {"rlanimate": agents[0], "nearest_clip": baselines.NearestClip(train)}
     command = (f"nice -n 15 python -m trainer.scripts.realmocap_gestures --epochs {settings.epochs} "
-               f"--preset {settings.preset} --seed {settings.seed}")
+               f"--preset {settings.preset} --seeds {' '.join(str(seed) for seed in seeds)}")
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
-               "command": command, "epochs": settings.epochs, "preset": settings.preset, "seed": settings.seed,
+               "command": command, "epochs": settings.epochs, "preset": settings.preset, "seeds": seeds,
                "behaviours": {b.name: b.kind for b in GESTURE_LABELS.values()},
                "test_styles": list(gesture_test_styles()),
                "train_clips": {behaviours.key(b): sum(c.behaviour == b for c in train)
@@ -105,4 +113,13 @@ def run_experiment(settings: GestureSettings) -> tuple[dict, dict]:
                "sets": {name: {"clips": [c.name for c in clips],
                                **{m: score(method, clips, env) for m, method in methods.items()}}
                         for name, clips in sets.items()}}
+    results["seed_sets"] = {}
+    for name in HELD_OUT_SETS:
+        per_seed = {str(seeds[0]): held_out_summary(results["sets"][name]["rlanimate"])}
+        per_seed.update({str(seed): held_out_summary(score(agent, sets[name], env))
+                         for seed, agent in zip(seeds[1:], agents[1:])})
+        results["seed_sets"][name] = {"rlanimate": per_seed,
+                                      "nearest_clip": held_out_summary(results["sets"][name]["nearest_clip"])}
+    results["train_seconds_per_seed"] = {str(seed): reports[run.settings.output]["train_seconds"]
+                                         for seed, run in zip(seeds, runs)}
     return results, {"env": env, "methods": methods, "sets": sets}

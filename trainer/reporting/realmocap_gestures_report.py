@@ -18,14 +18,21 @@ SETS = (("waves", "wave", "waves, takes 009-010"),
 FIGURE_STYLE = "musical"
 
 
-def _accepted_key(clip_row):
-    return "guide_accepted" if "guide_accepted" in clip_row else "wave_accepted"
+def accepted_count(rows):
+    """How many clip rows the behaviour's metrics accept (guide_accepted, or wave_accepted)."""
+    return int(sum(r["guide_accepted"] if "guide_accepted" in r else r["wave_accepted"] for r in rows))
 
 
 def accepted(result):
-    """Takes `result`'s behaviour metrics accept (guide_accepted or wave_accepted), as 'n / N'."""
+    """Takes `result`'s behaviour metrics accept, as 'n / N'."""
+    return f"{accepted_count(result['clips'])} / {len(result['clips'])}"
+
+
+def held_out_summary(result):
+    """One method's scoring on one set, in short: clips, score, DTW score (aligned_score) and accepted takes."""
     rows = result["clips"]
-    return f"{int(sum(r[_accepted_key(r)] for r in rows))} / {len(rows)}"
+    return {"clips": len(rows), "score": result["score"],
+            "aligned_score": float(np.mean([r["aligned_score"] for r in rows])), "accepted": accepted_count(rows)}
 
 
 def _reference(row):
@@ -59,27 +66,50 @@ def raised_starts(results):
     return sorted(parse_name(r["name"])["style"] for r in rows if r["elevation_reference_first"] >= RAISED_START_DEG)
 
 
+def _seeds_sentence(seeds):
+    if len(seeds) == 1:
+        return f"**one seed only (seed {seeds[0]})**: no spread over seeds is given."
+    return (f"**seeds {', '.join(str(s) for s in seeds)}**: the tables but the seeds table are seed {seeds[0]}'s; "
+            f"{len(seeds)} seeds give a rough idea of the spread, not a measure of it.")
+
+
 def summary_rows(results):
     """Score, DTW score, smoothness and accepted takes, per set and method."""
     rows = []
     for key, _, label in SETS:
         for method in ("rlanimate", "nearest_clip"):
             result = results["sets"][key][method]
-            rows.append([label, METHOD_LABELS[method], len(result["clips"]), f"{result['score']:.2f}",
-                         f"{np.mean([r['aligned_score'] for r in result['clips']]):.2f}",
-                         f"{result['smoothness']:.2f}", accepted(result)])
+            summary = held_out_summary(result)
+            rows.append([label, METHOD_LABELS[method], summary["clips"], f"{summary['score']:.2f}",
+                         f"{summary['aligned_score']:.2f}", f"{result['smoothness']:.2f}", accepted(result)])
     return rows
 
 
 def gap_rows(results):
-    """RLAnimate minus retrieval, per held-out set: score, DTW score, accepted takes."""
+    """RLAnimate (the first seed's agent) minus retrieval, per held-out set: score, DTW score, accepted takes."""
     rows = []
     for key, _, label in SETS[:3]:
-        ours, theirs = (results["sets"][key][m] for m in ("rlanimate", "nearest_clip"))
-        dtw = [np.mean([r["aligned_score"] for r in result["clips"]]) for result in (ours, theirs)]
-        count = [sum(r[_accepted_key(r)] for r in result["clips"]) for result in (ours, theirs)]
-        rows.append([label, f"{ours['score'] - theirs['score']:+.2f}", f"{dtw[0] - dtw[1]:+.2f}",
-                     f"{int(count[0] - count[1]):+d}"])
+        ours, theirs = (held_out_summary(results["sets"][key][m]) for m in ("rlanimate", "nearest_clip"))
+        rows.append([label, f"{ours['score'] - theirs['score']:+.2f}",
+                     f"{ours['aligned_score'] - theirs['aligned_score']:+.2f}", f"{ours['accepted'] - theirs['accepted']:+d}"])
+    return rows
+
+
+def seed_rows(results):
+    """Per held-out set: each seed's agent, their mean ± sd when there are several, and retrieval: score, DTW
+    score, accepted takes."""
+    def cells(summary):
+        return [f"{summary['score']:.2f}", f"{summary['aligned_score']:.2f}", f"{summary['accepted']} / {summary['clips']}"]
+
+    rows = []
+    for key, _, label in SETS[:3]:
+        per_seed = results["seed_sets"][key]["rlanimate"]
+        rows += [[label, f"RLAnimate, seed {seed}", *cells(summary)] for seed, summary in per_seed.items()]
+        if len(per_seed) > 1:
+            spread = {k: [s[k] for s in per_seed.values()] for k in ("score", "aligned_score", "accepted")}
+            rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}",
+                         *(f"**{np.mean(v):.2f} ± {np.std(v, ddof=1):.2f}**" for v in spread.values())])
+        rows.append([label, METHOD_LABELS["nearest_clip"], *cells(results["seed_sets"][key]["nearest_clip"])])
     return rows
 
 
@@ -127,8 +157,7 @@ def style_rows(results):
         for ours, theirs in pairs:
             rows.append([label.split(",")[0], parse_name(ours["name"])["style"],
                          *(f"{ours[k]:.1f} / {theirs[k]:.1f}" for k in ("score", "aligned_score")),
-                         f"{'yes' if ours[_accepted_key(ours)] else 'no'} / "
-                         f"{'yes' if theirs[_accepted_key(theirs)] else 'no'}"])
+                         " / ".join("yes" if accepted_count([row]) else "no" for row in (ours, theirs))])
     return rows
 
 
@@ -157,13 +186,13 @@ def gestures_markdown(results, wave_only=None):
         "as in realmocap.md. **Nothing trained here ships** (the licence is non-commercial): only these figures "
         f"and the plot are in the repository. Regenerate: `{results['command']}`.",
         "",
-        f"**One seed only (seed {results['seed']}), preset `{results['preset']}`, {results['epochs']} epochs**: "
-        "no spread over seeds is given. The held-out guide and bye sets have 4 takes each, so one take is "
-        "25 points of acceptance; read them as indications, not measurements.",
+        f"Preset `{results['preset']}`, {results['epochs']} epochs, {_seeds_sentence(results['seeds'])} The "
+        "held-out guide and bye sets have 4 takes each, so one take is 25 points of acceptance; read them as "
+        "indications, not measurements.",
         "",
         "## What was trained",
         "",
-        "One agent, three behaviours (core/behaviours.py kinds):",
+        "One agent per seed, three behaviours (core/behaviours.py kinds):",
         "- `WAVE` (intensity): the one-arm waves of dataset 2, split as realmocap.md's wave experiment "
         "(takes 001-008 and 021-036 train, takes 009-010 test; takes 011-020 never read).",
         "- `GUIDE` (target): \"this way\", the right arm held out to direct. It is conditioned on a direction, as "
@@ -179,7 +208,8 @@ def gestures_markdown(results, wave_only=None):
         f"14 styles for both behaviours ({styles}), drawn with numpy's default_rng(27) before training "
         "(trainer/motion/realmocap_takes.py, gesture_test_styles); the other 10 train "
         f"({', '.join(results['train_styles'])}). Training clips: {counts['wave']} waves, {counts['guide']} guides, "
-        f"{counts['bye']} byes; {results['episodes']} episodes, {results['train_seconds']:.0f} s of training "
+        f"{counts['bye']} byes; {results['episodes']} episodes; training took "
+        f"{', '.join(f'{t:.0f} s (seed {s})' for s, t in results['train_seconds_per_seed'].items())} "
         "(1 torch thread, under load). Note that 2 of the 4 held-out goodbye waves (active 0.99, childish 0.94) "
         "lie above the training byes' labels (the highest: masculinity 0.75): both methods extrapolate there.",
         "",
@@ -202,9 +232,15 @@ def gestures_markdown(results, wave_only=None):
         *markdown_table(["set", "method", "takes", "score", "DTW score", "smoothness", "accepted"],
                         summary_rows(results)),
         "",
-        "RLAnimate minus retrieval on the held-out sets (negative: retrieval is better):",
+        "RLAnimate (the first seed's agent) minus retrieval on the held-out sets (negative: retrieval is better):",
         "",
         *markdown_table(["set", "score", "DTW score", "accepted takes"], gap_rows(results)),
+        "",
+        "### Seeds",
+        "",
+        "Each seed's agent on the held-out sets (the tables above and below are the first seed's).",
+        "",
+        *markdown_table(["set", "method", "score", "DTW score", "accepted"], seed_rows(results)),
         "",
         "## Guide metrics",
         "",

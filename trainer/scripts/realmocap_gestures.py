@@ -1,10 +1,10 @@
 """Train one agent on the real waves, guide and goodbye takes and compare it with retrieval:
 docs/results/realmocap_guide_bye.json and .md, docs/results/realmocap_guide_bye_paths.png.
 
-    nice -n 15 python -m trainer.scripts.realmocap_gestures [--epochs 50] [--seed 0]
+    nice -n 15 python -m trainer.scripts.realmocap_gestures [--epochs 50] [--seeds 0 1]
 
-An experiment on CC BY-NC capture: the agent stays in runs/realmocap/gestures/ (reused when finished) and
-never ships.
+An experiment on CC BY-NC capture: the agents stay in runs/realmocap/gestures/ and runs/realmocap_seed<N>/gestures/
+(reused when finished) and never ship.
 """
 import argparse
 import json
@@ -24,7 +24,8 @@ def build_parser():
     parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
     parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs, help="iterations of Algorithm 1 (paper: 50)")
     parser.add_argument("--preset", default=DEFAULTS.preset)
-    parser.add_argument("--seed", type=int, default=DEFAULTS.seed)
+    parser.add_argument("--seeds", type=int, nargs="+", default=list(DEFAULTS.seeds),
+                        help="one agent per seed, trained one after another; the first gives the full tables")
     parser.add_argument("--runs", default=DEFAULTS.runs)
     parser.add_argument("--results", default=DEFAULTS.results)
     parser.add_argument("--import-workers", type=int, default=DEFAULTS.import_workers,
@@ -37,7 +38,7 @@ def build_parser():
 def parse_settings(argv=None):
     """GestureSettings from the command line."""
     args = build_parser().parse_args(script_args(argv))
-    return GestureSettings(realmocap=args.realmocap, epochs=args.epochs, preset=args.preset, seed=args.seed,
+    return GestureSettings(realmocap=args.realmocap, epochs=args.epochs, preset=args.preset, seeds=tuple(args.seeds),
                            runs=args.runs, results=args.results, import_workers=args.import_workers,
                            address=args.address)
 

@@ -25,3 +25,16 @@ def test_raised_starts_name_the_goodbye_takes_that_begin_mid_gesture():
     results = {"sets": {"bye_seen": rows(("giant", 157.0), ("sad", 17.0)), "bye_test": rows(("chimpira", 88.0),
                                                                                               ("musical", 23.0))}}
     assert report.raised_starts(results) == ["chimpira", "giant"]
+
+
+def test_seed_rows_give_each_seed_their_spread_and_retrieval():
+    def summary(score, accepted):
+        return {"clips": 4, "score": score, "aligned_score": score + 10.0, "accepted": accepted}
+    sets = {key: {"rlanimate": {"0": summary(10.0, 1), "1": summary(20.0, 3)}, "nearest_clip": summary(30.0, 2)}
+            for key, _, _ in report.SETS[:3]}
+    rows = report.seed_rows({"seed_sets": sets})
+    assert len(rows) == 3 * 4
+    assert rows[2][1:] == ["RLAnimate, mean ± sd of 2", "**15.00 ± 7.07**", "**25.00 ± 7.07**", "**2.00 ± 1.41**"]
+    assert rows[3][1:] == ["Nearest clip", "30.00", "40.00", "2 / 4"]
+    one_seed = {key: {**entry, "rlanimate": {"0": entry["rlanimate"]["0"]}} for key, entry in sets.items()}
+    assert [row[1] for row in report.seed_rows({"seed_sets": one_seed})[:2]] == ["RLAnimate, seed 0", "Nearest clip"]
