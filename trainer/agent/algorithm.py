@@ -8,7 +8,8 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
        objectives only (it self-describes with its portrayal model), so the whole rollout can be
        computed before the environment is asked for the real descriptions d'_t. Each episode
        (o, a, d', m, FK of m) is appended to the buffer;
-    3. run T update steps, each on C random chunks of L frames, with Adam on the description, KL and pose terms (the paper's L1 + L2 + L3).
+    3. run T update steps, each on C random chunks of L frames (C grows with the behaviours beyond
+       two: chunks_per_update), with Adam on the description, KL and pose terms (the paper's L1 + L2 + L3).
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
 that they explore and stay reproducible; evaluation rolls out deterministically. With
 `average_last_epochs` N, the agent that is evaluated and exported (`played_agent`) is the mean of the
@@ -36,6 +37,15 @@ def clips_for_behaviour(clips, behaviour, space):
     [wave clips]] for 'both')."""
     wanted = behaviours.training_set(behaviour, space.names)
     return [[clip for clip in clips if clip.behaviour == name] for name in wanted]
+
+
+def chunks_per_update(chunk_count, behaviour_count):
+    """Chunks per update step for `behaviour_count` behaviours: the config's `chunk_count` for one or
+    two (the paper's), and chunk_count * n / 2 (rounded up) for n > 2. With one random-target set per
+    target behaviour (Trainer.collect), each behaviour then gets as many chunks, and as many pointing
+    holds, as it gets beside one other: the updates are where it learns, and a fixed batch split four
+    ways gave point under half its chunks and its aim went from 0.9 to 3.2 degrees (docs/TRAINING.md)."""
+    return int(math.ceil(chunk_count * max(behaviour_count, 2) / 2))
 
 
 def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm=True):
@@ -95,6 +105,9 @@ class Trainer:
             read = [(clip.attributes, wave_rhythm.clip_rhythm(clip)) for clip in waves]
             swinging = [(exaggeration, read_rhythm) for exaggeration, read_rhythm in read if read_rhythm is not None]
             self.rhythm_model = rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])
+        #: C of the update steps: the config's for one or two behaviours, in proportion beyond
+        #: (chunks_per_update), so each behaviour keeps the chunks it has beside one other.
+        self.chunk_count = chunks_per_update(train_config.chunk_count, len(self.clip_groups))
         self.references = references or ClipReferences(env)
         self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
         self.buffer = EpisodeBuffer()
@@ -117,22 +130,23 @@ class Trainer:
     def collect(self):
         """Steps 1-2: draw a clip per group, roll the agent out, evaluate all frames in one FK batch.
 
-        With `random_targets`, each iteration also points at that many new targets: a direction drawn
-        uniformly within the training clips' range of azimuth and elevation, timed like a training
-        clip of the same arm (its length and hold frames). These episodes have no clip to imitate
+        With `random_targets`, each iteration also makes that many requests of each target behaviour at
+        new targets: a direction drawn uniformly within that behaviour's training clips' range of
+        azimuth and elevation, timed like one of its training clips of the same arm (its length and
+        hold frames). These episodes have no clip to imitate
         ("imitate" 0); only the pointing term, and the dynamics terms L1 and L2, learn from them:
         the objective is the reward, as the paper's RL framing has it."""
         drawn = [self.draw(k) for k in range(len(self.clip_groups))]
         objectives = [clip_objective(self.space, clip, with_rhythm=self.train_config.wave_rhythm) for clip in drawn]
         imitated = [True] * len(drawn)
-        targeted = self._target_clips()
-        if targeted and self.agent.variant != "supervised":
-            for _ in range(self.train_config.random_targets):
-                clip = targeted[int(self.rng.integers(len(targeted)))]
-                drawn.append(clip)
-                objectives.append(self.space.make_objective(clip.behaviour, clip.arm,
-                                                            self._random_direction(clip.arm), len(clip.rotvecs)))
-                imitated.append(False)
+        if self.agent.variant != "supervised":
+            for group in self._target_groups():
+                for _ in range(self.train_config.random_targets):
+                    clip = group[int(self.rng.integers(len(group)))]
+                    drawn.append(clip)
+                    objectives.append(self.space.make_objective(
+                        clip.behaviour, clip.arm, self._random_direction(group, clip.arm), len(clip.rotvecs)))
+                    imitated.append(False)
         self.agent.eval()
         actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
                    for o in objectives]
@@ -154,15 +168,15 @@ class Trainer:
             })
         return drawn
 
-    def _target_clips(self):
-        """The training clips of target behaviours, whose requests can aim anywhere."""
-        return [clip for group in self.clip_groups for clip in group if clip.behaviour_kind == behaviours.TARGET]
+    def _target_groups(self):
+        """The clip groups of target behaviours, whose requests can aim anywhere."""
+        return [group for group in self.clip_groups if group[0].behaviour_kind == behaviours.TARGET]
 
-    def _random_direction(self, arm):
-        """A unit pointing direction for `arm`, uniform in azimuth and elevation over the range of the
-        arm's training clips widened by the config's margin (elevation kept within 80 degrees)."""
-        angles = np.degrees([pointing.azimuth_elevation(arm, clip.attributes) for clip in self._target_clips()
-                             if clip.arm == arm])
+    def _random_direction(self, group, arm):
+        """A unit direction for `arm`, uniform in azimuth and elevation over the range of the arm's
+        clips in `group` (one target behaviour's) widened by the config's margin (elevation kept within
+        80 degrees)."""
+        angles = np.degrees([pointing.azimuth_elevation(arm, clip.attributes) for clip in group if clip.arm == arm])
         margin = self.train_config.random_target_margin_deg
         low = np.maximum(angles.min(axis=0) - margin, (-180.0, -80.0))
         high = np.minimum(angles.max(axis=0) + margin, (180.0, 80.0))
@@ -192,7 +206,7 @@ class Trainer:
         self.agent.train()
         totals = {}
         for _ in range(config.update_steps):
-            batch = self.buffer.sample_chunks(config.chunk_count, config.chunk_length, self.rng,
+            batch = self.buffer.sample_chunks(self.chunk_count, config.chunk_length, self.rng,
                                               config.random_target_weight)
             losses = gradient_step(self.agent, self.optimizer, batch, config, self.bounds)
             for name, value in losses.items():

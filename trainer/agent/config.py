@@ -44,7 +44,7 @@ class TrainConfig:
     epochs_single: int = 50  # iterations of Algorithm 1 for one behaviour (the paper's 50)
     epochs_both: int = 100  # ... and for both behaviours (the paper's 100)
     update_steps: int = 20  # T: model updates per iteration
-    chunk_count: int = 16  # C: chunks per update
+    chunk_count: int = 16  # C: chunks per update for one or two behaviours (n > 2: C * n / 2, algorithm.chunks_per_update)
     chunk_length: int = 32  # L: frames per chunk
     learning_rate: float = 1e-3  # Adam
     learning_rate_final: float = None  # cosine decay to this over the run's epochs (None: constant)
@@ -59,7 +59,7 @@ class TrainConfig:
     wrist_scale: float = 0.0  # squared distance (m^2) of the waving wrist to the clip's (0: off; default preset 1000)
     portrayal_direct_loss: bool = True  # also fit the self-description to the clip's description
     portrayal_scale: float = 1.0  # ... with this scale (MSE, summed over the 42 numbers)
-    random_targets: int = 1  # pointing requests at random targets per iteration (pointing term only)
+    random_targets: int = 1  # requests at random targets per iteration and target behaviour (pointing term only)
     random_target_margin_deg: float = 0.0  # random directions reach this far past the clips' azimuth and elevation
     random_target_weight: float = 1.0  # a random-target episode's chance in the update batch, relative to a clip's
     pointing_scale: float = 100.0  # the finger line against the objective's ray at the hold (squared radians)

@@ -8,10 +8,11 @@ import torch
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint, pointing
-from trainer.agent.algorithm import Trainer, clip_objective, clips_for_behaviour
+from trainer.agent.algorithm import Trainer, chunks_per_update, clip_objective, clips_for_behaviour
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
+from trainer.motion.clip import library_space
 from trainer.motion.fk import ClipReferences, NumpyFKEnvironment
 
 torch.set_num_threads(1)
@@ -115,6 +116,37 @@ def test_collect_stores_real_descriptions_and_clip_motion(env, library):
         assert np.all((episode["action"] >= 0) & (episode["action"] <= 1))
 
 
+def _four_behaviours(library):
+    """The library plus GUIDE (a target behaviour, its clips pointing to the side, away from the points)
+    and RAISE (an intensity behaviour): relabelled point and wave clips."""
+    def relabel(clip, behaviour, kind, attributes):
+        return replace(clip, name=clip.name.replace(clip.behaviour.lower(), behaviour.lower()),
+                       behaviour=behaviour, kind=kind, attributes=attributes)
+    side = {"LEFT": np.array([1.0, 0.0, 0.0]), "RIGHT": np.array([-1.0, 0.0, 0.0])}
+    guides = [relabel(c, "GUIDE", "target", side[c.arm]) for c in library.train if c.behaviour == "POINT"]
+    raises = [relabel(c, "RAISE", "intensity", c.attributes) for c in library.train if c.behaviour == "WAVE"]
+    return library.train + guides + raises
+
+
+def test_every_behaviour_keeps_the_chunks_and_random_targets_it_has_beside_one_other(env, library):
+    assert [chunks_per_update(32, n) for n in (1, 2, 3, 4)] == [32, 32, 48, 64]
+    clips = _four_behaviours(library)
+    agent_config, train_config = load_preset("debug")
+    torch.manual_seed(0)
+    agent = RLAnimateAgent(agent_config, "rlanimate", library_space(clips))
+    trainer = Trainer(agent, env, clips, replace(train_config, random_targets=3), "all", seed=1)
+    assert trainer.chunk_count == 2 * train_config.chunk_count
+    drawn = trainer.collect()
+    assert [c.behaviour for c in drawn] == ["POINT", "WAVE", "GUIDE", "RAISE"] + ["POINT"] * 3 + ["GUIDE"] * 3
+    for clip, episode in zip(drawn[4:], trainer.buffer.episodes[4:]):  # each within its own behaviour's range
+        direction = episode["objective"][0, spaces.OBJECTIVE_ATTRIBUTES]
+        side = 1.0 if clip.arm == "LEFT" else -1.0
+        if clip.behaviour == "GUIDE":  # the guides' range: straight to the arm's side, widened by the margin
+            assert side * direction[0] > 0.7
+        else:  # the points': ahead
+            assert direction[1] < -0.3
+
+
 def test_debug_preset_trains_end_to_end_and_its_loss_falls(env, library):
     agent_config, train_config = load_preset("debug")
     torch.manual_seed(0)
@@ -152,7 +184,8 @@ def test_random_targets_cover_the_clips_range_widened_by_the_margin(env, library
     trainer = Trainer(RLAnimateAgent(agent_config, "rlanimate"), env, library.train, train_config, "point", seed=2)
     clips = [np.degrees(pointing.azimuth_elevation("LEFT", c.attributes)) for c in trainer.clip_groups[0]
              if c.arm.upper() == "LEFT"]
-    drawn = np.degrees([pointing.azimuth_elevation("LEFT", trainer._random_direction("LEFT")) for _ in range(400)])
+    drawn = np.degrees([pointing.azimuth_elevation("LEFT", trainer._random_direction(trainer.clip_groups[0], "LEFT"))
+                       for _ in range(400)])
     low, high = np.min(clips, axis=0) - margin, np.max(clips, axis=0) + margin
     assert np.all(drawn >= low - 1e-9) and np.all(drawn <= high + 1e-9)
     reach = margin / 2 if margin else -0.1 * (high - low)  # the draws use the margin, or fill the range
