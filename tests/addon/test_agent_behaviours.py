@@ -1,7 +1,7 @@
 """The panel's behaviours are the selected agent's: the Behaviour enum lists them (POINT and WAVE keep their
 ids), a stored choice survives a change of agent, the panel shows Target or Exaggeration by the behaviour's
-kind, and Generate bakes a behaviour the agent declares beyond point and wave (tests/addon/declared_agents.py
-widens the shipped agent to four behaviours with numpy alone, so this runs on Blender 4.2 and 5.0)."""
+kind, and Generate bakes a behaviour the agent declares beyond the shipped agent's (tests/addon/declared_agents.py
+widens the shipped agent by two behaviours with numpy alone, so this runs on Blender 4.2 and 5.0)."""
 import addon_helpers
 import bpy
 import declared_agents
@@ -11,15 +11,15 @@ from test_registration import RecordingLayout, _draw
 
 from rlanimate_addon.blender import gestures, preferences, properties
 
-ADDED = [("BECKON", "target"), ("RAISE_HAND", "intensity")]
+ADDED = [("BECKON", "target"), ("SHRUG", "intensity")]
 
 
 @pytest.fixture
-def four(settings, tmp_path):
-    """Scene.rlanimate with a four-behaviour agent file written (not yet selected); returns its path."""
-    path = tmp_path / "four.npz"
-    declared_agents.widened_agent(path, ADDED)
-    return settings, path
+def widened_settings(settings, tmp_path):
+    """Scene.rlanimate with an agent file of the shipped behaviours and ADDED written (not yet selected);
+    returns its path and its behaviours."""
+    path = tmp_path / "widened.npz"
+    return settings, path, declared_agents.widened_agent(path, ADDED).names
 
 
 def _listed(settings):
@@ -30,12 +30,13 @@ def _shown(settings):
     return {call[2] for call in _draw(settings) if call[0] == "prop"}
 
 
-def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survives_a_change_of_agent(four):
-    settings, path = four
+def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survives_a_change_of_agent(widened_settings):
+    settings, path, widened = widened_settings
+    shipped = declared_agents.shipped_behaviours()
     preferences = addon_helpers.addon_preferences()
-    assert _listed(settings) == ["POINT", "WAVE"] and settings.behaviour == "POINT"
+    assert _listed(settings) == list(shipped) and settings.behaviour == "POINT"
     preferences.agent_path = str(path)
-    assert _listed(settings) == ["POINT", "WAVE", "BECKON", "RAISE_HAND"]
+    assert _listed(settings) == list(widened) and {"BECKON", "SHRUG"} < set(widened)
     settings.behaviour = "BECKON"
     assert settings.behaviour == "BECKON"
     preferences.agent_path = ""  # the bundled agent has no Beckon: the choice is kept, not replaced
@@ -43,8 +44,9 @@ def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survi
     with pytest.raises(TypeError, match='enum "BECKON" not found'):
         settings.behaviour = "BECKON"
     errors = " ".join(c[1].get("text", "") for c in _draw(settings) if c[0] == "label" and c[1].get("icon") == "ERROR")
-    assert "not one of this agent's (Point, Wave): pick one above" in errors
-    with pytest.raises(RuntimeError, match="The selected agent performs Point, Wave, not the behaviour chosen"):
+    assert f"not one of this agent's ({declared_agents.listed_titles(shipped)}): pick one above" in errors
+    with pytest.raises(RuntimeError, match=f"The selected agent performs {declared_agents.listed_titles(shipped)}, "
+                                           "not the behaviour chosen"):
         addon_helpers.generate(addon_helpers.load_sample_rig(), settings)
     preferences.agent_path = str(path)
     assert settings.behaviour == "BECKON", "the same behaviour again with the agent that has it"
@@ -53,33 +55,34 @@ def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survi
     assert settings.behaviour == "WAVE", "Point and Wave keep their values across agents"
 
 
-def test_preferences_name_the_chosen_agents_behaviours(four):
-    settings, path = four
+def test_preferences_name_the_chosen_agents_behaviours(widened_settings):
+    settings, path, widened = widened_settings
 
     def labels():
         layout = RecordingLayout()
         preferences.RLANIMATE_AP_preferences.draw(type("PreferencesStandIn", (), {"layout": layout})(), bpy.context)
         return [call[1].get("text", "") for call in layout.calls if call[0] == "label"]
 
-    assert "Behaviours: Point, Wave" in labels()
+    assert f"Behaviours: {declared_agents.listed_titles(declared_agents.shipped_behaviours())}" in labels()
     addon_helpers.addon_preferences().agent_path = str(path)
-    assert "Behaviours: Point, Wave, Beckon, Raise Hand" in labels()
+    assert f"Behaviours: {declared_agents.listed_titles(widened)}" in labels()
+    assert "Beckon" in declared_agents.listed_titles(widened)
 
 
-def test_the_panel_shows_target_for_a_target_behaviour_and_exaggeration_for_an_intensity_one(four):
-    settings, path = four
+def test_the_panel_shows_target_for_a_target_behaviour_and_exaggeration_for_an_intensity_one(widened_settings):
+    settings, path, _ = widened_settings
     addon_helpers.addon_preferences().agent_path = str(path)
     settings.behaviour = "BECKON"
     shown = _shown(settings)
     assert "target" in shown and "exaggeration" not in shown
     assert "exact_aim" not in shown, "Exact Aim lays the index finger on the target: Point's alone"
-    settings.behaviour = "RAISE_HAND"
+    settings.behaviour = "SHRUG"
     shown = _shown(settings)
     assert "exaggeration" in shown and "target" not in shown
 
 
-def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviours_target(four):
-    settings, path = four
+def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviours_target(widened_settings):
+    settings, path, _ = widened_settings
     addon_helpers.addon_preferences().agent_path = str(path)
     rig = addon_helpers.load_sample_rig()
     with pytest.raises(RuntimeError, match="Beckon needs a target"):
@@ -97,8 +100,8 @@ def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviour
     travel = np.linalg.norm(addon_helpers.bone_heads(rig, [hand], frames)[:, 0] - addon_helpers.bone_heads(
         rig, [hand], frames[:1])[0, 0], axis=1).max()
     assert travel > 0.1, f"the hand moves ({travel:.3f} m)"
-    assert addon_helpers.generate(rig, settings, behaviour="RAISE_HAND", arm="LEFT", exaggeration=0.9,
+    assert addon_helpers.generate(rig, settings, behaviour="SHRUG", arm="LEFT", exaggeration=0.9,
                                   start_frame=200, frame_count=80) == {"FINISHED"}
     raised = gestures.placed_gestures(rig)[0]
-    assert (raised.record["behaviour"], raised.record["kind"]) == ("RAISE_HAND", "intensity")
+    assert (raised.record["behaviour"], raised.record["kind"]) == ("SHRUG", "intensity")
     assert gestures.last_targeted(rig).action == beckon.action, "Follow Target follows the target behaviour"
