@@ -125,11 +125,12 @@ def test_metadata_accessors(tmp_path):
 def test_shipped_default_agent_plays(tmp_path):
     from pathlib import Path
     runtime = load_agent(Path(__file__).resolve().parents[2] / "rlanimate_addon" / "agents" / "default.npz")
-    assert runtime.metadata["format_version"] == 3 and runtime.space == spaces.PAPER_SPACE  # declares none
-    assert runtime.behaviours == ("POINT", "WAVE")
-    actions = runtime.rollout(spaces.PAPER_SPACE.make_objective("WAVE", "LEFT", 0.5, 40))
-    assert actions.shape == (40, spaces.ACTION_SIZE)
-    assert np.all(np.isfinite(actions)) and np.all((actions >= 0.0) & (actions <= 1.0))
+    assert runtime.behaviours[:2] == ("POINT", "WAVE"), "point and wave, as Table 2 has them, then any others"
+    for name in runtime.behaviours:
+        attributes = [0.0, -1.0, 0.0] if runtime.space.kind(name) == "target" else 0.5
+        actions = runtime.rollout(runtime.space.make_objective(name, "LEFT", attributes, 40))
+        assert actions.shape == (40, spaces.ACTION_SIZE)
+        assert np.all(np.isfinite(actions)) and np.all((actions >= 0.0) & (actions <= 1.0))
     assert isinstance(runtime, GestureAgent)
 
 
