@@ -81,10 +81,10 @@ def _keys(agent):
     """The output of an agent: the quaternions Generate Gesture would key for a 40-frame gesture of each
     behaviour it was trained for, concatenated over bones (40, B, 4)."""
     targets = np.tile([-1.2, -2.5, 1.7], (_FRAMES, 1))
-    requests = {"POINT": gesture.GestureRequest("POINT", "RIGHT", _FRAMES, targets=targets),
-                "WAVE": gesture.GestureRequest("WAVE", "RIGHT", _FRAMES, exaggeration=0.7)}
-    return np.concatenate([gesture.gesture_rotations(agent, requests[b], gesture.canonical_rig())[1]
-                           for b in agent.behaviours], axis=1)
+    requests = [gesture.GestureRequest(b, "RIGHT", _FRAMES, targets=targets) if agent.space.kind(b) == "target"
+                else gesture.GestureRequest(b, "RIGHT", _FRAMES, exaggeration=0.7) for b in agent.behaviours]
+    return np.concatenate([gesture.gesture_rotations(agent, request, gesture.canonical_rig())[1]
+                           for request in requests], axis=1)
 
 
 def outcome(path, reference):

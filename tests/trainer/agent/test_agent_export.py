@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import torch
 
-from rlanimate_addon.core import agent_file, skeleton, spaces
+from rlanimate_addon.core import agent_file, runtime, skeleton, spaces
 from rlanimate_addon.core.agent_file import load_agent_file
 from trainer.agent.agent_export import export_agent
 from trainer.agent.config import AgentConfig, load_preset
@@ -90,7 +90,9 @@ def test_the_shipped_agent_is_what_the_readme_run_exports_and_names_no_machine_p
     bit for bit, the metadata equal but for the git commit and the date of the run."""
     weights, shipped = load_agent_file(INSTALLED_AGENT)
     assert "/" + str(REPO_ROOT).split("/")[1] not in json.dumps(shipped), "the shipped metadata names no machine path"
-    agent = RLAnimateAgent(AgentConfig.from_dict(shipped["agent_config"]), shipped["variant"])
+    space = runtime.load_agent(INSTALLED_AGENT).space
+    assert space.names == ("POINT", "WAVE", "GUIDE", "RAISE_HAND"), "every behaviour of the sample library"
+    agent = RLAnimateAgent(AgentConfig.from_dict(shipped["agent_config"]), shipped["variant"], space)
     agent.load_state_dict({name: torch.from_numpy(array) for name, array in weights.items()})
     training = {key: shipped["training"][key] for key in ("behaviour", "variant", "preset", "seed", "epochs",
                                                           "episodes", "train_seconds")}
@@ -102,13 +104,7 @@ def test_the_shipped_agent_is_what_the_readme_run_exports_and_names_no_machine_p
         "evaluation": shipped["evaluation"]})
     for metadata in (written, shipped):
         metadata["training"] = {k: v for k, v in metadata["training"].items() if k not in ("git_commit", "date")}
-    # The shipped file is format 3, which declares no behaviours: it holds point and wave, as exported now.
-    assert (shipped["format_version"], written["format_version"]) == (3, agent_file.FORMAT_VERSION)
-    assert written.pop("behaviours") == [{"name": "POINT", "kind": "target"}, {"name": "WAVE", "kind": "intensity"}]
-    assert shipped["spaces"].pop("behaviour_type") == {"POINT": 1.0, "WAVE": 2.0}
-    assert written["spaces"].pop("behaviour_labels") == {"POINT": [1.0], "WAVE": [2.0]}  # the same type codes
-    assert shipped["spaces"].pop("behaviours") == ["POINT", "WAVE"]  # now the file's own `behaviours`
-    written["format_version"] = shipped["format_version"]
+    assert shipped["format_version"] == agent_file.FORMAT_VERSION and shipped["training"]["behaviour"] == "all"
     assert written == shipped
     with np.load(path) as new, np.load(INSTALLED_AGENT) as old:
         assert new.files == old.files
