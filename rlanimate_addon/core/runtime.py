@@ -40,47 +40,10 @@ def _mlp_arrays(weights, name, layers):
             for k in range(layers + 1)]
 
 
-def _mlp_tail(layers, first_preactivation):
-    """An MLP from its first layer's pre-activation on: tanh, then the remaining Linear layers."""
-    x = first_preactivation
-    for weight, bias in layers[1:]:
-        x = np.tanh(x) @ weight + bias
-    return x
-
-
-def _gru_arrays(weights, name, suffix=""):
-    """(W_ih (in, 3H), W_hh (H, 3H), b_ih, b_hh) of a torch GRU / GRUCell; gates r, z, n."""
-    return (weights[f"{name}.weight_ih{suffix}"].T.copy(), weights[f"{name}.weight_hh{suffix}"].T.copy(),
-            weights[f"{name}.bias_ih{suffix}"], weights[f"{name}.bias_hh{suffix}"])
-
-
-def _gru_step(input_gates, hidden_gates, h, gates, candidate):
-    """torch's GRU update h' = (1 - z) n + z h, written into h (H,), from W_ih x + b_ih and W_hh h + b_hh (3H,)
-    each; gates (2H,) and candidate (H,) are scratch. In place, in the order of torch's formula: the
-    per-frame loops are bound by numpy's cost per call, not by arithmetic."""
-    H = len(h)
-    np.add(input_gates[:2 * H], hidden_gates[:2 * H], out=gates)
-    _sigmoid_(gates)
-    reset, update = gates[:H], gates[H:]
-    np.multiply(reset, hidden_gates[2 * H:], out=candidate)
-    candidate += input_gates[2 * H:]
-    np.tanh(candidate, out=candidate)
-    np.subtract(h, candidate, out=h)
-    h *= update
-    h += candidate
-
-
-def _sigmoid_(x):
-    """x -> its logistic sigmoid 0.5 (1 + tanh(x / 2)), in place."""
-    x *= 0.5
-    np.tanh(x, out=x)
-    x += 1.0
-    x *= 0.5
-
-
-def _mlp_tail_(layers, x, spare, out):
-    """`_mlp_tail` in preallocated arrays: x (the first pre-activation) and spare, of the hidden width, are
-    overwritten; the result goes into out, which is returned."""
+def _mlp_tail(layers, x, spare, out):
+    """An MLP from its first layer's pre-activation x on (tanh, then the remaining Linear layers), in
+    preallocated arrays, for one frame (width,) or all (N, width) at once: x and spare, of the hidden
+    width, are overwritten; the result goes into out, which is returned."""
     if len(layers) == 1:
         np.copyto(out, x)
         return out
@@ -95,19 +58,54 @@ def _mlp_tail_(layers, x, spare, out):
     return out
 
 
+def _gru_arrays(weights, name, suffix=""):
+    """(W_ih (in, 3H), W_hh (H, 3H), b_ih, b_hh) of a torch GRU / GRUCell, gates r, z, n, with the r and z
+    columns halved: sigmoid(x) = 0.5 (1 + tanh(x / 2)), and halving is exact in floating point, so
+    `_gru_stepper` takes tanh of the gates as they come."""
+    arrays = (weights[f"{name}.weight_ih{suffix}"].T.copy(), weights[f"{name}.weight_hh{suffix}"].T.copy(),
+              weights[f"{name}.bias_ih{suffix}"].copy(), weights[f"{name}.bias_hh{suffix}"].copy())
+    for array in arrays:
+        array[..., :2 * array.shape[-1] // 3] *= 0.5
+    return arrays
+
+
+def _gru_stepper(h, hidden_gates):
+    """step(input_rz (2H,), input_n (H,)): torch's GRU update h' = (1 - z) n + z h in place on h (H,), from
+    W_ih x + b_ih (its r, z and its n parts) and W_hh h + b_hh, written into hidden_gates (3H,) before each
+    step (weights from `_gru_arrays`). Scratch arrays and views are made once: the per-frame loops are
+    bound by numpy's cost per call, not by arithmetic."""
+    H = len(h)
+    gates, candidate = np.empty(2 * H), np.empty(H)
+    reset, update = gates[:H], gates[H:]
+    hidden_rz, hidden_n = hidden_gates[:2 * H], hidden_gates[2 * H:]
+
+    def step(input_rz, input_n):
+        np.add(input_rz, hidden_rz, out=gates)  # halved pre-activations
+        np.tanh(gates, out=gates)
+        np.add(gates, 1.0, out=gates)
+        np.multiply(gates, 0.5, out=gates)  # r, z
+        np.multiply(reset, hidden_n, out=candidate)
+        np.add(candidate, input_n, out=candidate)
+        np.tanh(candidate, out=candidate)  # n
+        np.subtract(h, candidate, out=h)
+        np.multiply(h, update, out=h)
+        np.add(h, candidate, out=h)
+    return step
+
+
 def _gru_sequence(inputs, gru):
     """(N, in) -> (N, H) states of a GRU from h_0 = 0."""
     input_weight, hidden_weight, input_bias, hidden_bias = gru
     input_gates = inputs @ input_weight + input_bias  # (N, 3H)
     H = hidden_weight.shape[0]
     h, hidden_gates = np.zeros(H), np.empty(3 * H)
-    gates, candidate = np.empty(2 * H), np.empty(H)
+    step = _gru_stepper(h, hidden_gates)
     states = np.empty((len(inputs), H))
-    for t in range(len(inputs)):
+    for input_rz, input_n, state in zip(input_gates[:, :2 * H], input_gates[:, 2 * H:], states):
         np.dot(h, hidden_weight, out=hidden_gates)
         hidden_gates += hidden_bias
-        _gru_step(input_gates[t], hidden_gates, h, gates, candidate)
-        states[t] = h
+        step(input_rz, input_n)
+        state[...] = h
     return states
 
 
@@ -198,47 +196,56 @@ class GestureAgent:
         count = len(objectives)
         task = _gru_sequence(objectives, self._task_rnn) if self._uses_task_state else objectives  # (N, K)
         cell_inputs = task @ self._cell_task + self._cell_bias  # (N, 3E)
-        belief_inputs = np.broadcast_to(self._belief[0][1], (count, len(self._belief[0][1])))  # (N, hidden)
+        hidden = len(self._belief[0][1])
+        belief_inputs = np.broadcast_to(self._belief[0][1], (count, hidden))  # (N, hidden)
         if self._uses_portrayal:
-            described = _mlp_tail(self._portrayal, objectives @ self._portrayal[0][0] + self._portrayal[0][1])
+            portrayal = objectives @ self._portrayal[0][0] + self._portrayal[0][1]  # (N, hidden)
+            described = _mlp_tail(self._portrayal, portrayal, np.empty_like(portrayal),
+                                  np.empty((count, len(self._portrayal[-1][1]))))  # (N, D)
             belief_inputs = belief_inputs + described @ self._belief[0][0][E:]  # (N, hidden)
-        animation_inputs = np.broadcast_to(self._animation[0][1], (count, len(self._animation[0][1])))
+        animation_inputs = np.broadcast_to(self._animation[0][1], (count, hidden))
         if self._uses_task_state:
             animation_inputs = animation_inputs + task @ self._animation_task  # (N, hidden)
-        gates, belief_end = 3 * E, 3 * E + len(self._belief[0][1])
-        hidden = len(self._belief[0][1])
-        e, e_gates, e_candidate = np.zeros(E), np.empty(2 * E), np.empty(E)
-        input_gates, hidden_gates = np.empty(3 * E), self._cell_hidden_bias.copy()  # W_hh e_0 + b_hh, e_0 = 0
+        gates, belief_end = 3 * E, 3 * E + hidden
+        e, input_gates, hidden_gates = np.zeros(E), np.empty(3 * E), self._cell_hidden_bias.copy()  # W_hh e_0 + b_hh
+        cell_step = _gru_stepper(e, hidden_gates)
+        input_rz, input_n = input_gates[:2 * E], input_gates[2 * E:]
         from_e, from_z = np.empty(self._from_e.shape[1]), np.empty(self._from_z.shape[1])
+        e_gates, e_belief, e_animation = from_e[:gates], from_e[gates:belief_end], from_e[belief_end:]
+        z_gates, z_animation = from_z[:gates], from_z[gates:]
         from_a = np.full(A, agent_file.INITIAL_ACTION) @ self._from_a  # W_a a_0 (3E,)
         recurrent_gates = from_a.copy()  # W_z z_0 + W_a a_0 with z_0 = 0
         belief_x, animation_x, layer = np.empty(hidden), np.empty(hidden), np.empty(hidden)
         belief, out = np.empty(len(self._belief[-1][1])), np.empty(2 * A)
-        spread = np.empty(Z)
+        mean, spread, z = belief[:Z], belief[Z:], np.empty(Z)
+        alpha, beta = out[:A], out[A:]
+        belief_layers, animation_layers = self._belief, self._animation
+        from_e_weights, from_z_weights, from_a_weights = self._from_e, self._from_z, self._from_a
+        hidden_bias, floor, scale, min_std = self._cell_hidden_bias, self._floor, self._concentration_scale, self._min_std
         actions = np.empty((count, A))
-        for t in range(count):
-            np.add(cell_inputs[t], recurrent_gates, out=input_gates)
-            _gru_step(input_gates, hidden_gates, e, e_gates, e_candidate)
-            np.dot(e, self._from_e, out=from_e)
-            np.add(from_e[:gates], self._cell_hidden_bias, out=hidden_gates)
-            np.add(from_e[gates:belief_end], belief_inputs[t], out=belief_x)
-            _mlp_tail_(self._belief, belief_x, layer, belief)
-            z = belief[:Z]
-            if noise is not None:
-                _softplus_(belief[Z:], spread)
-                spread += self._min_std
+        for cell_row, belief_row, animation_row, a in zip(cell_inputs, belief_inputs, animation_inputs, actions):
+            np.add(cell_row, recurrent_gates, out=input_gates)
+            cell_step(input_rz, input_n)
+            np.dot(e, from_e_weights, out=from_e)
+            np.add(e_gates, hidden_bias, out=hidden_gates)
+            np.add(e_belief, belief_row, out=belief_x)
+            _mlp_tail(belief_layers, belief_x, layer, belief)
+            if noise is None:
+                np.dot(mean, from_z_weights, out=from_z)
+            else:
+                _softplus_(spread, spread)
+                spread += min_std
                 spread *= noise
-                z = z + spread
-            np.dot(z, self._from_z, out=from_z)
-            np.add(animation_inputs[t], from_e[belief_end:], out=animation_x)
-            animation_x += from_z[gates:]
-            _mlp_tail_(self._animation, animation_x, layer, out)
+                np.add(mean, spread, out=z)
+                np.dot(z, from_z_weights, out=from_z)
+            np.add(animation_row, e_animation, out=animation_x)
+            animation_x += z_animation
+            _mlp_tail(animation_layers, animation_x, layer, out)
             _softplus_(out, out)
-            out *= self._concentration_scale
-            concentrations = np.add(self._floor, out, out=out)  # (90,): alpha, beta
-            a = actions[t]
-            np.add(concentrations[:A], concentrations[A:], out=a)
-            np.divide(concentrations[:A], a, out=a)
-            np.dot(a, self._from_a, out=from_a)
-            np.add(from_z[:gates], from_a, out=recurrent_gates)
+            out *= scale
+            out += floor  # (90,): alpha, beta
+            np.add(alpha, beta, out=a)
+            np.divide(alpha, a, out=a)
+            np.dot(a, from_a_weights, out=from_a)
+            np.add(z_gates, from_a, out=recurrent_gates)
         return actions

@@ -54,6 +54,17 @@ def test_deterministic_rollout_matches_torch(tmp_path, preset, variant):
         assert expected.std(axis=0).max() > 1e-3  # the actions do change over the gesture
 
 
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_in_float64_the_rollout_is_torchs_to_rounding(tmp_path, variant):
+    """The in-place per-frame loop (joined weights, halved gates, scratch arrays) computes torch's equations:
+    against the torch agent in float64 it differs by rounding only, where float32 torch allows 1e-5."""
+    agent, path = exported_agent(tmp_path, "default", variant)
+    runtime, agent = load_agent(path), agent.double()
+    for objectives in objectives_for_tests():
+        expected = agent.rollout(torch.as_tensor(objectives, dtype=torch.float64)[None])[0].numpy()
+        assert np.abs(runtime.rollout(objectives) - expected).max() < 1e-12
+
+
 def test_rollout_is_a_pure_function_of_the_objectives(tmp_path):
     _, path = exported_agent(tmp_path, "debug", "rlanimate")
     runtime = load_agent(path)
@@ -72,8 +83,8 @@ def test_the_rollout_runs_numpy_blas_on_one_thread_and_restores_the_setting(tmp_
     assert blas_threads(), "numpy should load a BLAS library threadpoolctl can see"
     runtime = load_agent(exported_agent(tmp_path, "debug", "rlanimate")[1])
     seen = []
-    gru_step = runtime_module._gru_step
-    monkeypatch.setattr(runtime_module, "_gru_step", lambda *args: seen.append(blas_threads()) or gru_step(*args))
+    mlp_tail = runtime_module._mlp_tail
+    monkeypatch.setattr(runtime_module, "_mlp_tail", lambda *args: seen.append(blas_threads()) or mlp_tail(*args))
     with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
         runtime.rollout(objectives_for_tests()[0])
         assert blas_threads() == {2}, "the user's BLAS setting must be restored"
