@@ -24,12 +24,24 @@ PHASE_RAMP = (0.01, 0.5)
 MIN_RAMP_SHARE = 0.2
 
 
+def _finger_line_ends(arm):
+    prefix = skeleton.ARM_PREFIX[arm]
+    return prefix + "Arm", prefix + "HandIndex1", prefix + "HandIndex4"
+
+
+def finger_line_joints(arm: str) -> list[int]:
+    """Indices of the action joints (skeleton.ACTION_JOINTS) that `finger_lines` reads: the arm's chain."""
+    chain = {skeleton.BONE_NAMES[i] for i in kinematics.ancestors(_finger_line_ends(arm))}
+    return [k for k, joint in enumerate(skeleton.ACTION_JOINTS) if joint in chain]
+
+
 def finger_lines(rotvecs: ArrayLike, arm: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Posed shoulder S, index base b and unit finger direction f, each (N, 3), and the Arm bone's
-    armature-space pose rotation W (N, 3, 3), for canonical action-joint rotations (N, 15, 3)."""
+    armature-space pose rotation W (N, 3, 3), for canonical action-joint rotations (N, 15, 3), of which
+    only the `finger_line_joints` are read."""
     prefix = skeleton.ARM_PREFIX[arm]
     pose = kinematics.pose_matrices({j: rotvecs[:, i] for i, j in enumerate(skeleton.ACTION_JOINTS)},
-                                    only=(prefix + "Arm", prefix + "HandIndex1", prefix + "HandIndex4"))
+                                    only=_finger_line_ends(arm))
     heads = kinematics.head_positions(pose)  # (N, B, 3), NaN off the arm's chain
     arm_index = kinematics.bone_index(prefix + "Arm")
     base = heads[:, kinematics.bone_index(prefix + "HandIndex1")]

@@ -475,18 +475,16 @@ def look_at(rig, basis, changed, eye_bones, to_character, targets, weights):
     pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed,
                                    only=eye_bones)
     forward = to_character.T @ np.array([0.0, -1.0, 0.0])  # armature space
-    out = []
-    for bone in eye_bones:
-        i = rig.skeleton.index[bone]
-        world = _rotation_part(pose[:, i])  # (N, 3, 3)
-        looking = world @ (rig.skeleton.rest_frame(bone).T @ forward)  # (N, 3)
-        wanted = targets - pose[:, i, :3, 3]
-        turn = aim.rotation_between(looking / np.linalg.norm(looking, axis=1, keepdims=True),
-                                    wanted / np.linalg.norm(wanted, axis=1, keepdims=True))
-        turn = rotvec_to_matrix(matrix_to_rotvec(turn) * np.asarray(weights)[:, None])
-        local = _rotation_part(basis[:, i]) @ np.swapaxes(world, -1, -2) @ turn @ world
-        out.append(matrix_to_quat(local))
-    return np.stack(out, axis=1)
+    rows = [rig.skeleton.index[bone] for bone in eye_bones]
+    count, eyes = len(basis), len(rows)
+    world = _rotation_part(pose[:, rows])  # (N, E, 3, 3)
+    resting = np.stack([rig.skeleton.rest_frame(bone).T @ forward for bone in eye_bones])  # (E, 3)
+    looking = (world @ resting[:, :, None])[..., 0].reshape(-1, 3)  # (N E, 3)
+    wanted = (targets[:, None] - pose[:, rows][..., :3, 3]).reshape(-1, 3)
+    turn = aim.rotation_between(looking / np.linalg.norm(looking, axis=1, keepdims=True),
+                                wanted / np.linalg.norm(wanted, axis=1, keepdims=True)).reshape(count, eyes, 3, 3)
+    turn = rotvec_to_matrix(matrix_to_rotvec(turn) * np.asarray(weights)[:, None, None])
+    return matrix_to_quat(_rotation_part(basis[:, rows]) @ np.swapaxes(world, -1, -2) @ turn @ world)
 
 
 def hips_relative_targets(rig, targets, count):
@@ -507,10 +505,13 @@ def hips_relative_targets(rig, targets, count):
 def played_finger_base(canonical, arm):
     """(N, 3) index-base path of canonical rotations (N, 15, 3) blended from their first frame as the keys
     blend from the pose underneath (`blend_weights`): it comes back to its start even where the agent's
-    own hand does not (a target behind the character), so the aim's pointing phase stays whole."""
-    quats = rotvec_to_quat(canonical)  # (N, 15, 4)
-    blended = blend_from_pose(quats[0], quats, blend_weights(len(canonical)))
-    return aim.finger_lines(quat_to_rotvec(blended), arm)[1]
+    own hand does not (a target behind the character), so the aim's pointing phase stays whole. Only the
+    joints the finger line hangs from are blended."""
+    chain = aim.finger_line_joints(arm)
+    quats = rotvec_to_quat(canonical[:, chain])  # (N, C, 4)
+    played = np.zeros_like(canonical)
+    played[:, chain] = quat_to_rotvec(blend_from_pose(quats[0], quats, blend_weights(len(canonical))))
+    return aim.finger_lines(played, arm)[1]
 
 
 def gesture_rotations(agent, request, rig):

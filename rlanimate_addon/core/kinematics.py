@@ -31,7 +31,7 @@ def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] 
     a few bones) and every other bone's matrix is NaN.
     """
     batch = np.shape(next(iter(local_rotvecs.values())))[:-1] if local_rotvecs else ()
-    evaluated = range(len(_PARENT)) if only is None else _with_ancestors(only)
+    evaluated = range(len(_PARENT)) if only is None else ancestors(only)
     posed = [name for name in local_rotvecs if _INDEX[name] in evaluated]
     basis = np.broadcast_to(np.eye(4), batch + (len(posed), 4, 4)).copy()  # the posed bones' only
     if posed:  # converted at once: each rotation as it would be alone
@@ -46,7 +46,7 @@ def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] 
     return pose
 
 
-def _with_ancestors(names):
+def ancestors(names: Collection[str]) -> list[int]:
     """Sorted indices of the named bones and all their ancestors (parents come before children)."""
     indices = set()
     for name in names:
