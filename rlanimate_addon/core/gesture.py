@@ -539,11 +539,12 @@ def gesture_rotations(agent, request, rig):
     targeted = agent.kind(request.behaviour) == behaviours.TARGET
     phase_base = played_finger_base(canonical, request.arm) if targeted else None
     names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
-    if request.behaviour == behaviours.POINT:
-        hand_names, hand = pointing_hand_rotations(request.arm, request.frame_count)
+    joints = len(names)
+    if request.behaviour == behaviours.POINT:  # one hand shape, held on every frame
+        hand_names, hand = pointing_hand_rotations(request.arm, 1)
         present = [i for i, name in enumerate(hand_names) if name in rig.roles]
         names += [hand_names[i] for i in present]
-        canonical = np.concatenate([canonical, hand[:, present]], axis=1)
+        hand = hand[:, present]  # (1, H, 3)
     bones = [rig.roles[n] for n in names]
     columns = [rig.skeleton.index[b] for b in bones]  # the eyes, keyed for Point, come after these
     to_character = character_frame(rest_heads)
@@ -561,8 +562,11 @@ def gesture_rotations(agent, request, rig):
                             parent_conversions)  # (D, 4)
         at_rest = np.linalg.norm(under[..., 1:], axis=-1) < AT_REST
         start = np.where(at_rest[..., None], standing, under)
-    keyed = blend_from_pose(start, retarget(canonical, conversions, parent_conversions),
-                            blend_weights(request.frame_count))
+    played = retarget(canonical, conversions[:joints], parent_conversions[:joints])  # (N, J, 4)
+    if len(names) > joints:  # the hand shape retargeted once
+        held = retarget(hand, conversions[joints:], parent_conversions[joints:])  # (1, H, 4)
+        played = np.concatenate([played, np.broadcast_to(held, (len(played),) + held.shape[1:])], axis=1)
+    keyed = blend_from_pose(start, played, blend_weights(request.frame_count))
     if targeted:  # the eyes look at the target; Point's finger is aimed exactly on the rig
         phase = aim.pointing_phase(phase_base)
         targets = np.broadcast_to(request.targets, (request.frame_count, 3))
