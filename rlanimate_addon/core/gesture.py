@@ -247,6 +247,9 @@ _DIRECTION_TO = {f"{side}{bone}": f"{side}{child}" for side in ("Left", "Right")
                  for bone, child in (("Shoulder", "Arm"), ("Arm", "ForeArm"), ("ForeArm", "Hand"),
                                      ("Hand", "HandMiddle1"))
                  + tuple((f"Hand{finger}{k}", f"Hand{finger}{k + 1}") for finger in _FINGERS for k in (1, 2, 3))}
+#: The canonical skeleton's rest direction (3,) of each bone in _DIRECTION_TO.
+_CANONICAL_DIRECTIONS = {name: np.subtract(skeleton.BONE_BY_NAME[child].head, skeleton.BONE_BY_NAME[name].head)
+                         for name, child in _DIRECTION_TO.items()}
 #: Each finger's last posable bone: without the end bone after it, its direction comes from its tail.
 _FINGER_LAST = {f"{side}Hand{finger}3" for side in ("Left", "Right") for finger in _FINGERS}
 #: A finger's last bone follows its own tail (when the rig has no fourth bone) only within this many
@@ -286,8 +289,7 @@ def rest_swings(roles, rest_heads, rest_tails, to_character):
     directions = {n: _rest_direction(n, rest_heads, rest_tails) for n in names}
     directed = [n for n in names if directions[n] is not None]
     rig = np.array([directions[n] for n in directed]).reshape(-1, 3) @ np.asarray(to_character).T
-    canonical = np.array([np.subtract(skeleton.BONE_BY_NAME[_DIRECTION_TO[n]].head, skeleton.BONE_BY_NAME[n].head)
-                          for n in directed]).reshape(-1, 3)
+    canonical = np.array([_CANONICAL_DIRECTIONS[n] for n in directed]).reshape(-1, 3)
     turns = dict(zip(directed, aim.rotation_between(rig / np.linalg.norm(rig, axis=1, keepdims=True),
                                                      canonical / np.linalg.norm(canonical, axis=1, keepdims=True))))
     swings = {}
