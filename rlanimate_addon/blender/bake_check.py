@@ -16,7 +16,7 @@ error names the bone and what drives it.
 import bpy
 import numpy as np
 
-from ..core import bake_measure, blas_threads
+from ..core import bake_measure
 from ..core.errors import RLAnimateError
 from . import action_adapter, armature_io, constraints
 
@@ -136,14 +136,7 @@ def _rest_matrices(obj, names):
 
 def verify(scene, plan):
     """RLAnimateError when the baked plan does not play: the deformed hand or finger off the plan, or the
-    target of a target behaviour (Point) that moves with the gesture. plan: generate._Plan after its write.
-    On one BLAS thread, as generate._compute: an animated rig's planned pose inverts a 4 x 4 matrix per
-    bone and frame, and numpy's threaded BLAS took 3.5 times the CPU (20 ms a click on a busy machine)."""
-    with blas_threads.single_blas_thread():
-        _verify(scene, plan)
-
-
-def _verify(scene, plan):
+    target of a target behaviour (Point) that moves with the gesture. plan: generate._Plan after its write."""
     obj, rig, arm = plan.obj, plan.rig, plan.settings.arm
     indices = bake_measure.check_frames(len(plan.keyed), bake_measure.planned_wrist(rig, arm, plan.bones, plan.keyed))
     pose = bake_measure.planned_pose(rig, arm, plan.bones, plan.keyed, indices)  # (K, B, 4, 4) at the checked frames
