@@ -13,7 +13,10 @@ and the bake check (`bake_check.verify`, 3 frames played and measured); "other" 
 them (undo and replace records, the frame put back). Writes the section "Generate Gesture, where the
 time goes" of docs/BENCHMARKS.md.
 
-Run: `nice -n 10 python benchmarks/generate_stages.py [--rounds N] [--root DIR] [--no-write]`
+With --functions it prints, instead, the CPU time per click spent in each of the pipeline's main
+functions (FUNCTIONS; inclusive: a function's time holds the functions it calls), and writes nothing.
+
+Run: `nice -n 10 python benchmarks/generate_stages.py [--rounds N] [--root DIR] [--no-write] [--functions]`
 (--root: time another checkout of the repository, e.g. an older commit exported with `git archive`).
 """
 import argparse
@@ -43,8 +46,9 @@ import generate_benchmark as cases  # noqa: E402  (the chosen checkout's benchma
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-from rlanimate_addon.blender import armature_io, bake_check, generate  # noqa: E402
-from rlanimate_addon.core import gesture, runtime  # noqa: E402
+from rlanimate_addon.blender import action_adapter, armature_io, bake_check, generate  # noqa: E402
+from rlanimate_addon.core import aim, bake_measure, channels, gesture, runtime  # noqa: E402
+from rlanimate_addon.core.rig import RigSkeleton  # noqa: E402
 
 sys.path.insert(0, str(HERE))
 import report  # noqa: E402  (this checkout's benchmarks/report.py)
@@ -55,6 +59,13 @@ STAGES = (("checks", generate, "_check"), ("rig read", armature_io, "sample_rig"
           ("rollout", runtime.GestureAgent, "rollout"), ("numpy", gesture, "gesture_rotations"),
           ("compute", generate, "_compute"), ("key writes", generate, "_write"),
           ("bake check", bake_check, "verify"))
+
+#: (module or class, function) timed by --functions, in pipeline order.
+FUNCTIONS = ((runtime, "_gru_sequence"), (runtime.GestureAgent, "rollout"), (gesture, "played_finger_base"),
+             (gesture, "fold_missing"), (gesture, "rest_swings"), (gesture, "retarget"), (gesture, "blend_from_pose"),
+             (gesture, "aim_rig"), (gesture, "look_at"), (RigSkeleton, "pose_after"), (aim, "pointing_phase"),
+             (channels, "rotation_keys"), (action_adapter, "write_keys"), (action_adapter.ActionTarget, "new_fcurve"),
+             (bake_measure, "planned_pose"), (bake_check, "deformed_bones"), (bake_check, "stand_in"))
 
 
 def _timed(spent, label, function):
@@ -68,10 +79,10 @@ def _timed(spent, label, function):
     return wrapper
 
 
-def measure(rounds):
+def measure(rounds, stages=STAGES):
     """{case label: {stage: ms per click}} with the operator and playback, and the paired CPU ratio."""
-    spent = {label: 0.0 for label, _, _ in STAGES}
-    for label, owner, name in STAGES:
+    spent = {label: 0.0 for label, _, _ in stages}
+    for label, owner, name in stages:
         setattr(owner, name, _timed(spent, label, getattr(owner, name)))
     rig, settings = cases.fresh_scene()
     idle = cases.key_idle(rig)
@@ -93,6 +104,9 @@ def measure(rounds):
             cases.time_playback(frames)
             plays.append(time.process_time() - start)
         ms = {key: 1000.0 * value / rounds for key, value in spent.items()}
+        if stages is not STAGES:
+            out[label] = dict(ms, Generate=1000.0 * statistics.mean(clicks))
+            continue
         row = {"checks": ms["checks"], "rig read": ms["rig read"], "rollout": ms["rollout"],
                "numpy rest": ms["numpy"] - ms["rollout"], "keys": ms["compute"] - ms["numpy"] - ms["rig read"],
                "key writes": ms["key writes"], "bake check": ms["bake check"]}
@@ -109,9 +123,17 @@ def main():
     parser.add_argument("--rounds", type=int, default=15)
     parser.add_argument("--root", help="another checkout to time (its add-on and generate_benchmark.py)")
     parser.add_argument("--no-write", action="store_true", help="print the section only")
+    parser.add_argument("--functions", action="store_true", help="print CPU ms per click in FUNCTIONS instead")
     args = parser.parse_args()
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    if args.functions:
+        rows = measure(args.rounds, [(name, owner, name) for owner, name in FUNCTIONS if hasattr(owner, name)])
+        names = list(next(iter(rows.values())))
+        print("| function | " + " | ".join(rows) + " |\n|---|" + "---:|" * len(rows))
+        for name in names:
+            print(f"| {name} | " + " | ".join(f"{row[name]:.2f}" for row in rows.values()) + " |")
+        return
     load = os.getloadavg()[0]
     rows = measure(args.rounds)
     columns = ("checks", "rig read", "rollout", "numpy rest", "keys", "key writes", "bake check", "other",
