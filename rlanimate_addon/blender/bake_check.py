@@ -138,22 +138,21 @@ def verify(scene, plan):
     """RLAnimateError when the baked plan does not play: the deformed hand or finger off the plan, or the
     target of a target behaviour (Point) that moves with the gesture. plan: generate._Plan after its write."""
     obj, rig, arm = plan.obj, plan.rig, plan.settings.arm
-    indices = bake_measure.check_frames(len(plan.keyed), bake_measure.planned_wrist(rig, arm, plan.bones, plan.keyed))
-    pose = bake_measure.planned_pose(rig, arm, plan.bones, plan.keyed, indices)  # (K, B, 4, 4) at the checked frames
-    planned = bake_measure.planned_points(rig, arm, pose)  # (K, 3, 3)
+    pose = bake_measure.planned_pose(rig, arm, plan.bones, plan.keyed)  # (N, B, 4, 4)
+    planned = bake_measure.planned_points(rig, arm, pose)  # (N, 3, 3)
     measured = bake_measure.measured_bones(rig.roles, arm)
     deformed = deformed_bones(obj)
     carriers = [stand_in(obj, bone, deformed) for bone in measured]
     scale = float(np.cbrt(abs(np.linalg.det(np.array(obj.matrix_world.to_3x3())))))
     rest_points, carrier_rests = bake_measure.rest_points(rig, arm), _rest_matrices(obj, carriers)
     start = int(plan.settings.start_frame)
-    for k, index in enumerate(indices):
+    for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0]):
         frame = start + index
         scene.frame_set(frame)
         played = bake_measure.carried(_armature_matrices(obj, carriers)[None], carrier_rests, rest_points)
-        distance, angle = (float(v[0]) for v in bake_measure.misses(planned[k:k + 1], played, scale))
+        distance, angle = (float(v[0]) for v in bake_measure.misses(planned[index:index + 1], played, scale))
         if distance > bake_measure.HAND_TOLERANCE or angle > bake_measure.FINGER_TOLERANCE_DEG:
-            cause = _cause(obj, rig, pose[k], measured, carriers, plan.bones)
+            cause = _cause(obj, rig, pose[index], measured, carriers, plan.bones)
             raise RLAnimateError(
                 f"The bake of {obj.name!r} would not play, so it was undone: at frame {frame} the hand the mesh "
                 f"deforms with ({carriers[0]}) is {100 * distance:.1f} cm from where the gesture puts it and its "

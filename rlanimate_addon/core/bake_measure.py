@@ -35,44 +35,27 @@ def rest_points(rig, arm):
     return np.stack([rig.skeleton.rest_head(bone) for bone in measured_bones(rig.roles, arm)])
 
 
-def planned_pose(rig, arm, bones, keyed, frames=None, only=None):
-    """(K, B, 4, 4) armature-space pose of the rig's role bones as the gesture plans it, at `frames` (indices
-    of the gesture's N frames; all of them when None): the keyed rotations (N, D, 4) on `bones` over the
-    pose underneath. The bones named in `only` (`measured_bones` when None) and their ancestors are
-    updated, the others keep the pose underneath."""
-    frames = np.arange(len(keyed)) if frames is None else np.asarray(frames)
-    only = measured_bones(rig.roles, arm) if only is None else only
-    chain = {i for bone in only for i in rig.skeleton.ancestors(bone)}
+def planned_pose(rig, arm, bones, keyed):
+    """(N, B, 4, 4) armature-space pose of the rig's role bones as the gesture plans it: the keyed
+    rotations (N, D, 4) on `bones` over the pose underneath; the measured bones (`measured_bones`)
+    and their ancestors are updated, the others keep the pose underneath."""
+    count = len(keyed)
+    measured = measured_bones(rig.roles, arm)
+    chain = {i for bone in measured for i in rig.skeleton.ancestors(bone)}
     picked = [k for k, bone in enumerate(bones) if rig.skeleton.index[bone] in chain]  # others move nothing measured
     columns = [rig.skeleton.index[bones[k]] for k in picked]
-    under = _at(rig.under_at(len(keyed)), frames)
+    under = rig.under_at(count)
     basis = under.copy()
     scale = each_frame(lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True),
-                       under)  # (K, D, 1, 3)
-    basis[:, columns, :3, :3] = quat_to_matrix(np.asarray(keyed, dtype=np.float64)[frames][:, picked]) * scale
-    return rig.skeleton.pose_after(_at(rig.under_pose_at(len(keyed)), frames), under, basis, columns, only=only)
-
-
-def _at(values, frames):
-    """Per-frame values (N, ...) at frames (K,); one frame broadcast (a rig standing still: stride 0) stays so."""
-    if values.strides[0] == 0:
-        return np.broadcast_to(values[:1], (len(frames),) + values.shape[1:])
-    return values[frames]
+                       under)  # (N, D, 1, 3)
+    basis[:, columns, :3, :3] = quat_to_matrix(np.asarray(keyed, dtype=np.float64)[:, picked]) * scale
+    return rig.skeleton.pose_after(rig.under_pose_at(count), under, basis, columns, only=measured)
 
 
 def planned_points(rig, arm, pose):
-    """(K, 3, 3) wrist, finger base and tip (armature space) carried by the role bones' pose (K, B, 4, 4)."""
+    """(N, 3, 3) wrist, finger base and tip (armature space) carried by the role bones' pose (N, B, 4, 4)."""
     rows = [rig.skeleton.index[b] for b in measured_bones(rig.roles, arm)]
     return carried(pose[:, rows], rig.skeleton.rest[rows], rest_points(rig, arm))
-
-
-def planned_wrist(rig, arm, bones, keyed):
-    """(N, 3) the wrist's planned path (armature space), as `planned_points` carries it, over the gesture's
-    frames; only the hand's chain is posed."""
-    hand = measured_bones(rig.roles, arm)[0]
-    row = rig.skeleton.index[hand]
-    pose = planned_pose(rig, arm, bones, keyed, only=(hand,))
-    return carried(pose[:, [row]], rig.skeleton.rest[[row]], rest_points(rig, arm)[:1])[:, 0]
 
 
 def carried(poses, rests, points):
