@@ -14,7 +14,8 @@ them (undo and replace records, the frame put back). Writes the section "Generat
 time goes" of docs/BENCHMARKS.md.
 
 With --functions it prints, instead, the CPU time per click spent in each of the pipeline's main
-functions (FUNCTIONS; inclusive: a function's time holds the functions it calls), and writes nothing.
+functions (FUNCTIONS; inclusive: a function's time holds the functions it calls) and in the bake
+check's `scene.frame_set` calls (the first after the key writes, the others), and writes nothing.
 
 Run: `nice -n 10 python benchmarks/generate_stages.py [--rounds N] [--root DIR] [--no-write] [--functions]`
 (--root: time another checkout of the repository, e.g. an older commit exported with `git archive`).
@@ -65,7 +66,8 @@ FUNCTIONS = ((runtime, "_gru_sequence"), (runtime.GestureAgent, "rollout"), (ges
              (gesture, "fold_missing"), (gesture, "rest_swings"), (gesture, "retarget"), (gesture, "blend_from_pose"),
              (gesture, "aim_rig"), (gesture, "look_at"), (RigSkeleton, "pose_after"), (aim, "pointing_phase"),
              (channels, "rotation_keys"), (action_adapter, "write_keys"), (action_adapter.ActionTarget, "new_fcurve"),
-             (bake_measure, "planned_pose"), (bake_check, "deformed_bones"), (bake_check, "stand_in"))
+             (bake_check, "verify"), (bake_measure, "planned_pose"), (bake_check, "deformed_bones"),
+             (bake_check, "stand_in"))
 
 
 def _timed(spent, label, function):
@@ -79,11 +81,37 @@ def _timed(spent, label, function):
     return wrapper
 
 
+class _FrameTimedScene:
+    """The scene the bake check is handed, its `frame_set` calls timed: the first after the key writes, and
+    the others."""
+
+    def __init__(self, scene, spent):
+        self._scene, self._spent, self._label = scene, spent, "first frame_set"
+
+    def frame_set(self, frame):
+        start = time.process_time()
+        self._scene.frame_set(frame)
+        self._spent[self._label] += time.process_time() - start
+        self._label = "other frame_set"
+
+    def __getattr__(self, name):
+        return getattr(self._scene, name)
+
+
+def _time_check_frames(spent):
+    """Time the bake check's frame_set calls into spent."""
+    spent.update({"first frame_set": 0.0, "other frame_set": 0.0})
+    verify = bake_check.verify
+    bake_check.verify = functools.wraps(verify)(lambda scene, plan: verify(_FrameTimedScene(scene, spent), plan))
+
+
 def measure(rounds, stages=STAGES):
     """{case label: {stage: ms per click}} with the operator and playback, and the paired CPU ratio."""
     spent = {label: 0.0 for label, _, _ in stages}
     for label, owner, name in stages:
         setattr(owner, name, _timed(spent, label, getattr(owner, name)))
+    if stages is not STAGES:
+        _time_check_frames(spent)
     rig, settings = cases.fresh_scene()
     idle = cases.key_idle(rig)
     idle.use_fake_user = True
