@@ -13,6 +13,10 @@ proportionally longer). During training the task module reads these from each cl
 (trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves of
 nearby exaggeration: their kernel-weighted mean for `seed=None`, one of them (by weight) at any phase
 for a seed, so seeds vary the phase, rate and number of swings within what the training waves do.
+The mean's phase is the circular mean of all the training waves' phases, or, for a model made with
+`nearby_phase` (TrainConfig.wave_rhythm_nearby_phase), the kernel-weighted circular mean of the nearby
+waves' phases, as its rate, start and stop are: real styles start their swing at their own phase
+(docs/results/realmocap_ablation.md).
 """
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
@@ -60,42 +64,65 @@ class RhythmModel:
     """The training clips' rhythms as an agent file stores them (`to_dict` / `from_dict`).
 
     `examples` (K, 4): each training wave's exaggeration and its PARAMETERS; the phase's circular mean;
-    the envelope ramp in frames; the kernel bandwidth in exaggeration.
+    the envelope ramp in frames; the kernel bandwidth in exaggeration; `phases` (K,): each training
+    wave's phase (None in files exported before they were kept); `nearby_phase`: the mean rhythm takes
+    the nearby waves' phase, not the circular mean of all (it needs `phases`).
     """
 
-    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH):
+    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, nearby_phase=False):
         self.examples = np.asarray(examples, dtype=np.float64)
         self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
+        self.phases = None if phases is None else np.asarray(phases, dtype=np.float64)
+        self.nearby_phase = bool(nearby_phase)
 
     @classmethod
-    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm]) -> "RhythmModel":
+    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm], nearby_phase=False) -> "RhythmModel":
         """From the training clips' exaggerations (K,) and their Rhythms (K)."""
         if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
                                  "side: add such wave clips.")
         examples = [[float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms)]
-        phase = float(np.angle(np.mean(np.exp(1j * np.array([r.phase for r in rhythms])))))
-        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])))
+        phases = np.array([r.phase for r in rhythms])
+        phase = float(np.angle(np.mean(np.exp(1j * phases))))
+        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases,
+                   nearby_phase=nearby_phase)
+
+    def with_settings(self, bandwidth=None, nearby_phase=None) -> "RhythmModel":
+        """The same training waves with another kernel bandwidth and/or phase choice (None: keep this one's)."""
+        return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth if bandwidth is None else bandwidth,
+                           self.phases, self.nearby_phase if nearby_phase is None else nearby_phase)
 
     def to_dict(self) -> dict:
-        return {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
-                "bandwidth": self.bandwidth}
+        values = {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
+                  "bandwidth": self.bandwidth}
+        if self.phases is not None:
+            values.update(phases=self.phases.tolist(), nearby_phase=self.nearby_phase)
+        return values
 
     @classmethod
     def from_dict(cls, values: dict) -> "RhythmModel":
         try:
+            phases = values.get("phases")
             model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
-                        float(values["ramp"]), float(values["bandwidth"]))
+                        float(values["ramp"]), float(values["bandwidth"]),
+                        None if phases is None else np.asarray(phases, dtype=np.float64),
+                        values.get("nearby_phase", False))
+            if not isinstance(values.get("nearby_phase", False), bool):
+                raise TypeError("nearby_phase must be true or false")
         except (KeyError, TypeError, ValueError) as error:
             raise RLAnimateError(f"The agent's wave_rhythm metadata is invalid ({error!r}): re-export the "
                                  f"agent with trainer/agent/agent_export.py.") from error
         shape_ok = model.examples.ndim == 2 and model.examples.shape[0] >= 2 \
             and model.examples.shape[1] == 1 + len(PARAMETERS)
-        numbers = np.append(model.examples.ravel(), [model.phase, model.ramp, model.bandwidth])
-        if not shape_ok or not np.all(np.isfinite(numbers)) or model.ramp <= 0 or model.bandwidth <= 0:
+        phases_ok = model.phases is None or model.phases.shape == model.examples.shape[:1]
+        numbers = np.concatenate([model.examples.ravel(), [model.phase, model.ramp, model.bandwidth],
+                                  [] if model.phases is None else model.phases])
+        if not (shape_ok and phases_ok) or not np.all(np.isfinite(numbers)) or model.ramp <= 0 \
+                or model.bandwidth <= 0 or (model.nearby_phase and model.phases is None):
             raise RLAnimateError(f"The agent's wave_rhythm metadata holds invalid numbers (need at least 2 "
-                                 f"examples of {1 + len(PARAMETERS)} finite numbers and a positive ramp and "
-                                 f"bandwidth): re-export the agent.")
+                                 f"examples of {1 + len(PARAMETERS)} finite numbers, a finite phase for each "
+                                 f"when nearby_phase is on, and a positive ramp and bandwidth): re-export the "
+                                 f"agent.")
         return model
 
     def weights(self, exaggeration: float) -> np.ndarray:
@@ -106,10 +133,13 @@ class RhythmModel:
 
     def draw(self, exaggeration: float, seed: int | None = None) -> Rhythm:
         """The Rhythm for a wave of this exaggeration: for seed None the kernel-weighted mean of the
-        training waves' rhythms, else a seeded draw of one training wave's (by weight) at any phase."""
+        training waves' rhythms (its phase: `nearby_phase`'s choice), else a seeded draw of one training
+        wave's (by weight) at any phase."""
         weights = self.weights(exaggeration)
         if seed is None:
             values, phase = weights @ self.examples[:, 1:], self.phase
+            if self.nearby_phase:
+                phase = float(np.angle(weights @ np.exp(1j * self.phases)))
         else:
             rng = np.random.default_rng(seed)
             values, phase = self.examples[rng.choice(len(weights), p=weights), 1:], float(rng.uniform(-np.pi, np.pi))

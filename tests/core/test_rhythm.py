@@ -65,3 +65,41 @@ def test_the_model_round_trips_through_its_dict_and_refuses_a_broken_one():
         rhythm.RhythmModel.from_dict({**model.to_dict(), "ramp": float("nan")})
     with pytest.raises(RLAnimateError, match="at least 2"):
         rhythm.RhythmModel.fit([0.5], rhythms[:1])
+
+
+def _styles_with_their_own_phase():
+    """Two styles of nearby exaggeration that start swinging at opposite phases, and a third far away."""
+    e, rhythms = [], []
+    for exaggeration, phase in ((0.2, 2.5), (0.4, -2.5), (0.9, 0.0)):
+        for take in range(4):
+            e.append(exaggeration + 0.01 * take)
+            rhythms.append(rhythm.Rhythm(0.05, 0.1, 0.9, phase + 0.05 * (take - 1.5), 9.0))
+    return np.array(e), rhythms
+
+
+def test_nearby_phase_gives_the_mean_rhythm_the_phase_of_the_waves_near_the_request():
+    e, rhythms = _styles_with_their_own_phase()
+    everywhere = rhythm.RhythmModel.fit(e, rhythms)
+    nearby = rhythm.RhythmModel.fit(e, rhythms, nearby_phase=True)
+    assert everywhere.draw(0.215).phase == pytest.approx(everywhere.phase) == everywhere.draw(0.915).phase
+    assert abs(everywhere.phase) == pytest.approx(np.pi, abs=0.01)  # the mean of all twelve: no style's phase
+    assert nearby.draw(0.215).phase == pytest.approx(2.5, abs=0.05)  # the style's own, not the mean of all
+    assert nearby.draw(0.415).phase == pytest.approx(-2.5, abs=0.05)
+    assert nearby.draw(0.915).phase == pytest.approx(0.0, abs=0.05)
+    assert nearby.draw(0.5).frequency == everywhere.draw(0.5).frequency  # only the phase is chosen differently
+    assert nearby.draw(0.215, 4) == everywhere.draw(0.215, 4)  # seeded draws do not change
+    assert everywhere.with_settings(nearby_phase=True).draw(0.215) == nearby.draw(0.215)
+    assert everywhere.with_settings(bandwidth=0.02).weights(0.215).max() > everywhere.weights(0.215).max()
+
+
+def test_nearby_phase_round_trips_and_files_without_phases_keep_the_mean_of_all():
+    e, rhythms = _styles_with_their_own_phase()
+    nearby = rhythm.RhythmModel.fit(e, rhythms, nearby_phase=True)
+    again = rhythm.RhythmModel.from_dict(nearby.to_dict())
+    assert again.nearby_phase and again.draw(0.215) == nearby.draw(0.215)
+    older = {key: value for key, value in nearby.to_dict().items() if key not in ("phases", "nearby_phase")}
+    assert rhythm.RhythmModel.from_dict(older).draw(0.215).phase == pytest.approx(nearby.phase)
+    for broken in ({**older, "nearby_phase": True}, {**nearby.to_dict(), "phases": [0.1, 0.2]},
+                   {**nearby.to_dict(), "nearby_phase": "yes"}):
+        with pytest.raises(RLAnimateError, match="wave_rhythm"):
+            rhythm.RhythmModel.from_dict(broken)
