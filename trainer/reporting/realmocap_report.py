@@ -209,6 +209,8 @@ def realmocap_markdown(results):
              "", f"Training: wave agent {results['wave']['episodes']} episodes, "
              f"{results['wave']['train_seconds']:.0f} s; hold-out agent {results['holdout']['episodes']} episodes, "
              f"{results['holdout']['train_seconds']:.0f} s (1 torch thread).", "",
+             "The wave's rhythm at play time (its phase, the kernel, seeded draws), varied on seed 0's agents "
+             "without retraining: [realmocap_ablation.md](realmocap_ablation.md).", "",
              "## Guide clips as pointing", ""]
     if "skipped" in results["guide"]:
         return "\n".join(lines + [f"Not run: {results['guide']['skipped']}", "",

@@ -1,0 +1,167 @@
+"""What the wave's rhythm at play time does on real capture: one trained agent per experiment, its rhythm
+model's play-time settings varied (`python -m trainer.scripts.realmocap_ablation`).
+
+Every variant plays the same exported agent (runs/realmocap/<experiment>/agent.npz, trained as
+trainer.scripts.realmocap trains it, and reused by it) on each held-out take's own request, and is scored
+against that take as trainer.experiments.realmocap scores it (realmocap.compare):
+    mean rhythm, all waves' phase     seed None as the agent file plays it: the kernel-weighted mean rate,
+                                      start and stop of the nearby training waves, at the circular mean
+                                      phase of all of them (core/rhythm.py)
+    mean rhythm, nearby phase         the same at the kernel-weighted circular mean phase of the nearby
+                                      waves (TrainConfig.wave_rhythm_nearby_phase)
+    ..., kernel sd 0.02               the same with a tighter kernel than BANDWIDTH
+    seed N                            a seeded draw, as the panel plays a Variation Seed N > 0: one nearby
+                                      training wave's rhythm at a random phase, and sampled stochastic states
+Nearest-clip retrieval from the same training clips is the bar. No variant retrains anything.
+"""
+import copy
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+
+from rlanimate_addon.core import behaviours, spaces
+from rlanimate_addon.core.errors import RLAnimateError
+from rlanimate_addon.core.rhythm import RhythmModel
+from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.rig_session import blender_output, new_empty_scene
+from trainer.evaluation import baselines
+from trainer.experiments.realmocap import compare, load_folder, real_run, train_real_runs
+from trainer.motion import wave_rhythm
+from trainer.motion.fk import ClipReferences
+from trainer.motion.realmocap_takes import require_realmocap, style_holdout_split, wave_split
+from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
+from trainer.reporting.plots import wave_hand_paths
+from trainer.reporting.realmocap_report import seed_summary
+
+#: The experiments of trainer.experiments.realmocap this ablation can run: {name: (split, test set's label)}.
+EXPERIMENTS = {"wave": (wave_split, "takes 009-010"), "holdout": (style_holdout_split, "unseen styles")}
+
+
+@dataclass(frozen=True)
+class Variant:
+    """A play-time setting of the agent's rhythm model: `bandwidth` and `nearby_phase` as
+    RhythmModel.with_settings takes them (None: the file's), `seed` as AgentMethod.generate does."""
+    name: str
+    bandwidth: float | None = None
+    nearby_phase: bool | None = None
+    seed: int | None = None
+
+
+VARIANTS = (Variant("mean rhythm, all waves' phase (as trained)", nearby_phase=False),
+            Variant("mean rhythm, nearby phase", nearby_phase=True),
+            Variant("mean rhythm, nearby phase, kernel sd 0.02", bandwidth=0.02, nearby_phase=True),
+            *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase", seed=seed) for seed in (1, 2, 3)))
+#: The styles whose first test take (right arm) the hand-path figure shows, per experiment.
+PATH_STYLES = {"wave": ("feminine", "masculine", "normal", "active"), "holdout": ("elderly", "exhausted")}
+
+
+@dataclass(frozen=True)
+class AblationSettings:
+    """What the ablation runs: which experiments (EXPERIMENTS), the training seed and length of their agents."""
+    experiments: tuple[str, ...] = ("wave", "holdout")
+    seed: int = 0
+    epochs: int = 50
+    preset: str = "default"
+    realmocap: str = str(REALMOCAP_DIR)
+    runs: str = str(REALMOCAP_RUNS)
+    results: str = str(RESULTS_DIR)
+    workers: int | None = None
+
+    def __post_init__(self):
+        unknown = [name for name in self.experiments if name not in EXPERIMENTS]
+        if unknown or not self.experiments:
+            raise RLAnimateError(f"Unknown real-capture experiment(s) {unknown or '(none)'}: choose from "
+                                 f"{', '.join(EXPERIMENTS)}.")
+
+
+class VariantMethod:
+    """An AgentMethod whose agent plays `model` as its rhythm model, with `seed` for every request."""
+
+    def __init__(self, method, model, seed=None):
+        self.method = copy.copy(method)
+        self.method.agent = copy.copy(method.agent)
+        self.method.agent.rhythm_model = model
+        self.seed = seed
+
+    def generate(self, behaviour, arm, attributes, frame_count, seed=None):
+        return self.method.generate(behaviour, arm, attributes, frame_count, self.seed if seed is None else seed)
+
+
+def rhythm_with_phases(model, train_clips):
+    """`model` (the agent's RhythmModel) with each training wave's phase: its own, or, for a file exported
+    before they were kept, read again from `train_clips` (the waves it was fitted on, in their order),
+    which must give the file's examples back."""
+    if model.phases is not None:
+        return model
+    read = [(clip.attributes, wave_rhythm.clip_rhythm(clip)) for clip in train_clips if clip.behaviour == behaviours.WAVE]
+    swinging = [(e, r) for e, r in read if r is not None]
+    refit = RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])
+    if refit.examples.shape != model.examples.shape or not np.allclose(refit.examples, model.examples):
+        raise RLAnimateError("The agent's training waves read differently now than when it was trained: retrain "
+                             "it (delete its run folder under runs/realmocap/).")
+    return RhythmModel(model.examples, model.phase, model.ramp, model.bandwidth, refit.phases, model.nearby_phase)
+
+
+def variant_methods(agent, train_clips, variants=VARIANTS):
+    """{variant name: VariantMethod} of the AgentMethod `agent` for each Variant."""
+    model = rhythm_with_phases(agent.agent.rhythm_model, train_clips)
+    return {v.name: VariantMethod(agent, model.with_settings(v.bandwidth, v.nearby_phase), v.seed) for v in variants}
+
+
+def hand_path_panels(methods, clips, styles, env, references):
+    """plots.wave_hand_paths panels: per style of `styles`, its first right-arm take of `clips`, the real take
+    then each method of `methods` ({label: method})."""
+    panels = []
+    for style in styles:
+        clip = next(c for c in clips if c.style == style and c.arm == "RIGHT")
+        answers = {label: spaces.description_joint_positions(env.evaluate(motion).descriptions)
+                   for label, motion in ((label, method.generate(behaviours.WAVE, clip.arm, clip.attributes,
+                                                                 len(clip.rotvecs)))
+                                         for label, method in methods.items())}
+        panels.append((f"{style} {clip.take} right (e = {clip.exaggeration:.2f})", "RIGHT",
+                       {"real take": spaces.description_joint_positions(references.get(clip)[0]), **answers}))
+    return panels
+
+
+def run_ablation(settings: AblationSettings) -> dict:
+    """Train (or reuse) each experiment's agent and score every variant; the results dict the report writes.
+    Draws docs/results/realmocap_ablation_paths.png."""
+    torch.set_num_threads(1)
+    new_empty_scene()
+    root = require_realmocap(settings.realmocap)
+    with blender_output():
+        waves = load_folder("wave", root, Path(settings.runs) / "import_cache")
+        env = FKEnvironment()
+    references = ClipReferences(env)
+    splits = {name: EXPERIMENTS[name][0](waves) for name in settings.experiments}
+    runs = {name: real_run(name, train, test, settings.seed, settings) for name, (train, test) in splits.items()}
+    reports = train_real_runs(runs.values(), workers=settings.workers)
+    results = {"command": command_line(settings), "seed": settings.seed, "epochs": settings.epochs,
+               "preset": settings.preset, "variants": [v.name for v in VARIANTS], "experiments": {}}
+    panels = []
+    for name, (train, test) in splits.items():
+        started = time.process_time()
+        agent = baselines.AgentMethod(Path(runs[name].settings.output) / "agent.npz")
+        methods = {**variant_methods(agent, train), "nearest_clip": baselines.NearestClip(train)}
+        scored = compare(methods, test, env, references)
+        report = reports[runs[name].settings.output]
+        results["experiments"][name] = {
+            "test_set": EXPERIMENTS[name][1], "train_clips": len(train), "test_clips": len(test),
+            "train_seconds": report["train_seconds"],
+            "summaries": {method: seed_summary(result) for method, result in scored.items()}}
+        shown = {"as trained": methods[VARIANTS[0].name], "nearby phase": methods[VARIANTS[1].name],
+                 "seed 1": methods[VARIANTS[3].name], "nearest clip": methods["nearest_clip"]}
+        panels += hand_path_panels(shown, test, PATH_STYLES[name], env, references)
+        results["experiments"][name]["evaluation_cpu_seconds"] = time.process_time() - started
+    Path(settings.results).mkdir(parents=True, exist_ok=True)
+    wave_hand_paths(panels, Path(settings.results) / "realmocap_ablation_paths.png")
+    return results
+
+
+def command_line(settings):
+    """The command that regenerates these results."""
+    return (f"nice -n 10 python -m trainer.scripts.realmocap_ablation --experiments {' '.join(settings.experiments)} "
+            f"--seed {settings.seed} --epochs {settings.epochs} --preset {settings.preset}")

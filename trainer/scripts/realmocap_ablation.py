@@ -1,0 +1,56 @@
+"""The wave's rhythm at play time on real capture, as an ablation: docs/results/realmocap_ablation.{json,md} and
+docs/results/realmocap_ablation_paths.png.
+
+    nice -n 10 python -m trainer.scripts.realmocap_ablation [--experiments wave holdout] [--seed 0] [--epochs 50]
+
+Trains only the experiments named (each one agent, the seed's; reused when runs/realmocap[_seed<N>]/<name>/
+has it, as trainer.scripts.realmocap reuses it), then plays each with every setting of
+trainer/experiments/realmocap_ablation.py.
+"""
+import argparse
+import json
+from pathlib import Path
+
+from trainer.experiments.realmocap_ablation import EXPERIMENTS, AblationSettings, run_ablation
+from trainer.reporting.realmocap_ablation_report import ablation_markdown
+from trainer.scripts.cli import run_main, script_args
+
+DEFAULTS = AblationSettings()
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.realmocap_ablation",
+                                     description=__doc__.split("\n\n")[0])
+    parser.add_argument("--experiments", nargs="+", choices=list(EXPERIMENTS), default=list(DEFAULTS.experiments),
+                        help="which agents to train and play: wave (tested on takes 009-010), holdout (unseen styles)")
+    parser.add_argument("--seed", type=int, default=DEFAULTS.seed, help="the agents' training seed")
+    parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs)
+    parser.add_argument("--preset", default=DEFAULTS.preset)
+    parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
+    parser.add_argument("--runs", default=DEFAULTS.runs)
+    parser.add_argument("--results", default=DEFAULTS.results)
+    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
+                        help="training runs at a time on a local Ray (default: one per CPU)")
+    return parser
+
+
+def parse_settings(argv=None):
+    """AblationSettings from the command line."""
+    args = build_parser().parse_args(script_args(argv))
+    return AblationSettings(experiments=tuple(dict.fromkeys(args.experiments)), seed=args.seed, epochs=args.epochs,
+                            preset=args.preset, realmocap=args.realmocap, runs=args.runs, results=args.results,
+                            workers=args.workers)
+
+
+def main(argv=None):
+    settings = parse_settings(argv)
+    results = run_ablation(settings)
+    out = Path(settings.results)
+    (out / "realmocap_ablation.json").write_text(json.dumps(results, indent=2) + "\n")
+    (out / "realmocap_ablation.md").write_text(ablation_markdown(results))
+    print(ablation_markdown(results))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(run_main(main))
