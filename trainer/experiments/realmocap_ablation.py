@@ -10,6 +10,7 @@ against that take as trainer.experiments.realmocap scores it (realmocap.compare)
     mean rhythm, nearby phase         the same at the kernel-weighted circular mean phase of the nearby
                                       waves (TrainConfig.wave_rhythm_nearby_phase)
     ..., kernel sd 0.02               the same with a tighter kernel than BANDWIDTH
+    mean rhythm, sampled states N     the as-trained mean rhythm, the stochastic states sampled with seed N
     seed N                            a seeded draw, as the panel plays a Variation Seed N > 0: one nearby
                                       training wave's rhythm at a random phase, and sampled stochastic states
 Nearest-clip retrieval from the same training clips is the bar. No variant retrains anything.
@@ -43,17 +44,24 @@ EXPERIMENTS = {"wave": (wave_split, "takes 009-010"), "holdout": (style_holdout_
 @dataclass(frozen=True)
 class Variant:
     """A play-time setting of the agent's rhythm model: `bandwidth` and `nearby_phase` as
-    RhythmModel.with_settings takes them (None: the file's), `seed` as AgentMethod.generate does."""
+    RhythmModel.with_settings takes them (None: the file's); `rhythm_seed` draws the rhythm
+    (RhythmModel.draw's seed) and `state_seed` samples the stochastic states (GestureAgent.rollout's), the
+    panel's Variation Seed setting both."""
     name: str
     bandwidth: float | None = None
     nearby_phase: bool | None = None
-    seed: int | None = None
+    rhythm_seed: int | None = None
+    state_seed: int | None = None
 
 
+SEEDS = (1, 2, 3)
 VARIANTS = (Variant("mean rhythm, all waves' phase (as trained)", nearby_phase=False),
             Variant("mean rhythm, nearby phase", nearby_phase=True),
             Variant("mean rhythm, nearby phase, kernel sd 0.02", bandwidth=0.02, nearby_phase=True),
-            *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase", seed=seed) for seed in (1, 2, 3)))
+            *(Variant(f"sampled states {seed}: mean rhythm, all waves' phase", nearby_phase=False, state_seed=seed)
+              for seed in SEEDS),
+            *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", rhythm_seed=seed,
+                      state_seed=seed) for seed in SEEDS))
 #: The styles whose first test take (right arm) the hand-path figure shows, per experiment.
 PATH_STYLES = {"wave": ("feminine", "masculine", "normal", "active"), "holdout": ("elderly", "exhausted")}
 
@@ -78,16 +86,21 @@ class AblationSettings:
 
 
 class VariantMethod:
-    """An AgentMethod whose agent plays `model` as its rhythm model, with `seed` for every request."""
+    """The agent of an AgentMethod playing `model` as its rhythm model, the rhythm drawn with `rhythm_seed` and
+    the stochastic states sampled with `state_seed` for every request (AgentMethod.generate with one seed
+    for both)."""
 
-    def __init__(self, method, model, seed=None):
-        self.method = copy.copy(method)
-        self.method.agent = copy.copy(method.agent)
-        self.method.agent.rhythm_model = model
-        self.seed = seed
+    def __init__(self, method, model, rhythm_seed=None, state_seed=None):
+        self.agent = copy.copy(method.agent)
+        self.agent.rhythm_model = model
+        self.rhythm_seed, self.state_seed = rhythm_seed, state_seed
 
-    def generate(self, behaviour, arm, attributes, frame_count, seed=None):
-        return self.method.generate(behaviour, arm, attributes, frame_count, self.seed if seed is None else seed)
+    def generate(self, behaviour, arm, attributes, frame_count):
+        signals = self.agent.wave_rhythm(attributes, frame_count, self.rhythm_seed) \
+            if behaviour == behaviours.WAVE else None
+        objectives = self.agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
+        return spaces.decode_action(self.agent.rollout(objectives, seed=self.state_seed),
+                                    np.asarray(self.agent.action_bounds))
 
 
 def rhythm_with_phases(model, train_clips):
@@ -108,7 +121,8 @@ def rhythm_with_phases(model, train_clips):
 def variant_methods(agent, train_clips, variants=VARIANTS):
     """{variant name: VariantMethod} of the AgentMethod `agent` for each Variant."""
     model = rhythm_with_phases(agent.agent.rhythm_model, train_clips)
-    return {v.name: VariantMethod(agent, model.with_settings(v.bandwidth, v.nearby_phase), v.seed) for v in variants}
+    return {v.name: VariantMethod(agent, model.with_settings(v.bandwidth, v.nearby_phase), v.rhythm_seed,
+                                  v.state_seed) for v in variants}
 
 
 def hand_path_panels(methods, clips, styles, env, references):
@@ -153,7 +167,7 @@ def run_ablation(settings: AblationSettings) -> dict:
             "train_seconds": report["train_seconds"],
             "summaries": {method: seed_summary(result) for method, result in scored.items()}}
         shown = {"as trained": methods[VARIANTS[0].name], "nearby phase": methods[VARIANTS[1].name],
-                 "seed 1": methods[VARIANTS[3].name], "nearest clip": methods["nearest_clip"]}
+                 "seed 1": methods[VARIANTS[-len(SEEDS)].name], "nearest clip": methods["nearest_clip"]}
         panels += hand_path_panels(shown, test, PATH_STYLES[name], env, references)
         results["experiments"][name]["evaluation_cpu_seconds"] = time.process_time() - started
     Path(settings.results).mkdir(parents=True, exist_ok=True)

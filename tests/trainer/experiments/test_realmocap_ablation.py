@@ -41,8 +41,12 @@ def test_an_agent_file_without_phases_gets_its_training_waves_phases_read_again(
 def test_a_variant_plays_its_own_rhythm_model_and_seed_and_leaves_the_agent_alone():
     agent = baselines.AgentMethod(INSTALLED_AGENT)
     model = agent.agent.rhythm_model
-    seeded = realmocap_ablation.VariantMethod(agent, model, seed=3)
+    seeded = realmocap_ablation.VariantMethod(agent, model, rhythm_seed=3, state_seed=3)
     assert np.array_equal(seeded.generate("WAVE", "LEFT", 0.6, 60), agent.generate("WAVE", "LEFT", 0.6, 60, seed=3))
+    mean = realmocap_ablation.VariantMethod(agent, model)
+    assert np.array_equal(mean.generate("WAVE", "LEFT", 0.6, 60), agent.generate("WAVE", "LEFT", 0.6, 60))
+    sampled = realmocap_ablation.VariantMethod(agent, model, state_seed=3).generate("WAVE", "LEFT", 0.6, 60)
+    assert not np.allclose(sampled, mean.generate("WAVE", "LEFT", 0.6, 60))
     shifted = RhythmModel(model.examples, model.phase + np.pi, model.ramp, model.bandwidth)
     turned = realmocap_ablation.VariantMethod(agent, shifted)
     assert agent.agent.rhythm_model is model
