@@ -17,6 +17,7 @@ Nearest-clip retrieval from the same training clips is the bar. No variant retra
 """
 import copy
 import time
+from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -125,6 +126,19 @@ def variant_methods(agent, train_clips, variants=VARIANTS):
                                   v.state_seed) for v in variants}
 
 
+def style_phases(train_clips):
+    """{style: {phase (circular mean, radians), concentration (its resultant length, 0-1), waves}} of the
+    phases at which the training waves that swing start their swing (wave_rhythm.clip_rhythm)."""
+    by_style = defaultdict(list)
+    for clip in train_clips:
+        read = wave_rhythm.clip_rhythm(clip)
+        if read is not None:
+            by_style[clip.style].append(read.phase)
+    means = {style: np.mean(np.exp(1j * np.array(phases))) for style, phases in by_style.items()}
+    return {style: {"phase": float(np.angle(mean)), "concentration": float(abs(mean)), "waves": len(by_style[style])}
+            for style, mean in sorted(means.items())}
+
+
 def hand_path_panels(methods, clips, styles, env, references):
     """plots.wave_hand_paths panels: per style of `styles`, its first right-arm take of `clips`, the real take
     then each method of `methods` ({label: method})."""
@@ -164,7 +178,8 @@ def run_ablation(settings: AblationSettings) -> dict:
         report = reports[runs[name].settings.output]
         results["experiments"][name] = {
             "test_set": EXPERIMENTS[name][1], "train_clips": len(train), "test_clips": len(test),
-            "train_seconds": report["train_seconds"],
+            "train_seconds": report["train_seconds"], "phase_of_all": agent.agent.rhythm_model.phase,
+            "style_phases": style_phases(train),
             "summaries": {method: seed_summary(result) for method, result in scored.items()}}
         shown = {"as trained": methods[VARIANTS[0].name], "nearby phase": methods[VARIANTS[1].name],
                  "seed 1": methods[VARIANTS[-len(SEEDS)].name], "nearest clip": methods["nearest_clip"]}

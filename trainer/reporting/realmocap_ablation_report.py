@@ -70,6 +70,12 @@ def findings(results):
                          f"{np.mean([g['score'] for g in group]):.1f} / {np.mean([g['aligned_score'] for g in group]):.1f}")
         lines.append(f"- **{entry['test_set']}** (score / DTW score): as trained {pair(base)}; " + "; ".join(parts)
                      + f"; retrieval {pair(summaries[RETRIEVAL])}.")
+    for entry in results["experiments"].values():
+        styles = ", ".join(f"{style} {row['phase']:+.2f} ({row['concentration']:.2f}, {row['waves']})"
+                           for style, row in entry["style_phases"].items())
+        lines.append(f"- The phase at which the {entry['test_set']} agent's training waves start to swing, per "
+                     f"style (circular mean in radians; its concentration, 0-1; waves): {styles}; of all of them "
+                     f"{entry['phase_of_all']:+.2f}.")
     return lines + [""]
 
 

@@ -35,6 +35,12 @@ def test_an_agent_file_without_phases_gets_its_training_waves_phases_read_again(
     assert realmocap_ablation.rhythm_with_phases(fitted, []) is fitted
     with pytest.raises(RLAnimateError, match="retrain"):
         realmocap_ablation.rhythm_with_phases(older, waves[::-1])
+    for clip in waves:
+        clip.style = "normal" if clip.arm == "LEFT" else "active"
+    phases = realmocap_ablation.style_phases(waves)
+    left = np.exp(1j * fitted.phases[::2])
+    assert phases["normal"] == {"phase": pytest.approx(np.angle(left.mean())),
+                                "concentration": pytest.approx(abs(left.mean())), "waves": 3}
 
 
 @pytest.mark.skipif(not INSTALLED_AGENT.is_file(), reason="no shipped agent")

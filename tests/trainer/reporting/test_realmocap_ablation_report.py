@@ -19,7 +19,8 @@ def _results():
     summaries["nearest_clip"] = _summary(74.0, 90.0)
     return {"command": "cmd", "seed": 0, "epochs": 50, "preset": "default", "variants": names,
             "experiments": {"wave": {"test_set": "takes 009-010", "test_clips": 2, "train_seconds": 100.0,
-                                     "evaluation_cpu_seconds": 10.0, "summaries": summaries}}}
+                                     "evaluation_cpu_seconds": 10.0, "summaries": summaries, "phase_of_all": 0.05,
+                                     "style_phases": {"active": {"phase": -0.5, "concentration": 0.9, "waves": 4}}}}}
 
 
 def test_findings_compare_each_setting_with_the_agent_as_trained_and_average_seeded_groups():
@@ -27,6 +28,7 @@ def test_findings_compare_each_setting_with_the_agent_as_trained_and_average_see
     assert "as trained 60.0 / 70.0" in line and "mean rhythm, nearby phase: 62.5 / 71.0 (+2.5 / +1.0)" in line
     assert "sampled states (mean of 2 seeds): 52.0 / 66.0" in line and "seed (mean of 2 seeds): 42.0 / 61.0" in line
     assert line.endswith("retrieval 74.0 / 90.0.")
+    assert findings(_results())[1].endswith("waves): active -0.50 (0.90, 4); of all of them +0.05.")
 
 
 def test_per_style_rows_leave_out_the_seeded_settings():
