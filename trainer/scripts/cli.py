@@ -1,5 +1,8 @@
-"""What every trainer script shares: its own arguments under Blender or Python, and clear errors."""
+"""What every trainer script shares: its own arguments under Blender or Python, clear errors, and its results
+written as JSON beside a Markdown page."""
+import json
 import sys
+from pathlib import Path
 
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -17,3 +20,12 @@ def run_main(main, *args):
     except RLAnimateError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+
+
+def write_results(folder, name, results, page):
+    """Write `results` to <folder>/<name>.json and the `page` to <folder>/<name>.md, and print the page."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / f"{name}.json").write_text(json.dumps(results, indent=2) + "\n")
+    (folder / f"{name}.md").write_text(page)
+    print(page)

@@ -8,13 +8,12 @@ Each (experiment, seed) trains as a Ray task (trainer/cluster.py). Finished runs
 runs/realmocap/, seed N's in runs/realmocap_seed<N>/.
 """
 import argparse
-import json
 from pathlib import Path
 
 from trainer.experiments.realmocap import RealMocapSettings, baseline_sets, run_experiments
 from trainer.reporting.baselines_report import write_baselines_results
 from trainer.reporting.realmocap_report import realmocap_markdown
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts.cli import run_main, script_args, write_results
 
 DEFAULTS = RealMocapSettings()
 
@@ -53,14 +52,11 @@ def parse_settings(argv=None):
 def main(argv=None):
     settings = parse_settings(argv)
     results = run_experiments(settings)
-    out = Path(settings.results)
-    (out / "realmocap.json").write_text(json.dumps(results, indent=2) + "\n")
-    (out / "realmocap.md").write_text(realmocap_markdown(results))
-    write_baselines_results(out, "real motion capture",
+    write_results(settings.results, "realmocap", results, realmocap_markdown(results))
+    write_baselines_results(Path(settings.results), "real motion capture",
                   "Agents trained on the real waves (takes 001-008 and 021-036, or 5 styles); pointing agent from "
                   f"the sample library for the guide clips. Regenerate: `{results['command']}`.",
                   baseline_sets(results))
-    print(realmocap_markdown(results))
     return 0
 
 

@@ -8,12 +8,10 @@ has it, as trainer.scripts.realmocap reuses it), then plays each with every sett
 trainer/experiments/realmocap_ablation.py.
 """
 import argparse
-import json
-from pathlib import Path
 
 from trainer.experiments.realmocap_ablation import EXPERIMENTS, AblationSettings, run_ablation
 from trainer.reporting.realmocap_ablation_report import ablation_markdown
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts.cli import run_main, script_args, write_results
 
 DEFAULTS = AblationSettings()
 
@@ -45,10 +43,7 @@ def parse_settings(argv=None):
 def main(argv=None):
     settings = parse_settings(argv)
     results = run_ablation(settings)
-    out = Path(settings.results)
-    (out / "realmocap_ablation.json").write_text(json.dumps(results, indent=2) + "\n")
-    (out / "realmocap_ablation.md").write_text(ablation_markdown(results))
-    print(ablation_markdown(results))
+    write_results(settings.results, "realmocap_ablation", results, ablation_markdown(results))
     return 0
 
 

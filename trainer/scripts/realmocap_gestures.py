@@ -12,7 +12,7 @@ from pathlib import Path
 
 from trainer.experiments.realmocap_gestures import GestureSettings, run_experiment
 from trainer.reporting.realmocap_gestures_report import gestures_markdown, paths_figure
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts.cli import run_main, script_args, write_results
 
 DEFAULTS = GestureSettings()
 RESULT = "realmocap_guide_bye"
@@ -57,10 +57,7 @@ def main(argv=None):
     out = Path(settings.results)
     out.mkdir(parents=True, exist_ok=True)
     paths_figure(scored["env"], scored["methods"], scored["sets"], out / f"{RESULT}_paths.png")
-    (out / f"{RESULT}.json").write_text(json.dumps(results, indent=2) + "\n")
-    page = gestures_markdown(results, wave_only_summary(out))
-    (out / f"{RESULT}.md").write_text(page)
-    print(page)
+    write_results(out, RESULT, results, gestures_markdown(results, wave_only_summary(out)))
     return 0
 
 
