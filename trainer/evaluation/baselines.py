@@ -124,9 +124,16 @@ class AgentMethod:
     def generate(self, behaviour, arm, attributes, frame_count, seed=None):
         """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed), and for
         a wave the rhythm the agent draws for the seed."""
-        signals = self.agent.wave_rhythm(attributes, frame_count, seed) if behaviour == behaviours.WAVE else None
-        objectives = self.agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
-        return spaces.decode_action(self.agent.rollout(objectives, seed=seed), np.asarray(self.agent.action_bounds))
+        return agent_motion(self.agent, behaviour, arm, attributes, frame_count, seed, seed)
+
+
+def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=None, state_seed=None):
+    """(F, 15, 3) rotations the runtime agent (core.runtime.GestureAgent) plays for the request: a wave's
+    rhythm drawn with `rhythm_seed` (RhythmModel.draw), the stochastic states sampled with `state_seed`
+    (None: their means)."""
+    signals = agent.wave_rhythm(attributes, frame_count, rhythm_seed) if behaviour == behaviours.WAVE else None
+    objectives = agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
+    return spaces.decode_action(agent.rollout(objectives, seed=state_seed), np.asarray(agent.action_bounds))
 
 
 def generate_for(baseline: Any, clips: Sequence[MotionClip]) -> list[np.ndarray]:

@@ -88,8 +88,8 @@ class AblationSettings:
 
 class VariantMethod:
     """The agent of an AgentMethod playing `model` as its rhythm model, the rhythm drawn with `rhythm_seed` and
-    the stochastic states sampled with `state_seed` for every request (AgentMethod.generate with one seed
-    for both)."""
+    the stochastic states sampled with `state_seed` for every request (baselines.agent_motion; AgentMethod
+    gives both one seed)."""
 
     def __init__(self, method, model, rhythm_seed=None, state_seed=None):
         self.agent = copy.copy(method.agent)
@@ -97,11 +97,8 @@ class VariantMethod:
         self.rhythm_seed, self.state_seed = rhythm_seed, state_seed
 
     def generate(self, behaviour, arm, attributes, frame_count):
-        signals = self.agent.wave_rhythm(attributes, frame_count, self.rhythm_seed) \
-            if behaviour == behaviours.WAVE else None
-        objectives = self.agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
-        return spaces.decode_action(self.agent.rollout(objectives, seed=self.state_seed),
-                                    np.asarray(self.agent.action_bounds))
+        return baselines.agent_motion(self.agent, behaviour, arm, attributes, frame_count, self.rhythm_seed,
+                                      self.state_seed)
 
 
 def rhythm_with_phases(model, train_clips):
@@ -110,9 +107,7 @@ def rhythm_with_phases(model, train_clips):
     which must give the file's examples back."""
     if model.phases is not None:
         return model
-    read = [(clip.attributes, wave_rhythm.clip_rhythm(clip)) for clip in train_clips if clip.behaviour == behaviours.WAVE]
-    swinging = [(e, r) for e, r in read if r is not None]
-    refit = RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])
+    refit = wave_rhythm.fit_rhythm_model([clip for clip in train_clips if clip.behaviour == behaviours.WAVE])
     if refit.examples.shape != model.examples.shape or not np.allclose(refit.examples, model.examples):
         raise RLAnimateError("The agent's training waves read differently now than when it was trained: retrain "
                              "it (delete its run folder under runs/realmocap/).")

@@ -84,3 +84,10 @@ def clip_rhythm(clip):
     span = frames - 1
     return rhythm.Rhythm(frequency=float(slope / (2.0 * np.pi)), start=float(start / span),
                          stop=float(stop / span), phase=float(offset), ramp=float(ramp))
+
+
+def fit_rhythm_model(waves, nearby_phase=False):
+    """The RhythmModel of wave clips, fitted on those whose hand swings (clip_rhythm) by their exaggeration
+    (`.attributes`); `nearby_phase` as RhythmModel.fit takes it."""
+    swinging = [(clip.attributes, read) for clip in waves if (read := clip_rhythm(clip)) is not None]
+    return rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging], nearby_phase)
