@@ -1,7 +1,7 @@
 """The rhythm ablation on real capture as a page (docs/results/realmocap_ablation.md)."""
 import numpy as np
 
-from trainer.reporting.realmocap_report import SEED_METRICS, STYLE_METRICS
+from trainer.reporting.realmocap_report import SEED_METRICS, STYLE_METRICS, metric_cells
 from trainer.reporting.tables import markdown_table
 
 RETRIEVAL = "nearest_clip"
@@ -11,17 +11,13 @@ def _method_label(method):
     return "Nearest clip (retrieval)" if method == RETRIEVAL else method
 
 
-def _cells(summary, metrics):
-    return [f"{summary[key]:.{digits}f}" for key, digits in metrics]
-
-
 def overall_rows(results):
     """Per experiment and method: score, DTW score, median swing and frequency ratios and last-frame elevation
     error, accepted waves (realmocap_report.SEED_METRICS)."""
     rows = []
     for entry in results["experiments"].values():
         for method, summary in entry["summaries"].items():
-            *cells, accepted = _cells(summary, SEED_METRICS)
+            *cells, accepted = metric_cells(summary, SEED_METRICS)
             rows.append([f"{entry['test_set']} ({entry['test_clips']})", _method_label(method), *cells,
                          f"{accepted}/{summary['clips']}"])
     return rows
@@ -36,7 +32,7 @@ def style_rows(results, methods):
         for style in sorted(next(iter(summaries.values()))):
             for method, by_style in summaries.items():
                 row = by_style[style]
-                *cells, accepted = _cells(row, STYLE_METRICS)
+                *cells, accepted = metric_cells(row, STYLE_METRICS)
                 rows.append([entry["test_set"], style, _method_label(method), *cells, f"{accepted} / {row['takes']}"])
     return rows
 

@@ -6,7 +6,7 @@ from rlanimate_addon.core import behaviour_metrics, spaces
 from trainer.motion.realmocap_takes import parse_name
 from trainer.reporting import plots
 from trainer.reporting.baselines_report import METHOD_LABELS
-from trainer.reporting.realmocap_report import seed_summary
+from trainer.reporting.realmocap_report import mean_and_sd, seed_summary
 from trainer.reporting.tables import markdown_table
 
 #: The sets of the page, in order: (key in results["sets"], behaviour key in by_behaviour, label).
@@ -108,7 +108,7 @@ def seed_rows(results):
         if len(per_seed) > 1:
             spread = {k: [s[k] for s in per_seed.values()] for k in ("score", "aligned_score", "accepted")}
             rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}",
-                         *(f"**{np.mean(v):.2f} ± {np.std(v, ddof=1):.2f}**" for v in spread.values())])
+                         *(f"**{mean_and_sd(v, 2)}**" for v in spread.values())])
         rows.append([label, METHOD_LABELS["nearest_clip"], *cells(results["seed_sets"][key]["nearest_clip"])])
     return rows
 

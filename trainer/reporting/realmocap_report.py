@@ -78,7 +78,12 @@ def _median_of_defined(values):
     return float(np.median(defined)) if len(defined) else float("nan")
 
 
-def _spread(values, digits):
+def metric_cells(summary, metrics):
+    """The `summary`'s values of `metrics` ((key, decimals), ...) as table cells."""
+    return [f"{summary[key]:.{digits}f}" for key, digits in metrics]
+
+
+def mean_and_sd(values, digits):
     """'mean ± sd' of per-seed values (sd with ddof 1), at least one decimal."""
     values = np.asarray(values, dtype=np.float64)
     digits = max(digits, 1)
@@ -95,15 +100,14 @@ def per_style_rows(set_label, methods, seeds):
     for style in sorted(per_seed[0]):
         takes = per_seed[0][style]["takes"]
         if len(per_seed) > 1:
-            cells = [_spread([entry[style][key] for entry in per_seed], digits) for key, digits in STYLE_METRICS]
+            cells = [mean_and_sd([entry[style][key] for entry in per_seed], digits) for key, digits in STYLE_METRICS]
             label = f"RLAnimate, mean ± sd of {len(per_seed)} seeds"
         else:
-            cells = [f"{per_seed[0][style][key]:.{digits}f}" for key, digits in STYLE_METRICS]
+            cells = metric_cells(per_seed[0][style], STYLE_METRICS)
             label = f"RLAnimate, seed {next(iter(seeds))}"
         rows.append([set_label, style, label, takes, *cells[:-1], f"{cells[-1]} / {takes}"])
         for method, summaries in others.items():
-            entry = summaries[style]
-            cells = [f"{entry[key]:.{digits}f}" for key, digits in STYLE_METRICS]
+            cells = metric_cells(summaries[style], STYLE_METRICS)
             rows.append([set_label, style, METHOD_LABELS[method], takes, *cells[:-1], f"{cells[-1]} / {takes}"])
     return rows
 
@@ -131,18 +135,16 @@ def seed_summary(result):
 def seed_rows(results):
     """Rows of the seeds table: per wave test set, RLAnimate's agent of each seed, their mean ± sd, and
     nearest-clip retrieval (which has no seed)."""
-    def cells(summary):
-        return [f"{summary[key]:.{digits}f}" for key, digits in SEED_METRICS]
-
     rows = []
     for name, set_name, label in SEED_SETS:
         per_seed = results[name][f"{set_name}_seeds"]
-        rows += [[label, f"RLAnimate, seed {seed}", *cells(summary)] for seed, summary in per_seed.items()]
+        rows += [[label, f"RLAnimate, seed {seed}", *metric_cells(summary, SEED_METRICS)]
+                 for seed, summary in per_seed.items()]
         if len(per_seed) > 1:
-            spread = [f"**{_spread([summary[key] for summary in per_seed.values()], digits)}**"
+            spread = [f"**{mean_and_sd([summary[key] for summary in per_seed.values()], digits)}**"
                       for key, digits in SEED_METRICS]
             rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}", *spread])
-        rows.append([label, METHOD_LABELS["nearest_clip"], *cells(seed_summary(results[name][set_name]["nearest_clip"]))])
+        rows.append([label, METHOD_LABELS["nearest_clip"], *metric_cells(seed_summary(results[name][set_name]["nearest_clip"]), SEED_METRICS)])
     return rows
 
 
