@@ -105,12 +105,15 @@ def _time_check_frames(spent):
     bake_check.verify = functools.wraps(verify)(lambda scene, plan: verify(_FrameTimedScene(scene, spent), plan))
 
 
-def measure(rounds, stages=STAGES):
-    """{case label: {stage: ms per click}} with the operator and playback, and the paired CPU ratio."""
+def measure(rounds, functions=False):
+    """{case label: {stage: ms per click}} with the operator and playback, and the paired CPU ratio; with
+    `functions`, {case label: {function: ms per click}} of FUNCTIONS and the bake check's frame_set calls,
+    with the whole click."""
+    stages = [(name, owner, name) for owner, name in FUNCTIONS if hasattr(owner, name)] if functions else STAGES
     spent = {label: 0.0 for label, _, _ in stages}
     for label, owner, name in stages:
         setattr(owner, name, _timed(spent, label, getattr(owner, name)))
-    if stages is not STAGES:
+    if functions:
         _time_check_frames(spent)
     rig, settings = cases.fresh_scene()
     idle = cases.key_idle(rig)
@@ -132,7 +135,7 @@ def measure(rounds, stages=STAGES):
             cases.time_playback(frames)
             plays.append(time.process_time() - start)
         ms = {key: 1000.0 * value / rounds for key, value in spent.items()}
-        if stages is not STAGES:
+        if functions:
             out[label] = dict(ms, Generate=1000.0 * statistics.mean(clicks))
             continue
         row = {"checks": ms["checks"], "rig read": ms["rig read"], "rollout": ms["rollout"],
@@ -156,7 +159,7 @@ def main():
     if hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
     if args.functions:
-        rows = measure(args.rounds, [(name, owner, name) for owner, name in FUNCTIONS if hasattr(owner, name)])
+        rows = measure(args.rounds, functions=True)
         names = list(next(iter(rows.values())))
         print("| function | " + " | ".join(rows) + " |\n|---|" + "---:|" * len(rows))
         for name in names:
