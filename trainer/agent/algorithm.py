@@ -205,7 +205,7 @@ class Trainer:
         totals = {}
         for _ in range(config.update_steps):
             batch = self.buffer.sample_chunks(self.chunk_count, config.chunk_length, self.rng,
-                                              config.random_target_weight)
+                                              config.random_target_weight, config.last_frame_share)
             losses = gradient_step(self.agent, self.optimizer, batch, config, self.bounds)
             for name, value in losses.items():
                 totals[name] = totals.get(name, 0.0) + float(value.detach())

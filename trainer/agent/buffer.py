@@ -8,10 +8,13 @@ An episode is a mapping of per-frame arrays that share their first (time) axis:
     which only borrows a clip's length and hold timing).
 `sample_chunks` draws C chunks of L consecutive frames, each from an episode chosen at random (a
 random-target episode with `unimitated_weight` times a clip episode's chance), starting at its first
-frame with probability FIRST_FRAME_SHARE and otherwise at a uniformly random frame, and stacks them
+frame with probability FIRST_FRAME_SHARE, ending at its last frame with probability `last_frame_share`
+(TrainConfig.last_frame_share), and otherwise at a uniformly random frame, and stacks them
 batch-major: (C, L, ...). Uniform starts alone would show the agent a gesture's first frame, where
 the unroll starts from a_0 in the middle of every channel, in about one chunk in 85, and its
-rollouts started some 20 degrees off the neutral arm.
+rollouts started some 20 degrees off the neutral arm. They show its last frame as rarely (one start in
+F - L + 1 reaches it, where a middle frame has L), and the last L frames are where a wave's arm comes
+down (docs/results/realmocap.md).
 """
 import numpy as np
 import torch
@@ -40,12 +43,13 @@ class EpisodeBuffer:
             raise ValueError(f"Episode arrays disagree on their frame count: {lengths}")
         self.episodes.append({key: np.asarray(episode[key], dtype=np.float32) for key in EPISODE_KEYS})
 
-    def sample_chunks(self, count, length, rng, unimitated_weight=1.0):
+    def sample_chunks(self, count, length, rng, unimitated_weight=1.0, last_frame_share=0.0):
         """`count` chunks of `length` frames as {key: (C, L, ...) float32 tensor}.
 
         `length` is capped at the shortest episode, so every chunk is whole. Episodes that imitate no
-        clip are drawn `unimitated_weight` times as often as those that do. `rng` is a numpy
-        Generator, the only source of randomness, so sampling is reproducible.
+        clip are drawn `unimitated_weight` times as often as those that do. A share `last_frame_share` of
+        the chunks ends at the episode's last frame (0: the draws of runs from before it, unchanged). `rng`
+        is a numpy Generator, the only source of randomness, so sampling is reproducible.
         """
         if not self.episodes:
             raise ValueError("The episode buffer is empty: collect an episode before sampling.")
@@ -57,8 +61,11 @@ class EpisodeBuffer:
         for index in picks:
             episode = self.episodes[index]
             start = int(rng.integers(0, len(episode["objective"]) - length + 1))
-            if rng.random() < FIRST_FRAME_SHARE:
+            draw = rng.random()
+            if draw < FIRST_FRAME_SHARE:
                 start = 0
+            elif draw < FIRST_FRAME_SHARE + last_frame_share:
+                start = len(episode["objective"]) - length
             for key in EPISODE_KEYS:
                 chunks[key].append(episode[key][start:start + length])
         return {key: torch.from_numpy(np.stack(chunks[key])) for key in EPISODE_KEYS}

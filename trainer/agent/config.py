@@ -11,7 +11,10 @@
              is meant for the single_state variant (the stochastic behaviour state carries the wave);
     velocity_term, weight_average
              the default plus a pose-velocity term, or with the weights averaged over the last 20
-             epochs: tried for the biggest waves' shortfall and for pointing (docs/AGENT.md).
+             epochs: tried for the biggest waves' shortfall and for pointing (docs/AGENT.md);
+    end_chunks
+             the default with a fifth of the chunks ending at the gesture's last frame, where the arm
+             comes down (trainer/agent/buffer.py; real capture: docs/results/realmocap.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -69,6 +72,7 @@ class TrainConfig:
     wave_rhythm_nearby_phase: bool = False  # the mean rhythm's phase from the nearby training waves, not all
     # (core/rhythm.py; real capture: docs/results/realmocap_ablation.md)
     average_last_epochs: int = 0  # play and export the mean of the weights after each of the last N epochs (0: off)
+    last_frame_share: float = 0.0  # share of chunks that end at their episode's last frame (buffer.py; 0: off)
 
     def to_dict(self):
         return asdict(self)
@@ -101,6 +105,8 @@ PRESETS = {
     "velocity_term": (AgentConfig(), replace(_DEFAULT_TRAIN, velocity_scale=500.0)),
     "weight_average": (AgentConfig(), replace(_DEFAULT_TRAIN, average_last_epochs=20)),
     "no_wrist_term": (AgentConfig(), replace(_DEFAULT_TRAIN, wrist_scale=0.0)),
+    # Issue 26's: a fifth of the chunks end at the gesture's end, where the arm comes down (real capture).
+    "end_chunks": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

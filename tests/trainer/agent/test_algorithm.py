@@ -49,6 +49,15 @@ def test_a_share_of_chunks_starts_at_the_first_frame():
     assert len(np.unique(starts)) > 150  # the others anywhere
 
 
+def test_a_share_of_chunks_ends_at_the_last_frame():
+    buffer = EpisodeBuffer()
+    buffer.add(_episode(200, 0))
+    starts = buffer.sample_chunks(2000, 10, np.random.default_rng(3), last_frame_share=0.25)["objective"][:, 0, 0]
+    uniform = (1.0 - FIRST_FRAME_SHARE - 0.25) / 191
+    assert abs(np.mean(starts.numpy() == 190) - (0.25 + uniform)) < 0.03
+    assert abs(np.mean(starts.numpy() == 0) - (FIRST_FRAME_SHARE + uniform)) < 0.03
+
+
 def test_random_target_episodes_are_drawn_at_their_weight():
     buffer = EpisodeBuffer()
     for k in range(6):
