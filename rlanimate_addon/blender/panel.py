@@ -95,6 +95,8 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
                 layout.prop(settings, "exact_aim")
         elif kind == behaviours.INTENSITY:
             layout.prop(settings, "exaggeration", slider=True)
+            if behaviour == behaviours.WAVE:
+                layout.prop(settings, "tempo", text="Tempo (Hz)")
 
         column = layout.column(align=True)
         row = column.row(align=True)

@@ -1,6 +1,6 @@
 """`Scene.rlanimate`: the gesture settings the panel shows and Generate Gesture reads.
 
-The names behaviour, arm, target, exaggeration, frame_count, start_frame, seed and exact_aim are a
+The names behaviour, arm, target, exaggeration, tempo, frame_count, start_frame, seed and exact_aim are a
 contract that outside tools and checks use: keep them. `behaviour` lists the selected agent's behaviours
 (`behaviour_items`): its values are their ids, "POINT" and "WAVE" for those.
 """
@@ -125,6 +125,10 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     exaggeration: bpy.props.FloatProperty(
         name="Exaggeration", min=0.0, max=1.0, default=0.5, subtype="FACTOR",
         description="How big and high the wave is, from a small wave (0) to a whole-arm wave (1)")
+    tempo: bpy.props.FloatProperty(
+        name="Tempo", min=0.0, max=10.0, soft_max=4.0, default=0.0, precision=2,
+        description="Side-to-side swings per second (Hz) of a wave; 0 lets the agent choose, as the waves it "
+                    "learned from of this exaggeration do")
     frame_count: bpy.props.IntProperty(
         name="Length", min=0, soft_min=2, max=100000, default=DEFAULT_LENGTH,
         get=_get_frame_count, set=_set_frame_count,

@@ -528,7 +528,7 @@ def gesture_rotations(agent, request, rig):
     rest_heads = rig.rest_heads
     check_length(request.frame_count)
     span = request.agent_frames  # M: the gesture's seconds at the agent's rate
-    rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed)
+    rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed, request.tempo)
               if request.behaviour == behaviours.WAVE else None)
     if request.targets is not None:
         check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))
@@ -601,14 +601,14 @@ def gesture_rotations(agent, request, rig):
 
 class GestureRequest:
     """What the user asked for: behaviour, arm, length in scene frames at the scene's `fps`, seed, the
-    behaviour's attribute, and whether Point solves its aim exactly on the rig (else it keys the
-    agent's own aim)."""
+    behaviour's attribute, a wave's tempo (Hz; None: the agent's choice), and whether Point solves its aim
+    exactly on the rig (else it keys the agent's own aim)."""
 
-    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, exact_aim=True,
-                 fps=frame_rate.AGENT_FPS):
+    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, tempo=None,
+                 exact_aim=True, fps=frame_rate.AGENT_FPS):
         self.behaviour, self.arm = behaviour, arm
         self.frame_count, self.seed = int(frame_count), seed
-        self.targets, self.exaggeration = targets, float(exaggeration)
+        self.targets, self.exaggeration, self.tempo = targets, float(exaggeration), tempo
         self.exact_aim = bool(exact_aim)
         self.fps = float(fps)
 

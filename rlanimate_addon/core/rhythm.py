@@ -12,7 +12,10 @@ with start and stop in frames (given as fractions of the gesture, so a longer ge
 proportionally longer). During training the task module reads these from each clip
 (trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves of
 nearby exaggeration: their kernel-weighted mean for `seed=None`, one of them (by weight) at any phase
-for a seed, so seeds vary the phase, rate and number of swings within what the training waves do.
+for a seed, so seeds vary the phase, rate and number of swings within what the training waves do. A
+request may name its tempo (the panel's Tempo): the wave then swings at that rate, while when it
+swings, and its phase, still come from the training waves. One exaggeration cannot say a tempo: real styles
+of one exaggeration wave at 0.8 and 1.5 Hz (docs/results/realmocap.md).
 The mean's phase is the circular mean of all the training waves' phases, or, for a model made with
 `nearby_phase` (TrainConfig.wave_rhythm_nearby_phase), the kernel-weighted circular mean of the nearby
 waves' phases, as its rate, start and stop are: real styles start their swing at their own phase
@@ -27,6 +30,8 @@ from .errors import RLAnimateError
 
 #: The parameters of a rhythm that a request takes from the training waves of nearby exaggeration.
 PARAMETERS = ("frequency", "start", "stop")
+#: A requested tempo may lie this factor beyond the slowest and fastest training waves' (tempo_range).
+TEMPO_MARGIN = 1.25
 #: Exaggeration: the training waves within about this of a request's weigh in its rhythm (a Gaussian
 #: kernel's sd). Styles of one exaggeration can swing at different rates (docs/REALMOCAP.md), so the
 #: rhythm is a local average, not a line through all the waves.
@@ -131,10 +136,17 @@ class RhythmModel:
         kernel = np.exp(-0.5 * (squared - squared.min()))  # shifted, so that a far request still has weights
         return kernel / kernel.sum()
 
-    def draw(self, exaggeration: float, seed: int | None = None) -> Rhythm:
+    def tempo_range(self) -> tuple[float, float]:
+        """(slowest, fastest) tempo a request may ask, in cycles per frame: the training waves' own,
+        widened by TEMPO_MARGIN."""
+        frequencies = self.examples[:, 1 + PARAMETERS.index("frequency")]
+        return float(frequencies.min() / TEMPO_MARGIN), float(frequencies.max() * TEMPO_MARGIN)
+
+    def draw(self, exaggeration: float, seed: int | None = None, tempo: float | None = None) -> Rhythm:
         """The Rhythm for a wave of this exaggeration: for seed None the kernel-weighted mean of the
         training waves' rhythms (its phase: `nearby_phase`'s choice), else a seeded draw of one training
-        wave's (by weight) at any phase."""
+        wave's (by weight) at any phase; at `tempo` (cycles per frame; the caller keeps it within
+        tempo_range) when given."""
         weights = self.weights(exaggeration)
         if seed is None:
             values, phase = weights @ self.examples[:, 1:], self.phase
@@ -144,5 +156,6 @@ class RhythmModel:
             rng = np.random.default_rng(seed)
             values, phase = self.examples[rng.choice(len(weights), p=weights), 1:], float(rng.uniform(-np.pi, np.pi))
         frequency, start, stop = (float(v) for v in values)
+        frequency = frequency if tempo is None else float(tempo)
         start = float(np.clip(start, 0.0, 1.0))
         return Rhythm(max(frequency, 0.0), start, float(np.clip(stop, start, 1.0)), phase, self.ramp)

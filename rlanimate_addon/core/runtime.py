@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import agent_file, behaviours, blas_threads, rhythm, spaces
+from . import agent_file, behaviours, blas_threads, frame_rate, rhythm, spaces
 from .errors import RLAnimateError
 
 
@@ -163,12 +163,31 @@ class GestureAgent:
         self._from_z = np.hstack([cell_z, animation_z])  # (Z, 3E + hidden)
         self._from_a = cell_a  # (A, 3E)
 
-    def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None) -> np.ndarray | None:
+    def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None,
+                    tempo: float | None = None) -> np.ndarray | None:
         """(N, 2) rhythm signals for a wave's objectives (ObjectiveSpace.make_objective), drawn as core/rhythm.py
-        says (the training waves' mean for seed None), or None for an agent without a rhythm model."""
+        says (the training waves' mean for seed None) at `tempo` (Hz; None: the training waves'), or None for
+        an agent without a rhythm model."""
+        if self.rhythm_model is None:
+            if tempo is not None:
+                raise RLAnimateError("This agent was trained without the waves' rhythm, so it cannot wave at a "
+                                     "chosen tempo: set Tempo to 0, or choose an agent trained with it.")
+            return None
+        if tempo is not None:
+            low, high = self.tempo_range()
+            if not low <= float(tempo) <= high:  # also refuses NaN
+                raise RLAnimateError(f"A tempo of {float(tempo):.2f} Hz is outside what this agent learned: set "
+                                     f"Tempo between {low:.2f} and {high:.2f} Hz, or to 0 to let the agent choose.")
+            tempo = float(tempo) / frame_rate.AGENT_FPS
+        return rhythm.signals(self.rhythm_model.draw(exaggeration, seed, tempo), frame_count)
+
+    def tempo_range(self) -> tuple[float, float] | None:
+        """(slowest, fastest) wave tempo in Hz a request may ask (RhythmModel.tempo_range), or None for an agent
+        without a rhythm model."""
         if self.rhythm_model is None:
             return None
-        return rhythm.signals(self.rhythm_model.draw(exaggeration, seed), frame_count)
+        low, high = self.rhythm_model.tempo_range()
+        return low * frame_rate.AGENT_FPS, high * frame_rate.AGENT_FPS
 
     def kind(self, behaviour: str) -> str:
         """The kind of a declared behaviour (behaviours.TARGET or INTENSITY)."""

@@ -2,6 +2,7 @@
 and 60 fps (core/frame_rate.py), measured on the hand as Blender plays it."""
 import bpy
 import numpy as np
+import pytest
 
 from addon_helpers import bone_heads, generate, load_sample_rig, rig_bone
 from rlanimate_addon.core import behaviour_metrics, skeleton
@@ -32,3 +33,22 @@ def test_a_wave_lasts_the_same_seconds_and_swings_at_the_same_hz_at_24_30_and_60
             f"{frames} frames at {fps} fps last {(frames - 1) / fps:.2f} s, at 30 fps {(count - 1) / 30:.2f} s"
         assert np.isclose(measures["frequency"], at_30["frequency"], rtol=0.05), \
             f"{fps} fps waves at {measures['frequency']:.2f} Hz, 30 fps at {at_30['frequency']:.2f} Hz"
+
+
+def test_a_wave_swings_at_the_tempo_asked_as_blender_plays_it_and_an_unlearned_tempo_is_refused(settings):
+    rig = load_sample_rig()
+    played = {}
+    for tempo in (0.0, 1.8, 3.0):
+        settings.tempo = tempo
+        frames, played[tempo] = _played_wave(rig, settings, 30)
+    own = played[0.0]["frequency"]
+    for tempo in (1.8, 3.0):
+        assert played[tempo]["strokes"] >= 3, f"at {tempo} Hz the wave does not wave: {played[tempo]}"
+        assert np.isclose(played[tempo]["frequency"], tempo, rtol=0.1), \
+            f"asked {tempo} Hz, the hand swings at {played[tempo]['frequency']:.2f} Hz (its own tempo: {own:.2f} Hz)"
+    actions = sorted(a.name for a in bpy.data.actions)
+    settings.tempo = 8.0
+    with pytest.raises(RuntimeError, match=r"A tempo of 8\.00 Hz is outside what this agent learned: set Tempo "
+                                           r"between \d\.\d\d and \d\.\d\d Hz, or to 0"):
+        bpy.ops.rlanimate.generate_gesture()
+    assert sorted(a.name for a in bpy.data.actions) == actions

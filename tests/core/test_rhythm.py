@@ -103,3 +103,13 @@ def test_nearby_phase_round_trips_and_files_without_phases_keep_the_mean_of_all(
                    {**nearby.to_dict(), "nearby_phase": "yes"}):
         with pytest.raises(RLAnimateError, match="wave_rhythm"):
             rhythm.RhythmModel.from_dict(broken)
+
+
+def test_a_requested_tempo_sets_the_rate_and_the_training_waves_the_rest():
+    e, rhythms = _training_rhythms()
+    model = rhythm.RhythmModel.fit(e, rhythms)
+    for seed in (None, 5):
+        own, asked = model.draw(0.52, seed), model.draw(0.52, seed, tempo=0.05)
+        assert asked.frequency == 0.05
+        assert (asked.start, asked.stop, asked.phase, asked.ramp) == (own.start, own.stop, own.phase, own.ramp)
+    assert model.tempo_range() == pytest.approx((0.028 / rhythm.TEMPO_MARGIN, 0.075 * 1.06 * rhythm.TEMPO_MARGIN))

@@ -5,6 +5,7 @@ import torch
 
 from rlanimate_addon.core import runtime as runtime_module
 from rlanimate_addon.core import rhythm, spaces
+from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.runtime import GestureAgent, load_agent
 from trainer.agent.agent_export import export_agent
 from trainer.agent.config import load_preset
@@ -121,6 +122,30 @@ def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with
     assert np.abs(agent.wave_rhythm(0.4, 90, seed=3) - agent.wave_rhythm(0.4, 90, seed=4)).max() > 0.5
     _, plain = exported_agent(tmp_path, "debug", "rlanimate")
     assert load_agent(plain).wave_rhythm(0.4, 90) is None  # the paper's objective
+
+
+def test_a_wave_swings_at_the_requested_tempo_within_what_the_agent_learned(tmp_path):
+    torch.manual_seed(0)
+    path = tmp_path / "rhythm.npz"
+    export_agent(RLAnimateAgent(load_preset("debug")[0]), path,
+                 {"average_frames": {"POINT": 80, "WAVE": 95}, "wave_rhythm": RHYTHM.to_dict()})
+    agent = load_agent(path)
+    low, high = agent.tempo_range()  # Hz: the training waves' 0.072-0.08 cycles a frame at 30 fps, widened
+    assert (low, high) == pytest.approx((0.072 * 30 / rhythm.TEMPO_MARGIN, 0.08 * 30 * rhythm.TEMPO_MARGIN))
+    for tempo in (low, 2.0, high):
+        signals = agent.wave_rhythm(0.4, 300, tempo=tempo)
+        mean = RHYTHM.draw(0.4)
+        swinging = np.arange(int(mean.start * 299) + 12, int(mean.stop * 299) - 12)  # inside the envelope's ramps
+        turns = np.diff(np.unwrap(np.arctan2(signals[swinging, 0], signals[swinging, 1])))
+        assert np.allclose(turns * 30 / (2 * np.pi), tempo), "a full swing's phase turns at the tempo"
+    assert np.array_equal(agent.wave_rhythm(0.4, 90, seed=3, tempo=2.0), agent.wave_rhythm(0.4, 90, seed=3, tempo=2.0))
+    for outside in (low * 0.9, high * 1.1, float("nan")):
+        with pytest.raises(RLAnimateError, match=r"Tempo between \d+\.\d\d and \d+\.\d\d Hz, or to 0"):
+            agent.wave_rhythm(0.4, 90, tempo=outside)
+    _, plain = exported_agent(tmp_path, "debug", "rlanimate")
+    with pytest.raises(RLAnimateError, match="trained without the waves' rhythm"):
+        load_agent(plain).wave_rhythm(0.4, 90, tempo=2.0)
+    assert load_agent(plain).tempo_range() is None
 
 
 def test_metadata_accessors(tmp_path):
