@@ -20,8 +20,9 @@ def _bell(frames):
     return jerk(rise) - jerk(fall)
 
 
-def make_clip(name, behaviour, arm, value, frames):
-    """A clip pointing at `value` (a target (3,) in the character frame) or waving with exaggeration `value`."""
+def make_clip(name, behaviour, arm, value, frames, frequency=2.5):
+    """A clip pointing at `value` (a target (3,) in the character frame) or waving with exaggeration `value`
+    at `frequency` Hz."""
     side = 1.0 if arm == "LEFT" else -1.0
     envelope = _bell(frames)[:, None]  # (F, 1)
     rotvecs = np.zeros((frames, len(skeleton.ACTION_JOINTS), 3))
@@ -32,7 +33,7 @@ def make_clip(name, behaviour, arm, value, frames):
         attributes = float(value)
         t = np.arange(frames) / 30.0
         rotvecs[:, _ARM_JOINT[arm]] = envelope * np.array([0.0, 0.0, side * (0.6 + 0.4 * value)])
-        rotvecs[:, _FOREARM_JOINT[arm], 2] = envelope[:, 0] * (0.3 + 0.3 * value) * np.sin(2 * np.pi * 2.5 * t)
+        rotvecs[:, _FOREARM_JOINT[arm], 2] = envelope[:, 0] * (0.3 + 0.3 * value) * np.sin(2 * np.pi * frequency * t)
     return MotionClip(name=name, source=name, fps=30.0, rotvecs=rotvecs, behaviour=behaviour, arm=arm,
                       attributes=attributes)
 

@@ -101,7 +101,8 @@ class ProceduralIK:
             local.append(rotations.matrix_to_rotvec(bind.T @ pose[joint]))
         return np.stack(local)
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
+        """A wave swings at `tempo` (Hz; None: WAVE_FREQUENCY)."""
         spaces.PAPER_SPACE.check_request(behaviour, arm, frame_count)
         self._set_pose(self.neutral)
         side = skeleton.ARM_PREFIX[arm]
@@ -113,11 +114,12 @@ class ProceduralIK:
             return _blend(self.neutral, solved, envelope(frame_count, *POINT_TIMING))
         exaggeration = float(np.ravel(attributes)[0])
         self._constrain(side + "Hand", 3)
-        solved = np.stack([self._solve(p) for p in self.wave_targets(arm, exaggeration, frame_count)])
+        solved = np.stack([self._solve(p) for p in self.wave_targets(arm, exaggeration, frame_count, tempo)])
         return _blend(self.neutral, solved, envelope(frame_count, *WAVE_TIMING))
 
-    def wave_targets(self, arm, exaggeration, frame_count):
-        """(F, 3) hand targets of a wave, character frame in metres."""
+    def wave_targets(self, arm, exaggeration, frame_count, tempo=None):
+        """(F, 3) hand targets of a wave swinging at `tempo` Hz (None: WAVE_FREQUENCY), character frame in
+        metres."""
         side = skeleton.ARM_PREFIX[arm]
         sign = 1.0 if arm == "LEFT" else -1.0
         shoulder = skeleton.shoulder_rest_position(arm)
@@ -128,7 +130,8 @@ class ProceduralIK:
         up = shoulder + WAVE_REACH * length * np.array([sign * np.sin(elevation) * 0.7,
                                                         -np.sin(elevation) * 0.7, -np.cos(elevation)])
         t = np.arange(frame_count) / FPS
-        swing = (WAVE_SWING[0] + WAVE_SWING[1] * exaggeration) * length * np.sin(2 * np.pi * WAVE_FREQUENCY * t)
+        frequency = WAVE_FREQUENCY if tempo is None else tempo
+        swing = (WAVE_SWING[0] + WAVE_SWING[1] * exaggeration) * length * np.sin(2 * np.pi * frequency * t)
         positions = hang + raised[:, None] * (up - hang)  # (F, 3)
         positions[:, 0] += raised**2 * swing  # side to side, only once the arm is up
         return positions

@@ -1,14 +1,19 @@
 """The baselines an animator would try before RLAnimate, producing clips the evaluator scores.
 
-Each answers the agent's request (behaviour, arm, label attributes, frame count) with a clip of
-local rotations (F, 15, 3) of skeleton.ACTION_JOINTS, like MotionClip.rotvecs:
+Each answers the agent's request (behaviour, arm, label attributes, frame count, and for a wave
+optionally its tempo in Hz) with a clip of local rotations (F, 15, 3) of skeleton.ACTION_JOINTS, like
+MotionClip.rotvecs:
 
-NoMotion         the start pose held: a still arm.
-ClassMean        the per-frame mean of the training clips of the same behaviour and arm, label ignored.
+NoMotion         the start pose held: a still arm (tempo ignored).
+ClassMean        the per-frame mean of the training clips of the same behaviour and arm, label and
+                 tempo ignored.
 NearestClip      retrieval, as motion matching does: the training clip of the same behaviour and arm
                  whose label is closest (angle between pointing directions; |difference| of
-                 exaggerations), time-warped uniformly to the requested length (per-joint slerp).
-ProceduralIK     Blender's IK constraint on the sample rig (trainer/blender_io/procedural_ik.py).
+                 exaggerations; with a tempo, the distance in exaggeration and log tempo, each in units
+                 of its sd over the candidates), time-warped uniformly to the requested length
+                 (per-joint slerp).
+ProceduralIK     Blender's IK constraint on the sample rig (trainer/blender_io/procedural_ik.py), swinging
+                 at the tempo.
 
 Nearest clip and procedural IK start from and return to `mean_start_pose(clips)` (15, 3), the pose
 the training clips start in.
@@ -26,6 +31,7 @@ from rlanimate_addon.core import behaviours, rotations, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 from trainer.motion.clip import MotionClip
+from trainer.motion.wave_rhythm import clip_tempo
 
 
 def mean_start_pose(clips: Sequence[MotionClip]) -> np.ndarray:
@@ -63,12 +69,28 @@ class NearestClip:
 
     def __init__(self, clips):
         self.clips = list(clips)
+        self._tempos = {}  # {clip index: clip_tempo}, read when a request first names a tempo
 
-    def nearest(self, behaviour, arm, attributes):
-        """The training clip of `behaviour` and `arm` whose label is closest to `attributes`."""
+    def nearest(self, behaviour, arm, attributes, tempo=None):
+        """The training clip of `behaviour` and `arm` whose label (and tempo, Hz, when given) is closest to
+        the request's."""
         candidates = clips_of(self.clips, behaviour, arm, "nearest-clip")
         kind = candidates[0].behaviour_kind
+        if tempo is not None:
+            return self._nearest_in_tempo(candidates, float(np.ravel(attributes)[0]), float(tempo))
         return min(candidates, key=lambda c: self.label_distance(kind, c.attributes, attributes))
+
+    def _nearest_in_tempo(self, candidates, exaggeration, tempo):
+        """The candidate nearest (exaggeration, log tempo), each in units of its sd over the candidates
+        that swing; one that does not swing only when none does."""
+        tempos = [self._tempos.setdefault(self.clips.index(c), clip_tempo(c)) for c in candidates]
+        swinging = [(c, t) for c, t in zip(candidates, tempos) if t is not None]
+        if not swinging:
+            return min(candidates, key=lambda c: abs(float(np.ravel(c.attributes)[0]) - exaggeration))
+        values = np.array([[float(np.ravel(c.attributes)[0]), np.log(t)] for c, t in swinging])  # (K, 2)
+        scale = np.maximum(values.std(axis=0), 1e-6)
+        distances = np.linalg.norm((values - [exaggeration, np.log(tempo)]) / scale, axis=1)
+        return swinging[int(np.argmin(distances))][0]
 
     @staticmethod
     def label_distance(kind, a, b):
@@ -79,9 +101,9 @@ class NearestClip:
             return float(np.arccos(np.clip(cos, -1.0, 1.0)))
         return abs(float(np.ravel(a)[0]) - float(np.ravel(b)[0]))
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
         spaces.check_arm_and_length(arm, frame_count)
-        return time_warp(self.nearest(behaviour, arm, attributes).rotvecs, frame_count)
+        return time_warp(self.nearest(behaviour, arm, attributes, tempo).rotvecs, frame_count)
 
 
 class NoMotion:
@@ -90,7 +112,7 @@ class NoMotion:
     def __init__(self, neutral):
         self.neutral = np.asarray(neutral, dtype=np.float64)  # (15, 3)
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
         spaces.check_arm_and_length(arm, frame_count)
         return np.repeat(self.neutral[None], int(frame_count), axis=0)
 
@@ -103,7 +125,7 @@ class ClassMean:
     def __init__(self, clips):
         self.clips = list(clips)
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
         spaces.check_arm_and_length(arm, frame_count)
         group = clips_of(self.clips, behaviour, arm, "class-mean")
         quats = rotations.rotvec_to_quat(np.stack([time_warp(c.rotvecs, frame_count) for c in group]))  # (C, F, 15, 4)
@@ -121,21 +143,29 @@ class AgentMethod:
         self.path = Path(path)
         self.agent = runtime.load_agent(self.path)
 
-    def generate(self, behaviour, arm, attributes, frame_count, seed=None):
+    def generate(self, behaviour, arm, attributes, frame_count, seed=None, tempo=None):
         """Deterministic without `seed`; with one, the runtime's seeded sampling (as the panel's seed), and for
         a wave the rhythm the agent draws for the seed."""
-        return agent_motion(self.agent, behaviour, arm, attributes, frame_count, seed, seed)
+        return agent_motion(self.agent, behaviour, arm, attributes, frame_count, seed, seed, tempo)
 
 
-def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=None, state_seed=None):
+def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=None, state_seed=None, tempo=None):
     """(F, 15, 3) rotations the runtime agent (core.runtime.GestureAgent) plays for the request: a wave's
-    rhythm drawn with `rhythm_seed` (RhythmModel.draw), the stochastic states sampled with `state_seed`
-    (None: their means)."""
-    signals = agent.wave_rhythm(attributes, frame_count, rhythm_seed) if behaviour == behaviours.WAVE else None
+    rhythm drawn with `rhythm_seed` (RhythmModel.draw) at `tempo` (Hz; None: the agent's), the stochastic
+    states sampled with `state_seed` (None: their means)."""
+    signals = (agent.wave_rhythm(attributes, frame_count, rhythm_seed, tempo) if behaviour == behaviours.WAVE
+               else None)
     objectives = agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
     return spaces.decode_action(agent.rollout(objectives, seed=state_seed), np.asarray(agent.action_bounds))
 
 
-def generate_for(baseline: Any, clips: Sequence[MotionClip]) -> list[np.ndarray]:
-    """The baseline's answer to each clip's own request (label and length): list of (F_i, 15, 3)."""
-    return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs)) for c in clips]
+def generate_for(baseline: Any, clips: Sequence[MotionClip], with_tempo: bool = False) -> list[np.ndarray]:
+    """The baseline's answer to each clip's own request (label and length, and `with_tempo` a wave's own
+    tempo, wave_rhythm.clip_tempo): list of (F_i, 15, 3)."""
+    return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs), tempo=request_tempo(c, with_tempo))
+            for c in clips]
+
+
+def request_tempo(clip: MotionClip, with_tempo: bool) -> float | None:
+    """The tempo (Hz) a request for `clip` names: the wave's own when `with_tempo`, else None."""
+    return clip_tempo(clip) if with_tempo and clip.behaviour == behaviours.WAVE else None

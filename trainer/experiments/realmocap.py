@@ -7,15 +7,16 @@ the canonicalisation); the capture has no fingers, so the synthesised clips' rel
 is put on, and labels come from the motion (trainer/motion/autolabel.py).
 
 Experiments, each seed's agent trained as a Ray task (trainer/cluster.py; `train_real`: the worker builds the
-session of real clips from the import cache and runs trainer.experiments.run.train) into runs/realmocap/<name>/,
-and runs/realmocap_seed<N>/<name>/ for each further seed:
+session of real clips from the import cache and runs trainer.experiments.run.train) into runs/realmocap/<name>/
+(<name>_<preset>/ for a preset other than default), and runs/realmocap_seed<N>/ for each further seed:
     wave      wave agent on takes 001-008 and 021-036 of the 7 styles x 2 arms (249 clips), tested on takes
               009-010 (28) and on the 14 goodbye waves of dataset 1 (other actor takes, other styles)
     holdout   the same on every take of 5 styles, tested on takes 001-010 of the 2 unseen styles (40 clips)
     guide     the right-arm directing gestures as pointing: the pointing agent is given the direction
               in which the actor held the arm, and we report the angle between the generated and the
               real forearm (elbow -> wrist) at each one's hold
-Takes 011-020 are never read (motion/realmocap_takes.py, WITHHELD_TAKES). Both baselines
+Takes 011-020 are never read (motion/realmocap_takes.py, WITHHELD_TAKES). Every test take's request is answered
+twice (REQUESTS): with its auto-label and length, and naming its wave's tempo as well. Both baselines
 (trainer/evaluation/baselines.py) answer the same requests, retrieval from the same training clips; the
 agents are scored through their exported agent.npz (the numpy runtime the add-on plays). The first seed's
 agents give the full tables and the figure; every seed's agents are scored on the wave sets ("seeds").
@@ -23,6 +24,7 @@ Writes docs/results/realmocap.json and .md, the real-data section of docs/result
 and docs/results/realmocap_frames.png (generated and real frames side by side).
 """
 import functools
+import itertools
 import json
 import sys
 from dataclasses import dataclass, field
@@ -139,9 +141,9 @@ class RealRun:
 
 def real_run(name, train_clips, test_clips, seed, settings, labels=PAPER_LABELS, training_set=behaviours.WAVE):
     """The RealRun of experiment `name` ('wave', 'holdout', 'gestures') with `seed`, training the behaviours
-    `training_set` names (behaviours.training_set), into <runs>[_seed<N>]/<name>/ (resumed when a checkpoint
-    is there)."""
-    output = seed_folder(settings.runs, seed) / name
+    `training_set` names (behaviours.training_set), into <runs>[_seed<N>]/<name>/ for the default preset and
+    <name>_<preset>/ for another (resumed when a checkpoint is there)."""
+    output = seed_folder(settings.runs, seed) / (name if settings.preset == "default" else f"{name}_{settings.preset}")
     run = RunSettings(output=str(output), behaviour=behaviours.key(training_set), clips=f"realmocap:{name}",
                       epochs=settings.epochs, seed=seed, preset=settings.preset, variant="rlanimate", eval_every=0,
                       resume=(output / checkpoint.FILENAME).is_file(), progress=False)
@@ -178,12 +180,18 @@ def train_real_runs(runs, address=None, workers=None):
     return {run.settings.output: json.loads((Path(run.settings.output) / "report.json").read_text()) for run in runs}
 
 
-def compare(methods, clips, env, references):
-    """{method: scoring.score_motions result} on `clips`; for waves also `label_error`, the mean
-    |autolabel exaggeration of the generated wave - requested exaggeration| (does it portray the label?)."""
+#: The requests every method answers, by the suffix of their result keys: the paper's (each take's auto-label
+#: and length), and the same naming the wave's own tempo (baselines.request_tempo; the panel's Tempo).
+REQUESTS = {"": False, "_tempo": True}
+
+
+def compare(methods, clips, env, references, with_tempo=False):
+    """{method: scoring.score_motions result} on `clips`, each answering the clip's request (with its tempo when
+    `with_tempo`); for waves also `label_error`, the mean |autolabel exaggeration of the generated wave -
+    requested exaggeration| (does it portray the label?)."""
     results = {}
     for name, method in methods.items():
-        motions = baselines.generate_for(method, clips)
+        motions = baselines.generate_for(method, clips, with_tempo)
         result = scoring.score_motions(env, motions, clips, references)
         if all(c.behaviour == behaviours.WAVE for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
@@ -290,12 +298,13 @@ def run_experiments(settings: RealMocapSettings) -> dict:
                  "train_seconds": report["train_seconds"], "seen": _summary(report["training"])}
         if name == "holdout":
             entry["held_out_styles"] = list(HOLDOUT_STYLES)
-        for set_name, clips in sets.items():
-            entry[set_name] = compare(methods, clips, env, references)
-            entry[f"{set_name}_seeds"] = {str(seeds[0]): seed_summary(entry[set_name]["rlanimate"])}
+        for (set_name, clips), (suffix, with_tempo) in itertools.product(sets.items(), REQUESTS.items()):
+            key = set_name + suffix
+            entry[key] = compare(methods, clips, env, references, with_tempo)
+            entry[f"{key}_seeds"] = {str(seeds[0]): seed_summary(entry[key]["rlanimate"])}
             for seed in seeds[1:]:
-                result = compare({"rlanimate": agents[seed]}, clips, env, references)["rlanimate"]
-                entry[f"{set_name}_seeds"][str(seed)] = seed_summary(result)
+                result = compare({"rlanimate": agents[seed]}, clips, env, references, with_tempo)["rlanimate"]
+                entry[f"{key}_seeds"][str(seed)] = seed_summary(result)
         results[name] = entry
         if name == "wave":
             chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]

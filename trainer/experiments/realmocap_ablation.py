@@ -1,7 +1,8 @@
-"""What the wave's rhythm at play time does on real capture: one trained agent per experiment, its rhythm
-model's play-time settings varied (`python -m trainer.scripts.realmocap_ablation`).
+"""What the wave's rhythm at play time, its tempo and the training preset do on real capture: one trained agent
+per experiment and preset, its rhythm model's play-time settings varied (`python -m
+trainer.scripts.realmocap_ablation`).
 
-Every variant plays the same exported agent (runs/realmocap/<experiment>/agent.npz, trained as
+Every variant plays an exported agent (runs/realmocap/<experiment>[_<preset>]/agent.npz, trained as
 trainer.scripts.realmocap trains it, and reused by it) on each held-out take's own request, and is scored
 against that take as trainer.experiments.realmocap scores it (realmocap.compare):
     mean rhythm, all waves' phase     seed None as the agent file plays it: the kernel-weighted mean rate,
@@ -13,9 +14,14 @@ against that take as trainer.experiments.realmocap scores it (realmocap.compare)
     mean rhythm, sampled states N     the as-trained mean rhythm, the stochastic states sampled with seed N
     seed N                            a seeded draw, as the panel plays a Variation Seed N > 0: one nearby
                                       training wave's rhythm at a random phase, and sampled stochastic states
-Nearest-clip retrieval from the same training clips is the bar. No variant retrains anything.
+    tempo asked[, nearby phase]       the request names the take's own tempo (the panel's Tempo;
+                                      baselines.request_tempo), the rest as the mean rhythm [at nearby phase]
+    preset P[, tempo asked]           the agent trained with another preset (`compare_presets`), as trained
+Nearest-clip retrieval from the same training clips is the bar, for the plain request and for the one naming the
+tempo. No variant retrains anything.
 """
 import copy
+import dataclasses
 import time
 from collections import defaultdict
 from dataclasses import dataclass
@@ -36,6 +42,7 @@ from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import require_realmocap, style_holdout_split, wave_split
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.plots import wave_hand_paths
+from trainer.reporting.realmocap_ablation_report import RETRIEVAL, RETRIEVAL_TEMPO
 from trainer.reporting.realmocap_report import seed_summary
 
 #: The experiments of trainer.experiments.realmocap this ablation can run: {name: (split, test set's label)}.
@@ -47,12 +54,15 @@ class Variant:
     """A play-time setting of the agent's rhythm model: `bandwidth` and `nearby_phase` as
     RhythmModel.with_settings takes them (None: the file's); `rhythm_seed` draws the rhythm
     (RhythmModel.draw's seed) and `state_seed` samples the stochastic states (GestureAgent.rollout's), the
-    panel's Variation Seed setting both."""
+    panel's Variation Seed setting both; `tempo`: the request names the take's tempo; `preset`: the agent
+    trained with this preset (None: the ablation's own)."""
     name: str
     bandwidth: float | None = None
     nearby_phase: bool | None = None
     rhythm_seed: int | None = None
     state_seed: int | None = None
+    tempo: bool = False
+    preset: str | None = None
 
 
 SEEDS = (1, 2, 3)
@@ -62,7 +72,15 @@ VARIANTS = (Variant("mean rhythm, all waves' phase (as trained)", nearby_phase=F
             *(Variant(f"sampled states {seed}: mean rhythm, all waves' phase", nearby_phase=False, state_seed=seed)
               for seed in SEEDS),
             *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", rhythm_seed=seed,
-                      state_seed=seed) for seed in SEEDS))
+                      state_seed=seed) for seed in SEEDS),
+            Variant("tempo asked: mean rhythm at the take's tempo", nearby_phase=False, tempo=True),
+            Variant("tempo asked, nearby phase", nearby_phase=True, tempo=True))
+
+
+def preset_variants(preset):
+    """The Variants that play the agent trained with another `preset`: as trained, and asked the tempo."""
+    return (Variant(f"preset {preset}: as trained", nearby_phase=False, preset=preset),
+            Variant(f"preset {preset}, tempo asked", nearby_phase=False, tempo=True, preset=preset))
 #: The styles whose first test take (right arm) the hand-path figure shows, per experiment.
 PATH_STYLES = {"wave": ("feminine", "masculine", "normal", "active"), "holdout": ("elderly", "exhausted")}
 
@@ -73,7 +91,8 @@ class AblationSettings:
     experiments: tuple[str, ...] = ("wave", "holdout")
     seed: int = 0
     epochs: int = 50
-    preset: str = "default"
+    preset: str = "end_chunks"
+    compare_presets: tuple[str, ...] = ("default",)  # agents of these presets too (preset_variants)
     realmocap: str = str(REALMOCAP_DIR)
     runs: str = str(REALMOCAP_RUNS)
     results: str = str(RESULTS_DIR)
@@ -96,9 +115,9 @@ class VariantMethod:
         self.agent.rhythm_model = model
         self.rhythm_seed, self.state_seed = rhythm_seed, state_seed
 
-    def generate(self, behaviour, arm, attributes, frame_count):
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
         return baselines.agent_motion(self.agent, behaviour, arm, attributes, frame_count, self.rhythm_seed,
-                                      self.state_seed)
+                                      self.state_seed, tempo)
 
 
 def rhythm_with_phases(model, train_clips):
@@ -114,11 +133,12 @@ def rhythm_with_phases(model, train_clips):
     return RhythmModel(model.examples, model.phase, model.ramp, model.bandwidth, refit.phases, model.nearby_phase)
 
 
-def variant_methods(agent, train_clips, variants=VARIANTS):
-    """{variant name: VariantMethod} of the AgentMethod `agent` for each Variant."""
-    model = rhythm_with_phases(agent.agent.rhythm_model, train_clips)
-    return {v.name: VariantMethod(agent, model.with_settings(v.bandwidth, v.nearby_phase), v.rhythm_seed,
-                                  v.state_seed) for v in variants}
+def variant_methods(agents, train_clips, variants):
+    """{variant name: VariantMethod} for each Variant, of the AgentMethod in `agents` ({preset: AgentMethod}; None
+    the ablation's own) it names."""
+    models = {preset: rhythm_with_phases(agent.agent.rhythm_model, train_clips) for preset, agent in agents.items()}
+    return {v.name: VariantMethod(agents[v.preset], models[v.preset].with_settings(v.bandwidth, v.nearby_phase),
+                                  v.rhythm_seed, v.state_seed) for v in variants}
 
 
 def style_phases(train_clips):
@@ -136,14 +156,15 @@ def style_phases(train_clips):
 
 def hand_path_panels(methods, clips, styles, env, references):
     """plots.wave_hand_paths panels: per style of `styles`, its first right-arm take of `clips`, the real take
-    then each method of `methods` ({label: method})."""
+    then each method of `methods` ({label: (method, whether its request names the tempo)})."""
     panels = []
     for style in styles:
         clip = next(c for c in clips if c.style == style and c.arm == "RIGHT")
         answers = {label: spaces.description_joint_positions(env.evaluate(motion).descriptions)
                    for label, motion in ((label, method.generate(behaviours.WAVE, clip.arm, clip.attributes,
-                                                                 len(clip.rotvecs)))
-                                         for label, method in methods.items())}
+                                                                 len(clip.rotvecs),
+                                                                 tempo=baselines.request_tempo(clip, with_tempo)))
+                                         for label, (method, with_tempo) in methods.items())}
         panels.append((f"{style} {clip.take} right (e = {clip.exaggeration:.2f})", "RIGHT",
                        {"real take": spaces.description_joint_positions(references.get(clip)[0]), **answers}))
     return panels
@@ -160,24 +181,35 @@ def run_ablation(settings: AblationSettings) -> dict:
         env = FKEnvironment()
     references = ClipReferences(env)
     splits = {name: EXPERIMENTS[name][0](waves) for name in settings.experiments}
-    runs = {name: real_run(name, train, test, settings.seed, settings) for name, (train, test) in splits.items()}
+    presets = {None: settings.preset, **{preset: preset for preset in settings.compare_presets}}
+    runs = {(name, key): real_run(name, train, test, settings.seed, dataclasses.replace(settings, preset=preset))
+            for name, (train, test) in splits.items() for key, preset in presets.items()}
     reports = train_real_runs(runs.values(), workers=settings.workers)
+    variants = VARIANTS + tuple(v for preset in settings.compare_presets for v in preset_variants(preset))
     results = {"command": command_line(settings), "seed": settings.seed, "epochs": settings.epochs,
-               "preset": settings.preset, "variants": [v.name for v in VARIANTS], "experiments": {}}
+               "preset": settings.preset, "variants": [v.name for v in variants], "experiments": {}}
     panels = []
     for name, (train, test) in splits.items():
         started = time.process_time()
-        agent = baselines.AgentMethod(Path(runs[name].settings.output) / "agent.npz")
-        methods = {**variant_methods(agent, train), "nearest_clip": baselines.NearestClip(train)}
-        scored = compare(methods, test, env, references)
-        report = reports[runs[name].settings.output]
+        agents = {key: baselines.AgentMethod(Path(runs[name, key].settings.output) / "agent.npz") for key in presets}
+        methods = variant_methods(agents, train, variants)
+        retrieval = baselines.NearestClip(train)
+        scored = {**compare({**{v.name: methods[v.name] for v in variants if not v.tempo}, RETRIEVAL: retrieval},
+                            test, env, references),
+                  **compare({**{v.name: methods[v.name] for v in variants if v.tempo}, RETRIEVAL_TEMPO: retrieval},
+                            test, env, references, with_tempo=True)}
+        report = reports[runs[name, None].settings.output]
         results["experiments"][name] = {
             "test_set": EXPERIMENTS[name][1], "train_clips": len(train), "test_clips": len(test),
-            "train_seconds": report["train_seconds"], "phase_of_all": agent.agent.rhythm_model.phase,
+            "train_seconds": report["train_seconds"], "phase_of_all": agents[None].agent.rhythm_model.phase,
             "style_phases": style_phases(train),
-            "summaries": {method: seed_summary(result) for method, result in scored.items()}}
-        shown = {"as trained": methods[VARIANTS[0].name], "nearby phase": methods[VARIANTS[1].name],
-                 "seed 1": methods[VARIANTS[-len(SEEDS)].name], "nearest clip": methods["nearest_clip"]}
+            "summaries": {method: seed_summary(scored[method]) for method in [v.name for v in variants]
+                          + [RETRIEVAL, RETRIEVAL_TEMPO]}}
+        shown = {f"{settings.preset}, as trained": (methods[VARIANTS[0].name], False),
+                 **{f"{preset}, as trained": (methods[preset_variants(preset)[0].name], False)
+                    for preset in settings.compare_presets},
+                 f"{settings.preset}, tempo asked": (methods[VARIANTS[-2].name], True),
+                 "nearest clip": (retrieval, False), "nearest clip, tempo asked": (retrieval, True)}
         panels += hand_path_panels(shown, test, PATH_STYLES[name], env, references)
         results["experiments"][name]["evaluation_cpu_seconds"] = time.process_time() - started
     Path(settings.results).mkdir(parents=True, exist_ok=True)
@@ -188,4 +220,5 @@ def run_ablation(settings: AblationSettings) -> dict:
 def command_line(settings):
     """The command that regenerates these results."""
     return (f"nice -n 10 python -m trainer.scripts.realmocap_ablation --experiments {' '.join(settings.experiments)} "
-            f"--seed {settings.seed} --epochs {settings.epochs} --preset {settings.preset}")
+            f"--seed {settings.seed} --epochs {settings.epochs} --preset {settings.preset} --compare-presets "
+            f"{' '.join(settings.compare_presets)}")

@@ -86,6 +86,13 @@ def clip_rhythm(clip):
                          stop=float(stop / span), phase=float(offset), ramp=float(ramp))
 
 
+def clip_tempo(clip):
+    """Hz: how fast a wave clip's hand swings side to side (clip_rhythm), the tempo a request for it names;
+    None for a wave whose hand does not swing."""
+    read = clip_rhythm(clip)
+    return None if read is None else read.frequency * clip.fps
+
+
 def fit_rhythm_model(waves, nearby_phase=False):
     """The RhythmModel of wave clips, fitted on those whose hand swings (clip_rhythm) by their exaggeration
     (`.attributes`); `nearby_phase` as RhythmModel.fit takes it."""

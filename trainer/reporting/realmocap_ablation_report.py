@@ -4,11 +4,13 @@ import numpy as np
 from trainer.reporting.realmocap_report import SEED_METRICS, STYLE_METRICS, metric_cells
 from trainer.reporting.tables import markdown_table
 
-RETRIEVAL = "nearest_clip"
+#: Retrieval's results: for the plain request, and for the one naming the take's tempo.
+RETRIEVAL, RETRIEVAL_TEMPO = "nearest_clip", "nearest_clip, tempo asked"
+_RETRIEVAL_LABELS = {RETRIEVAL: "Nearest clip (retrieval)", RETRIEVAL_TEMPO: "Nearest clip (retrieval), tempo asked"}
 
 
 def _method_label(method):
-    return "Nearest clip (retrieval)" if method == RETRIEVAL else method
+    return _RETRIEVAL_LABELS.get(method, method)
 
 
 def overall_rows(results):
@@ -51,7 +53,7 @@ def findings(results):
     lines = []
     for entry in results["experiments"].values():
         summaries = entry["summaries"]
-        names = [name for name in summaries if name != RETRIEVAL]
+        names = [name for name in summaries if name not in _RETRIEVAL_LABELS]
         base = summaries[names[0]]
 
         def pair(summary):
@@ -65,7 +67,8 @@ def findings(results):
             parts.append(f"{prefix.strip()} (mean of {len(group)} seeds): "
                          f"{np.mean([g['score'] for g in group]):.1f} / {np.mean([g['aligned_score'] for g in group]):.1f}")
         lines.append(f"- **{entry['test_set']}** (score / DTW score): as trained {pair(base)}; " + "; ".join(parts)
-                     + f"; retrieval {pair(summaries[RETRIEVAL])}.")
+                     + f"; retrieval {pair(summaries[RETRIEVAL])}; retrieval, tempo asked "
+                       f"{pair(summaries[RETRIEVAL_TEMPO])}.")
     for entry in results["experiments"].values():
         styles = ", ".join(f"{style} {row['phase']:+.2f} ({row['concentration']:.2f}, {row['waves']})"
                            for style, row in entry["style_phases"].items())
@@ -77,15 +80,16 @@ def findings(results):
 
 def ablation_markdown(results):
     """docs/results/realmocap_ablation.md from run_ablation's results."""
-    deterministic = [name for name in results["variants"] if not _seeded(name)] + [RETRIEVAL]
+    deterministic = [name for name in results["variants"] if not _seeded(name)] + [RETRIEVAL, RETRIEVAL_TEMPO]
     timing = "; ".join(f"{entry['test_set']}: agent trained in {entry['train_seconds']:.0f} s, all variants "
                        f"scored in {entry['evaluation_cpu_seconds']:.0f} CPU s"
                        for entry in results["experiments"].values())
-    lines = ["# The wave's rhythm at play time, on real capture (an ablation)", "",
+    lines = ["# The wave's rhythm and tempo at play time, and the training preset, on real capture (an ablation)", "",
              f"One agent per test set (training seed {results['seed']}, preset `{results['preset']}`, "
              f"{results['epochs']} epochs: the agents of docs/results/realmocap.md), played with different "
-             "rhythm settings and nothing retrained (trainer/experiments/realmocap_ablation.py). Every method "
-             "answers each held-out take's own request (its auto-label and length) and is scored against it as in "
+             "rhythm settings and nothing retrained, beside the same seed's agents of other presets "
+             "(trainer/experiments/realmocap_ablation.py). Every method answers each held-out take's own request "
+             "(its auto-label and length, and where it says so the take's tempo) and is scored against it as in "
              "docs/results/realmocap.md. Regenerate: "
              f"`{results['command']}` ({timing}; one torch thread).", "",
              "- *mean rhythm, all waves' phase*: what the agent file plays for Variation Seed 0 (the panel's seed 0 "
@@ -97,7 +101,12 @@ def ablation_markdown(results):
              "- *sampled states N*: the as-trained mean rhythm, with the stochastic states sampled (seed N) instead "
              "of their means.",
              "- *seed N*: the panel's Variation Seed N > 0: one nearby training wave's rhythm at a uniformly random "
-             "phase, and sampled stochastic states.", "",
+             "phase, and sampled stochastic states.",
+             "- *tempo asked*: the request names the take's own tempo (Hz, read from its swing as the trainer reads "
+             "it: the panel's Tempo); the agent swings at it, its start, stop and phase as the mean rhythm's. "
+             "Retrieval, tempo asked, ranks the training waves by exaggeration and log tempo, each in units of its sd.",
+             "- *preset P*: the agent trained with preset P instead (`end_chunks` is `default` with a fifth of the "
+             "update's chunks ending at the gesture's last frame, trainer/agent/buffer.py).", "",
              *findings(results),
              "## All takes", "",
              "Mean score and DTW score; median swing and frequency ratios (issue 26 asks 0.75-1.33 and 0.8-1.25) and "

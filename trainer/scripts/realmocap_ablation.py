@@ -1,11 +1,12 @@
-"""The wave's rhythm at play time on real capture, as an ablation: docs/results/realmocap_ablation.{json,md} and
-docs/results/realmocap_ablation_paths.png.
+"""The wave's rhythm and tempo at play time and the training preset on real capture, as an ablation:
+docs/results/realmocap_ablation.{json,md} and docs/results/realmocap_ablation_paths.png.
 
     nice -n 10 python -m trainer.scripts.realmocap_ablation [--experiments wave holdout] [--seed 0] [--epochs 50]
+                                                            [--preset end_chunks] [--compare-presets default]
 
-Trains only the experiments named (each one agent, the seed's; reused when runs/realmocap[_seed<N>]/<name>/
-has it, as trainer.scripts.realmocap reuses it), then plays each with every setting of
-trainer/experiments/realmocap_ablation.py.
+Trains only the experiments named (one agent per preset, the seed's; reused when
+runs/realmocap[_seed<N>]/<name>[_<preset>]/ has it, as trainer.scripts.realmocap reuses it), then plays each with
+every setting of trainer/experiments/realmocap_ablation.py.
 """
 import argparse
 
@@ -23,7 +24,9 @@ def build_parser():
                         help="which agents to train and play: wave (tested on takes 009-010), holdout (unseen styles)")
     parser.add_argument("--seed", type=int, default=DEFAULTS.seed, help="the agents' training seed")
     parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs)
-    parser.add_argument("--preset", default=DEFAULTS.preset)
+    parser.add_argument("--preset", default=DEFAULTS.preset, help="the agents whose play-time settings vary")
+    parser.add_argument("--compare-presets", nargs="*", default=list(DEFAULTS.compare_presets),
+                        help="agents trained with these presets too, played as trained and asked the tempo")
     parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
     parser.add_argument("--runs", default=DEFAULTS.runs)
     parser.add_argument("--results", default=DEFAULTS.results)
@@ -36,7 +39,8 @@ def parse_settings(argv=None):
     """AblationSettings from the command line."""
     args = build_parser().parse_args(script_args(argv))
     return AblationSettings(experiments=tuple(dict.fromkeys(args.experiments)), seed=args.seed, epochs=args.epochs,
-                            preset=args.preset, realmocap=args.realmocap, runs=args.runs, results=args.results,
+                            preset=args.preset, compare_presets=tuple(dict.fromkeys(args.compare_presets)),
+                            realmocap=args.realmocap, runs=args.runs, results=args.results,
                             workers=args.workers)
 
 

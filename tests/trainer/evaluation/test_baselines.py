@@ -43,6 +43,17 @@ def test_nearest_clip_retrieves_the_closest_label():
         nearest.generate("POINT", "RIGHT", up, 50)
 
 
+def test_with_a_tempo_nearest_clip_weighs_the_swing_rate_beside_the_exaggeration():
+    library = [make_clip(name, "WAVE", "RIGHT", e, 150, hz) for name, e, hz in
+               (("slow", 0.50, 1.2), ("same_label", 0.52, 2.5), ("big", 0.9, 2.4), ("small", 0.1, 1.0))]
+    nearest = baselines.NearestClip(library)
+    assert nearest.nearest("WAVE", "RIGHT", 0.52).name == "same_label"
+    assert nearest.nearest("WAVE", "RIGHT", 0.52, tempo=1.3).name == "slow"
+    assert nearest.nearest("WAVE", "RIGHT", 0.52, tempo=2.4).name == "same_label"
+    assert baselines.request_tempo(library[0], True) == pytest.approx(1.2, rel=0.05)
+    assert baselines.request_tempo(library[0], False) is None
+
+
 def test_the_evaluator_scores_baseline_clips():
     env = NumpyFKEnvironment()
     reference, other = _wave(1.0, 80), _wave(0.0, 60)

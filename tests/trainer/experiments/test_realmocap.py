@@ -10,7 +10,7 @@ from trainer.evaluation import baselines
 from trainer.experiments import realmocap
 from trainer.experiments.realmocap import RealMocapSettings
 from trainer.experiments.run import train as train_run
-from trainer.motion import autolabel
+from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import wave_split
 from trainer.motion.synthesis import neutral_pose
@@ -48,9 +48,9 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     references = ClipReferences(env)
     session = realmocap.RealSession(env, references, train, test)
     run = realmocap.real_run("wave", train, test, 0, RealMocapSettings(epochs=1, preset="debug", runs=str(tmp_path)))
-    assert run.settings.output == str(tmp_path / "wave") and run.train_takes == tuple(c.source for c in train)
+    assert run.settings.output == str(tmp_path / "wave_debug") and run.train_takes == tuple(c.source for c in train)
     report, _ = train_run(run.settings, session)
-    agent = baselines.AgentMethod(tmp_path / "wave" / "agent.npz")
+    agent = baselines.AgentMethod(tmp_path / "wave_debug" / "agent.npz")
     assert report["episodes"] == 1 and agent.agent.metadata["training"]["clips"].endswith("realmocap:wave")
     methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train),
                "procedural_ik": ProceduralIK(baselines.mean_start_pose(train))}
@@ -58,6 +58,11 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     for result in comparison.values():
         assert np.isfinite(result["score"]) and 0.0 <= result["smoothness"] <= 100.0
         assert 0.0 <= result["label_error"] <= 1.0
+    asked = realmocap.compare({name: methods[name] for name in ("nearest_clip", "procedural_ik")}, test, env,
+                              references, with_tempo=True)
+    tempo = wave_rhythm.clip_tempo(test[0])
+    assert 0.5 < tempo < 5.0 and all(np.isfinite(result["score"]) for result in asked.values())
+    assert asked["procedural_ik"]["clips"][0]["frequency_ratio"] == pytest.approx(1.0, abs=0.2)  # it swings at the tempo
     summary = seed_summary(comparison["rlanimate"])
     assert summary["clips"] == len(test) and 0 <= summary["accepted"] <= len(test)
     assert summary["aligned_score"] == comparison["rlanimate"]["by_behaviour"]["wave"]["aligned_score"]

@@ -17,6 +17,7 @@ def _results():
     scores = [(60.0, 70.0), (62.5, 71.0), (50.0, 65.0), (54.0, 67.0), (40.0, 60.0), (44.0, 62.0)]
     summaries = {name: _summary(*score) for name, score in zip(names, scores)}
     summaries["nearest_clip"] = _summary(74.0, 90.0)
+    summaries["nearest_clip, tempo asked"] = _summary(80.0, 95.0)
     return {"command": "cmd", "seed": 0, "epochs": 50, "preset": "default", "variants": names,
             "experiments": {"wave": {"test_set": "takes 009-010", "test_clips": 2, "train_seconds": 100.0,
                                      "evaluation_cpu_seconds": 10.0, "summaries": summaries, "phase_of_all": 0.05,
@@ -27,7 +28,7 @@ def test_findings_compare_each_setting_with_the_agent_as_trained_and_average_see
     line = findings(_results())[0]
     assert "as trained 60.0 / 70.0" in line and "mean rhythm, nearby phase: 62.5 / 71.0 (+2.5 / +1.0)" in line
     assert "sampled states (mean of 2 seeds): 52.0 / 66.0" in line and "seed (mean of 2 seeds): 42.0 / 61.0" in line
-    assert line.endswith("retrieval 74.0 / 90.0.")
+    assert line.endswith("retrieval 74.0 / 90.0; retrieval, tempo asked 80.0 / 95.0.")
     assert findings(_results())[1].endswith("waves): active -0.50 (0.90, 4); of all of them +0.05.")
 
 
@@ -36,6 +37,7 @@ def test_per_style_rows_leave_out_the_seeded_settings():
     page = ablation_markdown(results)
     rows = [line for line in page.splitlines() if line.startswith("| takes 009-010 | normal |")]
     assert [row.split(" | ")[2] for row in rows] == ["mean rhythm, all waves' phase (as trained)",
-                                                     "mean rhythm, nearby phase", "Nearest clip (retrieval)"]
+                                                     "mean rhythm, nearby phase", "Nearest clip (retrieval)",
+                                                     "Nearest clip (retrieval), tempo asked"]
     assert rows[1].endswith("| 62.5 | 71.0 | 1.00 | 1.10 | 3.0 | 1 / 2 |")
     assert len(style_rows(results, ["nearest_clip"])) == 1

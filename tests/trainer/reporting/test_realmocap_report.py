@@ -58,8 +58,12 @@ def test_seed_rows_give_each_seed_then_their_mean_and_sd_then_retrieval():
                         "bye": {"rlanimate": agent, "nearest_clip": _retrieval(30.0)},
                         "bye_seeds": {"0": _seed(20.0, 35.0, 0.5, 0)}},
                "holdout": {"test": {"rlanimate": agent, "nearest_clip": _retrieval(45.0)},
-                           "test_seeds": {"0": _seed(40.0, 45.0, 0.6, 0), "1": _seed(40.0, 47.0, 0.8, 1)}}}
+                           "test_seeds": {"0": _seed(40.0, 45.0, 0.6, 0), "1": _seed(40.0, 47.0, 0.8, 1)},
+                           "test_tempo": {"rlanimate": agent, "nearest_clip": _retrieval(41.0)},
+                           "test_tempo_seeds": {"0": _seed(50.0, 55.0, 0.9, 1)}}}
     rows = seed_rows(results)
+    assert rows[-2:] == [["unseen styles, tempo asked", "RLAnimate, seed 0", "50.0", "55.0", "0.90", "1.00", "3.0", "1"],
+                         ["unseen styles, tempo asked", "Nearest clip", "70.0", "41.0", "1.00", "1.00", "2.0", "1"]]
     assert [row[:2] for row in rows[:4]] == [["takes 009-010", "RLAnimate, seed 0"], ["takes 009-010", "RLAnimate, seed 1"],
                                              ["takes 009-010", "RLAnimate, mean ± sd of 2"],
                                              ["takes 009-010", "Nearest clip"]]
