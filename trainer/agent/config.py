@@ -12,9 +12,10 @@
     velocity_term, weight_average
              the default plus a pose-velocity term, or with the weights averaged over the last 20
              epochs: tried for the biggest waves' shortfall and for pointing (docs/AGENT.md);
-    end_chunks
+    end_chunks, end_chunks_wide
              the default with a fifth of the chunks ending at the gesture's last frame, where the arm
-             comes down (trainer/agent/buffer.py; real capture: docs/results/realmocap.md).
+             comes down (trainer/agent/buffer.py), and that with every state and hidden layer twice as
+             wide (real capture: docs/results/realmocap.md, realmocap_ablation.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -107,6 +108,8 @@ PRESETS = {
     "no_wrist_term": (AgentConfig(), replace(_DEFAULT_TRAIN, wrist_scale=0.0)),
     # Issue 26's: a fifth of the chunks end at the gesture's end, where the arm comes down (real capture).
     "end_chunks": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
+    "end_chunks_wide": (AgentConfig(task_size=128, behaviour_size=128, hidden_size=128, portrayal_hidden_size=128),
+                        replace(_DEFAULT_TRAIN, last_frame_share=0.2)),  # ... and twice the width (capacity)
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

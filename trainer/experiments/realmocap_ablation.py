@@ -21,10 +21,9 @@ Nearest-clip retrieval from the same training clips is the bar, for the plain re
 tempo. No variant retrains anything.
 """
 import copy
-import dataclasses
 import time
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -81,6 +80,8 @@ def preset_variants(preset):
     """The Variants that play the agent trained with another `preset`: as trained, and asked the tempo."""
     return (Variant(f"preset {preset}: as trained", nearby_phase=False, preset=preset),
             Variant(f"preset {preset}, tempo asked", nearby_phase=False, tempo=True, preset=preset))
+
+
 #: The styles whose first test take (right arm) the hand-path figure shows, per experiment.
 PATH_STYLES = {"wave": ("feminine", "masculine", "normal", "active"), "holdout": ("elderly", "exhausted")}
 
@@ -182,7 +183,7 @@ def run_ablation(settings: AblationSettings) -> dict:
     references = ClipReferences(env)
     splits = {name: EXPERIMENTS[name][0](waves) for name in settings.experiments}
     presets = {None: settings.preset, **{preset: preset for preset in settings.compare_presets}}
-    runs = {(name, key): real_run(name, train, test, settings.seed, dataclasses.replace(settings, preset=preset))
+    runs = {(name, key): real_run(name, train, test, settings.seed, replace(settings, preset=preset))
             for name, (train, test) in splits.items() for key, preset in presets.items()}
     reports = train_real_runs(runs.values(), workers=settings.workers)
     variants = VARIANTS + tuple(v for preset in settings.compare_presets for v in preset_variants(preset))

@@ -69,3 +69,26 @@ def test_the_evaluator_scores_baseline_clips():
     copied = scoring.score_motions(env, baselines.generate_for(baselines.NearestClip([other]), [reference]),
                                    [reference], references)
     assert copied["score"] < exact["score"] - 0.5  # a different exaggeration costs score
+
+
+def test_the_agent_plays_a_tempo_beyond_what_it_learned_at_the_nearest_it_allows(tmp_path):
+    import torch
+
+    from rlanimate_addon.core import rhythm, runtime
+    from trainer.agent.agent_export import export_agent
+    from trainer.agent.config import load_preset
+    from trainer.agent.models import RLAnimateAgent
+
+    torch.manual_seed(0)
+    model = rhythm.RhythmModel.fit([0.2, 0.8], [rhythm.Rhythm(0.05, 0.3, 0.7, 0.2, 9.0),
+                                                rhythm.Rhythm(0.08, 0.3, 0.7, 0.4, 9.0)])
+    path = tmp_path / "agent.npz"
+    export_agent(RLAnimateAgent(load_preset("debug")[0]), path,
+                 {"average_frames": {"POINT": 80, "WAVE": 95}, "wave_rhythm": model.to_dict()})
+    agent = runtime.load_agent(path)
+    low, high = agent.tempo_range()
+    for beyond, nearest in ((0.2, low), (9.0, high)):
+        np.testing.assert_array_equal(baselines.agent_motion(agent, "WAVE", "LEFT", 0.5, 90, tempo=beyond),
+                                      baselines.agent_motion(agent, "WAVE", "LEFT", 0.5, 90, tempo=nearest))
+    assert not np.array_equal(baselines.agent_motion(agent, "WAVE", "LEFT", 0.5, 90, tempo=low),
+                              baselines.agent_motion(agent, "WAVE", "LEFT", 0.5, 90, tempo=high))
