@@ -27,6 +27,7 @@ import functools
 import itertools
 import json
 import sys
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -285,6 +286,7 @@ def run_experiments(settings: RealMocapSettings) -> dict:
                "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
 
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
+    evaluation_started = time.process_time()
     runs = {(name, seed): real_run(name, train_clips, test_clips, seed, settings)
             for name, (train_clips, test_clips) in experiments.items() for seed in seeds}
     reports = train_real_runs(runs.values(), settings.address, settings.workers)
@@ -295,7 +297,9 @@ def run_experiments(settings: RealMocapSettings) -> dict:
                    "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
         sets = {"test": test_clips} if name == "holdout" else {"test": test_clips, "bye": byes}
         entry = {"train_clips": len(train_clips), "episodes": report["episodes"],
-                 "train_seconds": report["train_seconds"], "seen": _summary(report["training"])}
+                 "train_seconds": report["train_seconds"], "seen": _summary(report["training"]),
+                 "train_cpu_seconds": {str(seed): reports[runs[name, seed].settings.output]["train_cpu_seconds"]
+                                       for seed in seeds}}
         if name == "holdout":
             entry["held_out_styles"] = list(HOLDOUT_STYLES)
         for (set_name, clips), (suffix, with_tempo) in itertools.product(sets.items(), REQUESTS.items()):
@@ -311,6 +315,7 @@ def run_experiments(settings: RealMocapSettings) -> dict:
             generated = baselines.generate_for(methods["rlanimate"], chosen)
             frames_figure(env, [(f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
                                 for c, g in zip(chosen, generated)], Path(settings.results) / "realmocap_frames.png")
+    results["evaluation_cpu_seconds"] = time.process_time() - evaluation_started
 
     try:
         point_method, point_clips = point_agent_and_library(settings.point_agent, settings.runs, settings.epochs,

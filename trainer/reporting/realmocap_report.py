@@ -155,6 +155,11 @@ def seed_rows(results):
     return rows
 
 
+def cpu_list(entry):
+    """An experiment's training CPU seconds per seed, as 'N s (seed S), ...'."""
+    return ", ".join(f"{seconds:.0f} s (seed {seed})" for seed, seconds in entry["train_cpu_seconds"].items())
+
+
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
     label_rows = [[style, f"{row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f}", f"{row['elevation_deg']:.0f}",
@@ -223,9 +228,9 @@ def realmocap_markdown(results):
              "seeds).", "",
              *markdown_table(["test set", "method", "score", "DTW score", "swing ratio", "frequency ratio",
                               "last-frame elevation error (deg)", "accepted"], seed_rows(results)),
-             "", f"Training: wave agent {results['wave']['episodes']} episodes, "
-             f"{results['wave']['train_seconds']:.0f} s; hold-out agent {results['holdout']['episodes']} episodes, "
-             f"{results['holdout']['train_seconds']:.0f} s (1 torch thread).", "",
+             "", f"CPU time (one torch thread): training, per seed's agent ({results['wave']['episodes']} "
+             f"episodes), {cpu_list(results['wave'])} for the wave agent and {cpu_list(results['holdout'])} for the "
+             f"hold-out agent; scoring every method, request and seed, {results['evaluation_cpu_seconds']:.0f} s.", "",
              "The wave's rhythm at play time (its phase, the kernel, seeded draws), varied on seed 0's agents "
              "without retraining: [realmocap_ablation.md](realmocap_ablation.md).", "",
              "## Guide clips as pointing", ""]
