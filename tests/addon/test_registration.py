@@ -20,6 +20,7 @@ CONTRACT = {
     "arm": ("ENUM", {"LEFT", "RIGHT"}),
     "target": ("POINTER", None),
     "exaggeration": ("FLOAT", None),
+    "tempo": ("FLOAT", None),
     "frame_count": ("INT", None),
     "start_frame": ("INT", None),
     "seed": ("INT", None),
@@ -59,6 +60,7 @@ def test_scene_settings_keep_the_contract(settings):
                 assert getattr(settings, name) == value
     assert properties["target"].fixed_type.identifier == "Object"
     assert (properties["exaggeration"].hard_min, properties["exaggeration"].hard_max) == (0.0, 1.0)
+    assert settings.tempo == 0.0 and properties["tempo"].hard_min == 0.0, "by default the agent chooses the tempo"
     assert settings.frame_count >= 2, "the default length must be a usable gesture"
     assert settings.exact_aim is True, "aim correction is on by default"
     assert {"REGISTER", "UNDO"} <= set(bpy.types.RLANIMATE_OT_generate_gesture.bl_options)
@@ -126,6 +128,7 @@ def test_panel_draw_uses_only_existing_properties_operators_and_icons(settings, 
         assert kwargs.get("icon", "NONE") in _ICONS
     assert {"behaviour", "arm", "frame_count", "start_frame", "seed"} <= shown
     assert ("exaggeration" in shown) == (behaviour == "WAVE")
+    assert ("tempo" in shown) == (behaviour == "WAVE")
     assert ("target" in shown) == (behaviour == "POINT")
     assert ("exact_aim" in shown) == (behaviour == "POINT")
     operators = [c[1] for c in calls if c[0] == "operator"]
