@@ -111,12 +111,17 @@ def test_seeded_rollout_varies_reproducibly_within_the_action_range(tmp_path, va
     assert roughness(varied) < 4.0 * roughness(deterministic), "a seed varies the gesture; it must not make it jitter"
 
 
-def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with_one(tmp_path):
+def rhythm_agent(tmp_path):
+    """A debug-sized agent whose file carries the RHYTHM model."""
     torch.manual_seed(0)
     path = tmp_path / "rhythm.npz"
     export_agent(RLAnimateAgent(load_preset("debug")[0]), path,
                  {"average_frames": {"POINT": 80, "WAVE": 95}, "wave_rhythm": RHYTHM.to_dict()})
-    agent = load_agent(path)
+    return load_agent(path)
+
+
+def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with_one(tmp_path):
+    agent = rhythm_agent(tmp_path)
     assert np.array_equal(agent.wave_rhythm(0.4, 90), rhythm.signals(RHYTHM.draw(0.4), 90))
     assert np.array_equal(agent.wave_rhythm(0.4, 90, seed=3), agent.wave_rhythm(0.4, 90, seed=3))
     assert np.abs(agent.wave_rhythm(0.4, 90, seed=3) - agent.wave_rhythm(0.4, 90, seed=4)).max() > 0.5
@@ -125,11 +130,7 @@ def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with
 
 
 def test_a_wave_swings_at_the_requested_tempo_within_what_the_agent_learned(tmp_path):
-    torch.manual_seed(0)
-    path = tmp_path / "rhythm.npz"
-    export_agent(RLAnimateAgent(load_preset("debug")[0]), path,
-                 {"average_frames": {"POINT": 80, "WAVE": 95}, "wave_rhythm": RHYTHM.to_dict()})
-    agent = load_agent(path)
+    agent = rhythm_agent(tmp_path)
     low, high = agent.tempo_range()  # Hz: the training waves' 0.072-0.08 cycles a frame at 30 fps, widened
     assert (low, high) == pytest.approx((0.072 * 30 / rhythm.TEMPO_MARGIN, 0.08 * 30 * rhythm.TEMPO_MARGIN))
     for tempo in (low, 2.0, high):
