@@ -69,7 +69,7 @@ class NearestClip:
 
     def __init__(self, clips):
         self.clips = list(clips)
-        self._tempos = {}  # {clip index: clip_tempo}, read when a request first names a tempo
+        self._tempos = {}  # {id(clip): clip_tempo(clip)}, read when a request first names a tempo
 
     def nearest(self, behaviour, arm, attributes, tempo=None):
         """The training clip of `behaviour` and `arm` whose label (and tempo, Hz, when given) is closest to
@@ -83,7 +83,10 @@ class NearestClip:
     def _nearest_in_tempo(self, candidates, exaggeration, tempo):
         """The candidate nearest (exaggeration, log tempo), each in units of its sd over the candidates
         that swing; one that does not swing only when none does."""
-        tempos = [self._tempos.setdefault(self.clips.index(c), clip_tempo(c)) for c in candidates]
+        for clip in candidates:
+            if id(clip) not in self._tempos:
+                self._tempos[id(clip)] = clip_tempo(clip)
+        tempos = [self._tempos[id(c)] for c in candidates]
         swinging = [(c, t) for c, t in zip(candidates, tempos) if t is not None]
         if not swinging:
             return min(candidates, key=lambda c: abs(float(np.ravel(c.attributes)[0]) - exaggeration))
