@@ -171,7 +171,8 @@ def _compute(context, plan, settings, agent, frames):
         request = gesture.GestureRequest(settings.behaviour, settings.arm, len(frames),
                                          targets=targets if targeted else None,
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
-                                         tempo=settings.tempo or None, exact_aim=settings.exact_aim, fps=properties.scene_fps(scene))
+                                         tempo=settings.tempo or None, exact_aim=settings.exact_aim,
+                                         fps=properties.scene_fps(scene))
         plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
         plan.keyed = keyed
         if target is not None:
