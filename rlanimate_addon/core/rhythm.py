@@ -10,18 +10,20 @@ into a still arm. Here the wave's attributes are [exaggeration, A_t sin(phi_t), 
 
 with start and stop in frames (given as fractions of the gesture, so a longer gesture swings for
 proportionally longer). During training the task module reads these from each clip
-(trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves of
-nearby exaggeration: their kernel-weighted mean for `seed=None`, one of them (by weight) at any phase
-for a seed, so seeds vary the phase, rate and number of swings within what the training waves do. A
-request may name its tempo (the panel's Tempo): the wave then swings at that rate, while when it
-swings, and its phase, still come from the training waves. One exaggeration cannot say a tempo: real masculine
-and normal waves overlap in exaggeration (0.67 ± 0.06, 0.62 ± 0.10) and swing at 0.85 and 1.6 Hz
-(docs/REALMOCAP.md).
-The mean's phase is the circular mean of all the training waves' phases, or, for a model made with
-`nearby_phase` (TrainConfig.wave_rhythm_nearby_phase), the kernel-weighted circular mean of the nearby
-waves' phases, as its rate, start and stop are: real styles start their swing at their own phase
-(docs/results/realmocap_ablation.md).
+(trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves near
+the request: near its exaggeration, and near its tempo in log Hz. The tempo is the one the request names
+(the panel's Tempo), or else the typical tempo of the waves near its exaggeration: the mode of their
+tempos, not their mean. Styles of one exaggeration can swing at different rates (real masculine and
+normal waves: 0.67 ± 0.06 and 0.62 ± 0.10, at 0.85 and 1.6 Hz; docs/REALMOCAP.md), and the mean of two
+rates is a rate neither style swings at, as the mean of out-of-phase swings is a still arm. Seed None
+plays those waves' weighted mean rate, start and stop at their weighted circular mean phase; a seed plays
+one of them (by weight) at any phase, so seeds vary the phase, rate and number of swings within what
+those waves do. A named tempo sets the rate.
+Files exported before the training waves' phases were kept (`phases` None) play as they were made: the
+rate, start and stop near the exaggeration alone at the circular mean phase of all the training waves
+(`typical_tempo` False; docs/results/realmocap_ablation.md compares the two).
 """
+import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
@@ -37,6 +39,9 @@ TEMPO_MARGIN = 1.25
 #: kernel's sd). Styles of one exaggeration can swing at different rates (docs/REALMOCAP.md), so the
 #: rhythm is a local average, not a line through all the waves.
 BANDWIDTH = 0.05
+#: Log Hz: the training waves within about this of a request's tempo (asked or typical) weigh in its rhythm
+#: (a Gaussian kernel's sd): a rate within the frequency ratio's tolerance of 1.25 is the same tempo.
+TEMPO_BANDWIDTH = math.log(1.25)
 
 
 @dataclass(frozen=True)
@@ -71,18 +76,19 @@ class RhythmModel:
 
     `examples` (K, 4): each training wave's exaggeration and its PARAMETERS; the phase's circular mean;
     the envelope ramp in frames; the kernel bandwidth in exaggeration; `phases` (K,): each training
-    wave's phase (None in files exported before they were kept); `nearby_phase`: the mean rhythm takes
-    the nearby waves' phase, not the circular mean of all (it needs `phases`).
+    wave's phase (None in files exported before they were kept); `typical_tempo`: the waves near the
+    request's tempo weigh in its rhythm, and theirs is its phase (it needs `phases`; None: on when they
+    are there).
     """
 
-    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, nearby_phase=False):
+    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, typical_tempo=None):
         self.examples = np.asarray(examples, dtype=np.float64)
         self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
         self.phases = None if phases is None else np.asarray(phases, dtype=np.float64)
-        self.nearby_phase = bool(nearby_phase)
+        self.typical_tempo = self.phases is not None if typical_tempo is None else typical_tempo
 
     @classmethod
-    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm], nearby_phase=False) -> "RhythmModel":
+    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm]) -> "RhythmModel":
         """From the training clips' exaggerations (K,) and their Rhythms (K)."""
         if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
@@ -90,19 +96,19 @@ class RhythmModel:
         examples = [[float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms)]
         phases = np.array([r.phase for r in rhythms])
         phase = float(np.angle(np.mean(np.exp(1j * phases))))
-        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases,
-                   nearby_phase=nearby_phase)
+        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases)
 
-    def with_settings(self, bandwidth=None, nearby_phase=None) -> "RhythmModel":
-        """The same training waves with another kernel bandwidth and/or phase choice (None: keep this one's)."""
+    def with_settings(self, bandwidth=None, typical_tempo=None) -> "RhythmModel":
+        """The same training waves with another kernel bandwidth and/or choice of `typical_tempo` (None: keep
+        this one's)."""
         return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth if bandwidth is None else bandwidth,
-                           self.phases, self.nearby_phase if nearby_phase is None else nearby_phase)
+                           self.phases, self.typical_tempo if typical_tempo is None else typical_tempo)
 
     def to_dict(self) -> dict:
         values = {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
                   "bandwidth": self.bandwidth}
         if self.phases is not None:
-            values.update(phases=self.phases.tolist(), nearby_phase=self.nearby_phase)
+            values.update(phases=self.phases.tolist(), typical_tempo=self.typical_tempo)
         return values
 
     @classmethod
@@ -112,9 +118,9 @@ class RhythmModel:
             model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
                         float(values["ramp"]), float(values["bandwidth"]),
                         None if phases is None else np.asarray(phases, dtype=np.float64),
-                        values.get("nearby_phase", False))
-            if not isinstance(values.get("nearby_phase", False), bool):
-                raise TypeError("nearby_phase must be true or false")
+                        values.get("typical_tempo"))
+            if not isinstance(model.typical_tempo, bool):
+                raise TypeError("typical_tempo must be true or false")
         except (KeyError, TypeError, ValueError) as error:
             raise RLAnimateError(f"The agent's wave_rhythm metadata is invalid ({error!r}): re-export the "
                                  f"agent with trainer/agent/agent_export.py.") from error
@@ -124,18 +130,28 @@ class RhythmModel:
         numbers = np.concatenate([model.examples.ravel(), [model.phase, model.ramp, model.bandwidth],
                                   [] if model.phases is None else model.phases])
         if not (shape_ok and phases_ok) or not np.all(np.isfinite(numbers)) or model.ramp <= 0 \
-                or model.bandwidth <= 0 or (model.nearby_phase and model.phases is None):
+                or model.bandwidth <= 0 or (model.typical_tempo and model.phases is None):
             raise RLAnimateError(f"The agent's wave_rhythm metadata holds invalid numbers (need at least 2 "
                                  f"examples of {1 + len(PARAMETERS)} finite numbers, a finite phase for each "
-                                 f"when nearby_phase is on, and a positive ramp and bandwidth): re-export the "
+                                 f"when typical_tempo is on, and a positive ramp and bandwidth): re-export the "
                                  f"agent.")
         return model
 
-    def weights(self, exaggeration: float) -> np.ndarray:
-        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1)."""
-        squared = ((self.examples[:, 0] - float(exaggeration)) / self.bandwidth) ** 2
-        kernel = np.exp(-0.5 * (squared - squared.min()))  # shifted, so that a far request still has weights
-        return kernel / kernel.sum()
+    def weights(self, exaggeration: float, tempo: float | None = None) -> np.ndarray:
+        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1); with
+        `typical_tempo`, near its tempo too (cycles per frame; None: the typical one)."""
+        weights = _kernel(self.examples[:, 0] - float(exaggeration), self.bandwidth)
+        if not self.typical_tempo:
+            return weights
+        log_tempos = np.log(self._frequencies())
+        if tempo is None:
+            density = _gaussian(log_tempos[:, None] - log_tempos[None, :], TEMPO_BANDWIDTH) @ weights  # (K,)
+            tempo = self._frequencies()[np.argmax(density)]
+        weights = weights * _kernel(log_tempos - math.log(max(float(tempo), _SLOWEST)), TEMPO_BANDWIDTH)
+        return weights / weights.sum()
+
+    def _frequencies(self):
+        return np.maximum(self.examples[:, 1 + PARAMETERS.index("frequency")], _SLOWEST)
 
     def tempo_range(self) -> tuple[float, float]:
         """(slowest, fastest) tempo a request may ask, in cycles per frame: the training waves' own,
@@ -144,15 +160,13 @@ class RhythmModel:
         return float(frequencies.min() / TEMPO_MARGIN), float(frequencies.max() * TEMPO_MARGIN)
 
     def draw(self, exaggeration: float, seed: int | None = None, tempo: float | None = None) -> Rhythm:
-        """The Rhythm for a wave of this exaggeration: for seed None the kernel-weighted mean of the
-        training waves' rhythms (its phase: `nearby_phase`'s choice), else a seeded draw of one training
-        wave's (by weight) at any phase; at `tempo` (cycles per frame; the caller keeps it within
-        tempo_range) when given."""
-        weights = self.weights(exaggeration)
+        """The Rhythm for a wave of this exaggeration: for seed None the weighted mean of the training
+        waves' rhythms (`weights`), else a seeded draw of one training wave's (by weight) at any phase; at
+        `tempo` (cycles per frame; the caller keeps it within tempo_range) when given."""
+        weights = self.weights(exaggeration, tempo)
         if seed is None:
-            values, phase = weights @ self.examples[:, 1:], self.phase
-            if self.nearby_phase:
-                phase = float(np.angle(weights @ np.exp(1j * self.phases)))
+            values = weights @ self.examples[:, 1:]
+            phase = float(np.angle(weights @ np.exp(1j * self.phases))) if self.typical_tempo else self.phase
         else:
             rng = np.random.default_rng(seed)
             values, phase = self.examples[rng.choice(len(weights), p=weights), 1:], float(rng.uniform(-np.pi, np.pi))
@@ -160,3 +174,19 @@ class RhythmModel:
         frequency = frequency if tempo is None else float(tempo)
         start = float(np.clip(start, 0.0, 1.0))
         return Rhythm(max(frequency, 0.0), start, float(np.clip(stop, start, 1.0)), phase, self.ramp)
+
+
+#: Cycles per frame: the slowest rate a tempo's logarithm is taken of.
+_SLOWEST = 1e-6
+
+
+def _gaussian(differences, bandwidth):
+    return np.exp(-0.5 * (differences / bandwidth) ** 2)
+
+
+def _kernel(differences, bandwidth):
+    """(K,) Gaussian weights (sum 1) of `differences` in units of `bandwidth`, shifted so that far ones still
+    have weights."""
+    squared = (differences / bandwidth) ** 2
+    kernel = np.exp(-0.5 * (squared - squared.min()))
+    return kernel / kernel.sum()

@@ -102,7 +102,7 @@ class Trainer:
         #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
         self.rhythm_model = None
         if waves and train_config.wave_rhythm:
-            self.rhythm_model = wave_rhythm.fit_rhythm_model(waves, train_config.wave_rhythm_nearby_phase)
+            self.rhythm_model = wave_rhythm.fit_rhythm_model(waves)
         #: C of the update steps: the config's for one or two behaviours, in proportion beyond
         #: (chunks_per_update), so each behaviour keeps the chunks it has beside one other.
         self.chunk_count = chunks_per_update(train_config.chunk_count, len(self.clip_groups))

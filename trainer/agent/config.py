@@ -70,8 +70,6 @@ class TrainConfig:
     policy_scale: float = 0.01  # Beta concentrations fitted by NLL of the clip's pose (mean detached)
     posterior_on_reference: bool = False  # single_state: condition the posterior on the clip's description
     wave_rhythm: bool = True  # waves' objectives carry their rhythm (core/rhythm.py); False: the paper's
-    wave_rhythm_nearby_phase: bool = False  # the mean rhythm's phase from the nearby training waves, not all
-    # (core/rhythm.py; real capture: docs/results/realmocap_ablation.md)
     average_last_epochs: int = 0  # play and export the mean of the weights after each of the last N epochs (0: off)
     last_frame_share: float = 0.0  # share of chunks that end at their episode's last frame (buffer.py; 0: off)
 

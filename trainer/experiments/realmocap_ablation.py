@@ -5,18 +5,19 @@ trainer.scripts.realmocap_ablation`).
 Every variant plays an exported agent (runs/realmocap/<experiment>[_<preset>]/agent.npz, trained as
 trainer.scripts.realmocap trains it, and reused by it) on each held-out take's own request, and is scored
 against that take as trainer.experiments.realmocap scores it (realmocap.compare):
-    mean rhythm, all waves' phase     seed None as the agent file plays it: the kernel-weighted mean rate,
-                                      start and stop of the nearby training waves, at the circular mean
-                                      phase of all of them (core/rhythm.py)
-    mean rhythm, nearby phase         the same at the kernel-weighted circular mean phase of the nearby
-                                      waves (TrainConfig.wave_rhythm_nearby_phase)
-    ..., kernel sd 0.02               the same with a tighter kernel than BANDWIDTH
-    mean rhythm, sampled states N     the as-trained mean rhythm, the stochastic states sampled with seed N
+    typical tempo                     seed None as the agent file plays it (core/rhythm.py): the weighted
+                                      mean rate, start and stop of the training waves near the request's
+                                      exaggeration and near the typical tempo of those, at their weighted
+                                      circular mean phase
+    mean rhythm, all waves' phase     as files without their waves' phases play: the weighted mean of the
+                                      waves near the exaggeration alone, at the circular mean phase of all
+    ..., kernel sd 0.02               the typical tempo with a tighter exaggeration kernel than BANDWIDTH
+    sampled states N                  the typical tempo, the stochastic states sampled with seed N
     seed N                            a seeded draw, as the panel plays a Variation Seed N > 0: one nearby
                                       training wave's rhythm at a random phase, and sampled stochastic states
-    tempo asked[, nearby phase]       the request names the take's own tempo (the panel's Tempo;
-                                      baselines.request_tempo), the rest as the mean rhythm [at nearby phase]
-    preset P[, tempo asked]           the agent trained with another preset (`compare_presets`), as trained
+    tempo asked[, mean rhythm]        the request names the take's own tempo (the panel's Tempo;
+                                      baselines.request_tempo), the rest as the typical tempo [mean rhythm]
+    preset P[, tempo asked]           the agent trained with another preset (`compare_presets`), as exported
 Nearest-clip retrieval from the same training clips is the bar, for the plain request and for the one naming the
 tempo. No variant retrains anything.
 """
@@ -35,6 +36,7 @@ from rlanimate_addon.core.rhythm import RhythmModel
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines
+from trainer.evaluation.rhythm_leave_one_out import leave_one_out
 from trainer.experiments.realmocap import compare, load_folder, real_run, train_real_runs
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
@@ -50,14 +52,14 @@ EXPERIMENTS = {"wave": (wave_split, "takes 009-010"), "holdout": (style_holdout_
 
 @dataclass(frozen=True)
 class Variant:
-    """A play-time setting of the agent's rhythm model: `bandwidth` and `nearby_phase` as
+    """A play-time setting of the agent's rhythm model: `bandwidth` and `typical_tempo` as
     RhythmModel.with_settings takes them (None: the file's); `rhythm_seed` draws the rhythm
     (RhythmModel.draw's seed) and `state_seed` samples the stochastic states (GestureAgent.rollout's), the
     panel's Variation Seed setting both; `tempo`: the request names the take's tempo; `preset`: the agent
     trained with this preset (None: the ablation's own)."""
     name: str
     bandwidth: float | None = None
-    nearby_phase: bool | None = None
+    typical_tempo: bool | None = None
     rhythm_seed: int | None = None
     state_seed: int | None = None
     tempo: bool = False
@@ -65,21 +67,20 @@ class Variant:
 
 
 SEEDS = (1, 2, 3)
-VARIANTS = (Variant("mean rhythm, all waves' phase (as trained)", nearby_phase=False),
-            Variant("mean rhythm, nearby phase", nearby_phase=True),
-            Variant("mean rhythm, nearby phase, kernel sd 0.02", bandwidth=0.02, nearby_phase=True),
-            *(Variant(f"sampled states {seed}: mean rhythm, all waves' phase", nearby_phase=False, state_seed=seed)
-              for seed in SEEDS),
-            *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", rhythm_seed=seed,
-                      state_seed=seed) for seed in SEEDS),
-            Variant("tempo asked: mean rhythm at the take's tempo", nearby_phase=False, tempo=True),
-            Variant("tempo asked, nearby phase", nearby_phase=True, tempo=True))
+VARIANTS = (Variant("typical tempo (as exported)", typical_tempo=True),
+            Variant("mean rhythm, all waves' phase", typical_tempo=False),
+            Variant("typical tempo, kernel sd 0.02", bandwidth=0.02, typical_tempo=True),
+            *(Variant(f"sampled states {seed}: typical tempo", typical_tempo=True, state_seed=seed) for seed in SEEDS),
+            *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", typical_tempo=True,
+                      rhythm_seed=seed, state_seed=seed) for seed in SEEDS),
+            Variant("tempo asked: typical-tempo rhythm at the take's tempo", typical_tempo=True, tempo=True),
+            Variant("tempo asked, mean rhythm", typical_tempo=False, tempo=True))
 
 
 def preset_variants(preset):
     """The Variants that play the agent trained with another `preset`: as trained, and asked the tempo."""
-    return (Variant(f"preset {preset}: as trained", nearby_phase=False, preset=preset),
-            Variant(f"preset {preset}, tempo asked", nearby_phase=False, tempo=True, preset=preset))
+    return (Variant(f"preset {preset}: as exported", typical_tempo=True, preset=preset),
+            Variant(f"preset {preset}, tempo asked", typical_tempo=True, tempo=True, preset=preset))
 
 
 #: The styles whose first test take (right arm) the hand-path figure shows, per experiment.
@@ -131,14 +132,14 @@ def rhythm_with_phases(model, train_clips):
     if refit.examples.shape != model.examples.shape or not np.allclose(refit.examples, model.examples):
         raise RLAnimateError("The agent's training waves read differently now than when it was trained: retrain "
                              "it (delete its run folder under runs/realmocap/).")
-    return RhythmModel(model.examples, model.phase, model.ramp, model.bandwidth, refit.phases, model.nearby_phase)
+    return RhythmModel(model.examples, model.phase, model.ramp, model.bandwidth, refit.phases, typical_tempo=False)
 
 
 def variant_methods(agents, train_clips, variants):
     """{variant name: VariantMethod} for each Variant, of the AgentMethod in `agents` ({preset: AgentMethod}; None
     the ablation's own) it names."""
     models = {preset: rhythm_with_phases(agent.agent.rhythm_model, train_clips) for preset, agent in agents.items()}
-    return {v.name: VariantMethod(agents[v.preset], models[v.preset].with_settings(v.bandwidth, v.nearby_phase),
+    return {v.name: VariantMethod(agents[v.preset], models[v.preset].with_settings(v.bandwidth, v.typical_tempo),
                                   v.rhythm_seed, v.state_seed) for v in variants}
 
 
@@ -153,6 +154,17 @@ def style_phases(train_clips):
     means = {style: np.mean(np.exp(1j * np.array(phases))) for style, phases in by_style.items()}
     return {style: {"phase": float(np.angle(mean)), "concentration": float(abs(mean)), "waves": len(by_style[style])}
             for style, mean in sorted(means.items())}
+
+
+def rule_checks(train_clips):
+    """{rule: rhythm_leave_one_out.leave_one_out} over the training waves that swing, for the typical tempo and
+    the mean rhythm: the rule judged on training waves alone."""
+    read = [(clip, r) for clip in train_clips
+            if clip.behaviour == behaviours.WAVE and (r := wave_rhythm.clip_rhythm(clip)) is not None]
+    arguments = ([float(np.ravel(c.attributes)[0]) for c, _ in read], [r for _, r in read],
+                 [len(c.rotvecs) for c, _ in read])
+    return {"typical tempo": leave_one_out(*arguments, typical_tempo=True),
+            "mean rhythm": leave_one_out(*arguments, typical_tempo=False)}
 
 
 def hand_path_panels(methods, clips, styles, env, references):
@@ -203,11 +215,12 @@ def run_ablation(settings: AblationSettings) -> dict:
         results["experiments"][name] = {
             "test_set": EXPERIMENTS[name][1], "train_clips": len(train), "test_clips": len(test),
             "train_seconds": report["train_seconds"], "phase_of_all": agents[None].agent.rhythm_model.phase,
-            "style_phases": style_phases(train),
+            "style_phases": style_phases(train), "rule_checks": rule_checks(train),
             "summaries": {method: seed_summary(scored[method]) for method in [v.name for v in variants]
                           + [RETRIEVAL, RETRIEVAL_TEMPO]}}
-        shown = {f"{settings.preset}, as trained": (methods[VARIANTS[0].name], False),
-                 **{f"{preset}, as trained": (methods[preset_variants(preset)[0].name], False)
+        shown = {f"{settings.preset}, as exported": (methods[VARIANTS[0].name], False),
+                 f"{settings.preset}, mean rhythm": (methods[VARIANTS[1].name], False),
+                 **{f"{preset}, as exported": (methods[preset_variants(preset)[0].name], False)
                     for preset in settings.compare_presets},
                  f"{settings.preset}, tempo asked": (methods[VARIANTS[-2].name], True),
                  "nearest clip": (retrieval, False), "nearest clip, tempo asked": (retrieval, True)}

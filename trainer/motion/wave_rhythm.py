@@ -93,8 +93,8 @@ def clip_tempo(clip):
     return None if read is None else read.frequency * clip.fps
 
 
-def fit_rhythm_model(waves, nearby_phase=False):
+def fit_rhythm_model(waves):
     """The RhythmModel of wave clips, fitted on those whose hand swings (clip_rhythm) by their exaggeration
-    (`.attributes`); `nearby_phase` as RhythmModel.fit takes it."""
+    (`.attributes`)."""
     swinging = [(clip.attributes, read) for clip in waves if (read := clip_rhythm(clip)) is not None]
-    return rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging], nearby_phase)
+    return rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])

@@ -48,7 +48,7 @@ def _seeded(name):
 
 
 def findings(results):
-    """Lines comparing, per test set, each deterministic setting's score / DTW score with the agent as trained,
+    """Lines comparing, per test set, each deterministic setting's score / DTW score with the agent as exported,
     the seeded groups' means over their seeds, and retrieval."""
     lines = []
     for entry in results["experiments"].values():
@@ -66,9 +66,16 @@ def findings(results):
             group = [summaries[name] for name in names if name.startswith(prefix)]
             parts.append(f"{prefix.strip()} (mean of {len(group)} seeds): "
                          f"{np.mean([g['score'] for g in group]):.1f} / {np.mean([g['aligned_score'] for g in group]):.1f}")
-        lines.append(f"- **{entry['test_set']}** (score / DTW score): as trained {pair(base)}; " + "; ".join(parts)
+        lines.append(f"- **{entry['test_set']}** (score / DTW score): as exported {pair(base)}; " + "; ".join(parts)
                      + f"; retrieval {pair(summaries[RETRIEVAL])}; retrieval, tempo asked "
                        f"{pair(summaries[RETRIEVAL_TEMPO])}.")
+    for entry in results["experiments"].values():
+        checks = "; ".join(f"{rule}: {row['rate_within']:.0%} within 0.8-1.25x, median |log rate ratio| "
+                           f"{row['median_log_rate_error']:.3f}, signal correlation {row['signal_correlation']:.2f}"
+                           for rule, row in entry["rule_checks"].items())
+        lines.append(f"- Each of the {entry['test_set']} agent's {next(iter(entry['rule_checks'].values()))['waves']} "
+                     f"swinging training waves left out in turn, its rate and rhythm predicted from the rest "
+                     f"(trainer/evaluation/rhythm_leave_one_out.py; no test take): {checks}.")
     for entry in results["experiments"].values():
         styles = ", ".join(f"{style} {row['phase']:+.2f} ({row['concentration']:.2f}, {row['waves']})"
                            for style, row in entry["style_phases"].items())
@@ -92,20 +99,23 @@ def ablation_markdown(results):
              "(its auto-label and length, and where it says so the take's tempo) and is scored against it as in "
              "docs/results/realmocap.md. Regenerate: "
              f"`{results['command']}` ({timing}; one torch thread).", "",
-             "- *mean rhythm, all waves' phase*: what the agent file plays for Variation Seed 0 (the panel's seed 0 "
-             "is no seed): the kernel-weighted mean rate, start and stop of the training waves near the request's "
-             "exaggeration (kernel sd 0.05), at the circular mean phase of all training waves.",
-             "- *nearby phase*: the same, at the kernel-weighted circular mean phase of the nearby training waves "
-             "(`TrainConfig.wave_rhythm_nearby_phase`; off in every preset).",
-             "- *kernel sd 0.02*: the same with a tighter kernel.",
-             "- *sampled states N*: the as-trained mean rhythm, with the stochastic states sampled (seed N) instead "
+             "- *typical tempo*: what the agent file plays for Variation Seed 0 (the panel's seed 0 is no seed): "
+             "the weighted mean rate, start and stop of the training waves near the request's exaggeration (kernel "
+             "sd 0.05) and near the typical tempo of those (the mode of their log tempos; kernel sd log 1.25), at "
+             "their weighted circular mean phase (core/rhythm.py).",
+             "- *mean rhythm, all waves' phase*: as files exported without their waves' phases play, and as every "
+             "agent played before: the weighted mean of the waves near the exaggeration alone, whatever their "
+             "tempo, at the circular mean phase of all training waves.",
+             "- *kernel sd 0.02*: the typical tempo with a tighter exaggeration kernel.",
+             "- *sampled states N*: the typical tempo, with the stochastic states sampled (seed N) instead "
              "of their means.",
              "- *seed N*: the panel's Variation Seed N > 0: one nearby training wave's rhythm at a uniformly random "
              "phase, and sampled stochastic states.",
              "- *tempo asked*: the request names the take's own tempo (Hz, read from its swing as the trainer reads "
-             "it: the panel's Tempo); the agent swings at it, its start, stop and phase as the mean rhythm's. "
+             "it: the panel's Tempo); the agent swings at it, its start, stop and phase those of the training "
+             "waves near its exaggeration and that tempo (*mean rhythm*: of those near its exaggeration alone). "
              "Retrieval, tempo asked, ranks the training waves by exaggeration and log tempo, each in units of its sd.",
-             "- *preset P*: the agent trained with preset P instead (`end_chunks` is `default` with a fifth of the "
+             "- *preset P*: the agent trained with preset P instead, playing the typical tempo (`end_chunks` is `default` with a fifth of the "
              "update's chunks ending at the gesture's last frame, trainer/agent/buffer.py).", "",
              *findings(results),
              "## All takes", "",

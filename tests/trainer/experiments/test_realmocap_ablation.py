@@ -31,7 +31,7 @@ def test_an_agent_file_without_phases_gets_its_training_waves_phases_read_again(
     fitted = RhythmModel.fit([e for e, _ in read], [r for _, r in read])
     older = RhythmModel(fitted.examples, fitted.phase, fitted.ramp, fitted.bandwidth)  # as files before phases
     again = realmocap_ablation.rhythm_with_phases(older, waves)
-    assert again.phases is not None and np.array_equal(again.phases, fitted.phases) and not again.nearby_phase
+    assert again.phases is not None and np.array_equal(again.phases, fitted.phases) and not again.typical_tempo
     assert realmocap_ablation.rhythm_with_phases(fitted, []) is fitted
     with pytest.raises(RLAnimateError, match="retrain"):
         realmocap_ablation.rhythm_with_phases(older, waves[::-1])
