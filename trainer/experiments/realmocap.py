@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from rlanimate_addon.core import behaviours, skeleton
+from rlanimate_addon.core import behaviour_metrics, behaviours, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
 from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip, import_into_cache
@@ -45,7 +45,7 @@ from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation import baselines, scoring
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
-from trainer.motion import autolabel
+from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, parse_name,
                                             relaxed_hand, require_realmocap, style_holdout_split, take_paths,
@@ -216,6 +216,27 @@ def label_table(clips):
             for style, v in sorted(table.items(), key=lambda item: np.mean(item[1]["exaggeration"]))}
 
 
+def tempo_table(clips, references):
+    """{style: {takes, spectrum_hz, strokes_hz, stroke_cm}} over wave clips: the median tempo of a style's takes
+    as the trainer reads it (the peak of the swing's spectrum, wave_rhythm.clip_tempo; a request's Tempo) and
+    as the report's stroke count reads it (core.behaviour_metrics.wave_measures, whose frequency ratio the bars
+    judge), and the median stroke between turning points. A take neither reads a tempo in is left out of that
+    median."""
+    readings = {}
+    for clip in clips:
+        measures = behaviour_metrics.wave_measures(spaces.description_joint_positions(references.get(clip)[0]),
+                                                   clip.arm)
+        spectrum = wave_rhythm.clip_tempo(clip)
+        entry = readings.setdefault(clip.style, {"spectrum": [], "strokes": [], "stroke": []})
+        entry["spectrum"].append(np.nan if spectrum is None else spectrum)
+        entry["strokes"].append(measures["frequency"] or np.nan)
+        entry["stroke"].append(100.0 * measures["swing"])
+    return {style: {"takes": len(entry["spectrum"]), "spectrum_hz": float(np.nanmedian(entry["spectrum"])),
+                    "strokes_hz": float(np.nanmedian(entry["strokes"])),
+                    "stroke_cm": float(np.median(entry["stroke"]))}
+            for style, entry in sorted(readings.items())}
+
+
 def point_agent_and_library(point_agent, runs, epochs, seed):
     """(AgentMethod, sample-library point training clips) for the guide experiment.
 
@@ -283,7 +304,8 @@ def run_experiments(settings: RealMocapSettings) -> dict:
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
                "command": command,
                "epochs": settings.epochs, "preset": settings.preset, "seeds": seeds,
-               "labels": {"wave": label_table(waves), "bye": label_table(byes)}}
+               "labels": {"wave": label_table(waves), "bye": label_table(byes)},
+               "tempos": tempo_table(waves, references)}
 
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
     evaluation_started = time.process_time()

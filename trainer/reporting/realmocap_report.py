@@ -162,8 +162,11 @@ def cpu_list(entry):
 
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
+    tempos = results["tempos"]
     label_rows = [[style, f"{row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f}", f"{row['elevation_deg']:.0f}",
-                   f"{row['stroke_arm_lengths']:.2f}", f"{row['arm_correct']}/{row['clips']}"]
+                   f"{row['stroke_arm_lengths']:.2f}", f"{row['arm_correct']}/{row['clips']}",
+                   f"{tempos[style]['spectrum_hz']:.2f}", f"{tempos[style]['strokes_hz']:.2f}",
+                   f"{tempos[style]['stroke_cm']:.1f}"]
                   for style, row in results["labels"]["wave"].items()]
     score_rows, behaviour_rows, style_rows = [], [], []
     for name, label in (("wave", f"wave agent, takes 001-008 and 021-036 ({results['wave']['train_clips']} clips)"),
@@ -197,7 +200,14 @@ def realmocap_markdown(results):
                 "agent can sit a few points either side of the mean.**", ""] if len(results["seeds"]) == 1 else []),
              "## Auto-labels per style (one-arm waves: takes 001-010 and 021-036)", "",
              *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
-                              "arm detected"], label_rows),
+                              "arm detected", "tempo, spectrum (Hz)", "tempo, strokes (Hz)", "stroke (cm)"],
+                            label_rows),
+             "", "Tempo, median over the style's takes, read two ways: the peak of the hand's side-to-side "
+             "spectrum (how the trainer reads a training wave's rhythm, and the Tempo a request names), and "
+             "the strokes between turning points at least 8% of the shoulder width apart "
+             "(`core.behaviour_metrics.wave_measures`, whose frequency ratio the tables below report); stroke: "
+             "their median length. Where the strokes are small (a tremble) the two disagree, and the frequency "
+             "ratio judges a wave by the second.",
              "", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), "",
              "## Score and smoothness", "",
              "Every method answers each test take's request twice: with the take's auto-label and length (the "

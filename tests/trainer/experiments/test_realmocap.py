@@ -63,6 +63,10 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     tempo = wave_rhythm.clip_tempo(test[0])
     assert 0.5 < tempo < 5.0 and all(np.isfinite(result["score"]) for result in asked.values())
     assert asked["procedural_ik"]["clips"][0]["frequency_ratio"] == pytest.approx(1.0, abs=0.2)  # it swings at the tempo
+    tempos = realmocap.tempo_table(clips, references)
+    assert set(tempos) == {"feminine", "active", "normal"} and tempos["active"]["takes"] == 1
+    assert tempos["active"]["spectrum_hz"] == pytest.approx(tempos["active"]["strokes_hz"], rel=0.1)  # a clear swing
+    assert tempos["normal"]["spectrum_hz"] == pytest.approx(tempo) and tempos["active"]["stroke_cm"] > 10.0
     summary = seed_summary(comparison["rlanimate"])
     assert summary["clips"] == len(test) and 0 <= summary["accepted"] <= len(test)
     assert summary["aligned_score"] == comparison["rlanimate"]["by_behaviour"]["wave"]["aligned_score"]
