@@ -1,0 +1,76 @@
+"""The training-length search on real capture: its validation splits hold no test take, the choice of length,
+the script's settings and the page (trainer/experiments/realmocap_length.py)."""
+from types import SimpleNamespace
+
+import pytest
+
+from rlanimate_addon.core.errors import RLAnimateError
+from trainer.experiments import realmocap_length
+from trainer.motion import realmocap_takes
+from trainer.reporting.realmocap_length_report import length_markdown
+from trainer.scripts.realmocap_length import parse_settings
+
+
+def _takes():
+    """One clip per style, arm and take a real folder can hold (the withheld takes are never read)."""
+    takes = [f"{k:03d}" for k in range(1, 37) if f"{k:03d}" not in realmocap_takes.WITHHELD_TAKES]
+    return [SimpleNamespace(style=style, arm=arm, take=take)
+            for style in realmocap_takes.STYLES for arm in ("LEFT", "RIGHT") for take in takes]
+
+
+def test_each_validation_split_trains_within_its_experiments_training_takes_and_validates_on_no_test_take():
+    clips = _takes()
+    wave_train, wave_test = realmocap_takes.wave_split(clips)
+    unseen_train, unseen_test = realmocap_takes.style_holdout_split(clips)
+    tests = {id(c) for c in wave_test + unseen_test}
+    for split, trained in ((realmocap_takes.take_validation_split, wave_train),
+                           (realmocap_takes.style_validation_split, unseen_train)):
+        train, validation = split(clips)
+        assert train and validation and not {id(c) for c in train} & {id(c) for c in validation}
+        assert {id(c) for c in train} <= {id(c) for c in trained} and not {id(c) for c in validation} & tests
+    train, validation = realmocap_takes.take_validation_split(clips)
+    assert {c.take for c in validation} == {"007", "008"} and len(validation) == 5 * 2 * 2
+    assert {c.style for c in validation} == set(realmocap_takes.STYLES) - set(realmocap_takes.HOLDOUT_STYLES)
+    assert {c.take for c in train if c.style == "normal"} == set(realmocap_takes.TRAIN_TAKES) - {"007", "008"}
+    train, validation = realmocap_takes.style_validation_split(clips)
+    assert {c.style for c in validation} == {"normal"}
+    assert {c.take for c in validation} == {f"00{k}" for k in range(1, 9)}
+    assert {c.style for c in train} == {"active", "feminine", "masculine", "youthful"}
+
+
+def _summary(score, aligned):
+    return {"clips": 4, "score": score, "aligned_score": aligned, "swing_ratio_median": 1.0,
+            "frequency_ratio_median": 1.0, "elevation_last_error_median": 3.0, "accepted": 2}
+
+
+def test_the_chosen_length_has_the_best_mean_over_both_sets_and_the_shorter_wins_a_tie():
+    by_length = {50: {"takes": _summary(70, 80), "style": _summary(60, 62)},
+                 100: {"takes": _summary(76, 86), "style": _summary(56, 58)},  # better seen, worse unseen: +1 in all
+                 200: {"takes": _summary(80, 90), "style": _summary(50, 52)}}
+    assert realmocap_length.choose_length(by_length) == 100
+    by_length[50]["style"] = _summary(62, 64)  # now level with 100
+    assert realmocap_length.choose_length(by_length) == 50
+
+
+def test_the_script_takes_rising_lengths_only():
+    settings = parse_settings(["prog", "--lengths", "5", "10", "--seed", "2"])
+    assert (settings.lengths, settings.seed) == ((5, 10), 2)
+    assert "--lengths 5 10 --seed 2 --preset end_chunks" in realmocap_length.command_line(settings)
+    for lengths in ((10, 5), (), (0, 5)):
+        with pytest.raises(RLAnimateError, match="rising epoch counts"):
+            realmocap_length.LengthSettings(lengths=lengths)
+
+
+def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval():
+    entry = {"validates": "takes 007-008", "train_clips": 221, "validation_clips": 28,
+             "retrieval": {"paper": _summary(74, 90), "_tempo": _summary(80, 96)},
+             "by_length": {str(n): {"train_cpu_seconds": 5.0 * n, "paper": _summary(60 + n / 10, 80),
+                                    "_tempo": _summary(70, 85), "scoring_cpu_seconds": 1.0} for n in (50, 100)}}
+    page = length_markdown({"command": "cmd", "seed": 0, "preset": "end_chunks", "lengths": [50, 100],
+                            "experiments": {"takes": entry}, "chosen": 100})
+    assert "**Chosen: 100 epochs**" in page
+    rows = [line for line in page.splitlines() if line.startswith("| takes 007-008 (28) |")]
+    assert len(rows) == 6
+    assert rows[1] == ("| takes 007-008 (28) | the paper's | RLAnimate, 100 epochs | 70.0 | 80.0 | 1.00 | 1.00 | 3.0 "
+                       "| 2/28 | 500 |")
+    assert rows[2].startswith("| takes 007-008 (28) | the paper's | Nearest clip | 74.0 | 90.0 |")
