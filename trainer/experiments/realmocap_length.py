@@ -14,7 +14,7 @@ score and DTW score over both validation sets for the paper's request (the short
 retrieval from the same training takes is scored beside it.
 """
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +24,8 @@ from rlanimate_addon.core.errors import RLAnimateError
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines
-from trainer.experiments.realmocap import REQUESTS, compare, load_folder, real_run, train_real_runs
+from trainer.experiments.realmocap import (REQUESTS, RealMocapSettings, compare, load_folder, real_run,
+                                           train_real_runs)
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import require_realmocap, style_validation_split, take_validation_split
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
@@ -67,8 +68,12 @@ def run_lengths(settings: LengthSettings) -> dict:
     with blender_output():
         waves = load_folder("wave", root, Path(settings.runs) / "import_cache")
         env = FKEnvironment()
-    references = ClipReferences(env)
-    splits = {name: split(waves) for name, (split, _) in EXPERIMENTS.items()}
+    return length_results({name: split(waves) for name, (split, _) in EXPERIMENTS.items()}, settings, env,
+                          ClipReferences(env))
+
+
+def length_results(splits, settings, env, references):
+    """run_lengths's results for `splits` ({experiment of EXPERIMENTS: (train, validation) clips})."""
     results = {"command": command_line(settings), "seed": settings.seed, "preset": settings.preset,
                "lengths": list(settings.lengths), "experiments": {}}
     for name, (train, validation) in splits.items():
@@ -79,7 +84,7 @@ def run_lengths(settings: LengthSettings) -> dict:
                                                                    with_tempo)["r"])
                           for suffix, with_tempo in REQUESTS.items()}, "by_length": {}}
     runs = {(name, length): real_run(f"{name}_validation_{length}", train, validation, settings.seed,
-                                     replace(settings, epochs=length))
+                                     RealMocapSettings(epochs=length, preset=settings.preset, runs=settings.runs))
             for length in sorted(settings.lengths, reverse=True) for name, (train, validation) in splits.items()}
     reports = train_real_runs(runs.values(), workers=settings.workers)  # the longest first
     for (name, length), run in sorted(runs.items(), key=lambda item: item[0][1]):

@@ -5,8 +5,12 @@ from types import SimpleNamespace
 import pytest
 
 from rlanimate_addon.core.errors import RLAnimateError
-from trainer.experiments import realmocap_length
+from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.rig_session import new_empty_scene
+from trainer.experiments import realmocap, realmocap_length
 from trainer.motion import realmocap_takes
+from trainer.motion.fk import ClipReferences
+from trainer.paths import REALMOCAP_DIR
 from trainer.reporting.realmocap_length_report import length_markdown
 from trainer.scripts.realmocap_length import parse_settings
 
@@ -74,3 +78,25 @@ def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval()
     assert rows[1] == ("| takes 007-008 (28) | the paper's | RLAnimate, 100 epochs | 70.0 | 80.0 | 1.00 | 1.00 | 3.0 "
                        "| 2/28 | 500 |")
     assert rows[2].startswith("| takes 007-008 (28) | the paper's | Nearest clip | 74.0 | 90.0 |")
+
+
+@pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
+                    reason=f"real motion capture not found at {REALMOCAP_DIR} "
+                           "(../shared/realmocap/ beside the repository)")
+def test_each_length_is_trained_from_the_start_and_scored_on_the_validation_takes(tmp_path):
+    new_empty_scene()
+    clips = [realmocap.import_real_clip(REALMOCAP_DIR / "wave" / f"dataset-2_wave-left-hand_{name}.bvh",
+                                        tmp_path / "cache") for name in ("feminine_001", "active_002", "active_007")]
+    settings = realmocap_length.LengthSettings(lengths=(1, 2), preset="debug", runs=str(tmp_path), workers=1)
+    env = FKEnvironment(instances=4)
+    results = realmocap_length.length_results({"takes": realmocap_takes.take_validation_split(clips)}, settings, env,
+                                              ClipReferences(env))
+    entry = results["experiments"]["takes"]
+    assert (entry["train_clips"], entry["validation_clips"]) == (2, 1) and list(entry["by_length"]) == ["1", "2"]
+    for length in (1, 2):
+        report = (tmp_path / f"takes_validation_{length}_debug" / "report.json").read_text()
+        assert f'"epochs": {length}' in report
+        scored = entry["by_length"][str(length)]
+        assert scored["paper"]["clips"] == scored["_tempo"]["clips"] == 1 and scored["train_cpu_seconds"] > 0
+    assert entry["retrieval"]["paper"]["score"] > 90.0  # active 002 is the nearest clip to active 007
+    assert results["chosen"] in (1, 2)
