@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
+from rlanimate_addon.core import behaviours
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import new_empty_scene
