@@ -86,6 +86,18 @@ def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_c
     return [import_real_clip(p, cache_dir, labels) for p in paths]
 
 
+def waves_and_env(realmocap=REALMOCAP_DIR, runs=REALMOCAP_RUNS):
+    """(waves, env): the one-arm waves under `realmocap` (load_folder, through <runs>/import_cache) and an FK
+    environment, in a fresh scene with one torch thread: what the wave experiments score in."""
+    torch.set_num_threads(1)
+    new_empty_scene()
+    root = require_realmocap(realmocap)
+    with blender_output():
+        waves = load_folder("wave", root, Path(runs) / "import_cache")
+        env = FKEnvironment()
+    return waves, env
+
+
 class RealSession:
     """What trainer.experiments.run.train needs (env, references, train_clips, test_clips, problems), over real clips (every one
     imported: a take that does not import stops the experiment)."""

@@ -28,19 +28,16 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from rlanimate_addon.core import behaviours, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rhythm import RhythmModel
-from trainer.blender_io.fk_env import FKEnvironment
-from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import leave_one_out
-from trainer.experiments.realmocap import compare, load_folder, real_run, train_real_runs
+from trainer.experiments.realmocap import compare, real_run, train_real_runs, waves_and_env
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
-from trainer.motion.realmocap_takes import require_realmocap, style_holdout_split, wave_split
+from trainer.motion.realmocap_takes import style_holdout_split, wave_split
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.plots import wave_hand_paths
 from trainer.reporting.realmocap_ablation_report import RETRIEVAL, RETRIEVAL_TEMPO
@@ -186,12 +183,7 @@ def hand_path_panels(methods, clips, styles, env, references):
 def run_ablation(settings: AblationSettings) -> dict:
     """Train (or reuse) each experiment's agent and score every variant; the results dict the report writes.
     Draws docs/results/realmocap_ablation_paths.png."""
-    torch.set_num_threads(1)
-    new_empty_scene()
-    root = require_realmocap(settings.realmocap)
-    with blender_output():
-        waves = load_folder("wave", root, Path(settings.runs) / "import_cache")
-        env = FKEnvironment()
+    waves, env = waves_and_env(settings.realmocap, settings.runs)
     references = ClipReferences(env)
     splits = {name: EXPERIMENTS[name][0](waves) for name in settings.experiments}
     presets = {None: settings.preset, **{preset: preset for preset in settings.compare_presets}}

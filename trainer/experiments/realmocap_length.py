@@ -18,16 +18,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import torch
 
 from rlanimate_addon.core.errors import RLAnimateError
-from trainer.blender_io.fk_env import FKEnvironment
-from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines
-from trainer.experiments.realmocap import (REQUESTS, RealMocapSettings, compare, load_folder, real_run,
-                                           train_real_runs)
+from trainer.experiments.realmocap import (REQUESTS, RealMocapSettings, compare, real_run, train_real_runs,
+                                           waves_and_env)
 from trainer.motion.fk import ClipReferences
-from trainer.motion.realmocap_takes import require_realmocap, style_validation_split, take_validation_split
+from trainer.motion.realmocap_takes import style_validation_split, take_validation_split
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.realmocap_report import seed_summary
 
@@ -62,12 +59,7 @@ def choose_length(by_length):
 
 def run_lengths(settings: LengthSettings) -> dict:
     """Train each validation experiment's agent for each length and score it; the results dict."""
-    torch.set_num_threads(1)
-    new_empty_scene()
-    root = require_realmocap(settings.realmocap)
-    with blender_output():
-        waves = load_folder("wave", root, Path(settings.runs) / "import_cache")
-        env = FKEnvironment()
+    waves, env = waves_and_env(settings.realmocap, settings.runs)
     return length_results({name: split(waves) for name, (split, _) in EXPERIMENTS.items()}, settings, env,
                           ClipReferences(env))
 

@@ -22,6 +22,16 @@ def run_main(main, *args):
         return 2
 
 
+def add_real_capture_arguments(parser, defaults):
+    """--realmocap, --runs, --results and --workers, each defaulting to the field of that name of `defaults` (a
+    real-capture script's settings)."""
+    parser.add_argument("--realmocap", default=defaults.realmocap)
+    parser.add_argument("--runs", default=defaults.runs)
+    parser.add_argument("--results", default=defaults.results)
+    parser.add_argument("--workers", type=int, default=defaults.workers,
+                        help="training runs at a time on a local Ray (default: one per CPU)")
+
+
 def write_results(folder, name, results, page):
     """Write `results` to <folder>/<name>.json and the `page` to <folder>/<name>.md, and print the page."""
     folder = Path(folder)

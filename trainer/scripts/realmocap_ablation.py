@@ -12,7 +12,7 @@ import argparse
 
 from trainer.experiments.realmocap_ablation import EXPERIMENTS, AblationSettings, run_ablation
 from trainer.reporting.realmocap_ablation_report import ablation_markdown
-from trainer.scripts.cli import run_main, script_args, write_results
+from trainer.scripts.cli import add_real_capture_arguments, run_main, script_args, write_results
 
 DEFAULTS = AblationSettings()
 
@@ -27,11 +27,7 @@ def build_parser():
     parser.add_argument("--preset", default=DEFAULTS.preset, help="the agents whose play-time settings vary")
     parser.add_argument("--compare-presets", nargs="*", default=list(DEFAULTS.compare_presets),
                         help="agents trained with these presets too, played as trained and asked the tempo")
-    parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
-    parser.add_argument("--runs", default=DEFAULTS.runs)
-    parser.add_argument("--results", default=DEFAULTS.results)
-    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
-                        help="training runs at a time on a local Ray (default: one per CPU)")
+    add_real_capture_arguments(parser, DEFAULTS)
     return parser
 
 

@@ -10,7 +10,7 @@ import argparse
 
 from trainer.experiments.realmocap_length import LengthSettings, run_lengths
 from trainer.reporting.realmocap_length_report import length_markdown
-from trainer.scripts.cli import run_main, script_args, write_results
+from trainer.scripts.cli import add_real_capture_arguments, run_main, script_args, write_results
 
 DEFAULTS = LengthSettings()
 
@@ -22,11 +22,7 @@ def build_parser():
                         help="epoch counts to compare, rising (default 50 100 200)")
     parser.add_argument("--seed", type=int, default=DEFAULTS.seed, help="the agents' training seed")
     parser.add_argument("--preset", default=DEFAULTS.preset)
-    parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
-    parser.add_argument("--runs", default=DEFAULTS.runs)
-    parser.add_argument("--results", default=DEFAULTS.results)
-    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
-                        help="training runs at a time on a local Ray (default: one per CPU)")
+    add_real_capture_arguments(parser, DEFAULTS)
     return parser
 
 
