@@ -140,15 +140,15 @@ class RhythmModel:
     def weights(self, exaggeration: float, tempo: float | None = None) -> np.ndarray:
         """(K,) how much each training wave weighs in a request of this exaggeration (sum 1); with
         `typical_tempo`, near its tempo too (cycles per frame; None: the typical one)."""
-        weights = _kernel(self.examples[:, 0] - float(exaggeration), self.bandwidth)
+        log_kernel = _log_gaussian(self.examples[:, 0] - float(exaggeration), self.bandwidth)  # (K,)
         if not self.typical_tempo:
-            return weights
-        log_tempos = np.log(self._frequencies())
+            return _normalised(log_kernel)
+        log_tempos = np.log(self._frequencies())  # (K,)
         if tempo is None:
-            density = _gaussian(log_tempos[:, None] - log_tempos[None, :], TEMPO_BANDWIDTH) @ weights  # (K,)
-            tempo = self._frequencies()[np.argmax(density)]
-        weights = weights * _kernel(log_tempos - math.log(max(float(tempo), _SLOWEST)), TEMPO_BANDWIDTH)
-        return weights / weights.sum()
+            nearby = np.exp(_log_gaussian(log_tempos[:, None] - log_tempos[None, :], TEMPO_BANDWIDTH))  # (K, K)
+            tempo = self._frequencies()[np.argmax(nearby @ _normalised(log_kernel))]  # the densest tempo
+        return _normalised(log_kernel + _log_gaussian(log_tempos - math.log(max(float(tempo), _SLOWEST)),
+                                                      TEMPO_BANDWIDTH))
 
     def _frequencies(self):
         return np.maximum(self.examples[:, 1 + PARAMETERS.index("frequency")], _SLOWEST)
@@ -180,13 +180,11 @@ class RhythmModel:
 _SLOWEST = 1e-6
 
 
-def _gaussian(differences, bandwidth):
-    return np.exp(-0.5 * (differences / bandwidth) ** 2)
+def _log_gaussian(differences, bandwidth):
+    return -0.5 * (differences / bandwidth) ** 2
 
 
-def _kernel(differences, bandwidth):
-    """(K,) Gaussian weights (sum 1) of `differences` in units of `bandwidth`, shifted so that far ones still
-    have weights."""
-    squared = (differences / bandwidth) ** 2
-    kernel = np.exp(-0.5 * (squared - squared.min()))
-    return kernel / kernel.sum()
+def _normalised(log_weights):
+    """Weights (sum 1) from their logarithms, shifted so that far ones still have weights."""
+    weights = np.exp(log_weights - log_weights.max())
+    return weights / weights.sum()
