@@ -93,7 +93,8 @@ def ablation_markdown(results):
                        for entry in results["experiments"].values())
     lines = ["# The wave's rhythm and tempo at play time, and the training preset, on real capture (an ablation)", "",
              f"One agent per test set (training seed {results['seed']}, preset `{results['preset']}`, "
-             f"{results['epochs']} epochs: the agents of docs/results/realmocap.md), played with different "
+             f"{results['epochs']} epochs: the agents `trainer.scripts.realmocap --epochs {results['epochs']}` "
+             "trains), played with different "
              "rhythm settings and nothing retrained, beside the same seed's agents of other presets "
              "(trainer/experiments/realmocap_ablation.py). Every method answers each held-out take's own request "
              "(its auto-label and length, and where it says so the take's tempo) and is scored against it as in "

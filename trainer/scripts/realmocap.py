@@ -1,7 +1,7 @@
 """Train on real motion capture and compare with the baselines: docs/results/realmocap.json and .md, the
 real-data section of docs/results/baselines.json and .md, docs/results/realmocap_frames.png.
 
-    nice -n 15 python -m trainer.scripts.realmocap [--epochs 50] [--seeds 0 1 2] [--point-agent PATH]
+    nice -n 15 python -m trainer.scripts.realmocap [--epochs 100] [--seeds 0 1 2] [--point-agent PATH]
                                                    [--workers N | --address auto]
 
 Each (experiment, seed) trains as a Ray task (trainer/cluster.py). Finished runs are reused: seed 0's in
@@ -22,7 +22,8 @@ def build_parser():
     parser = argparse.ArgumentParser(prog="python -m trainer.scripts.realmocap", description=__doc__.split("\n\n")[0])
     parser.add_argument("--realmocap", default=DEFAULTS.realmocap)
     parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs,
-                        help="iterations of Algorithm 1 per agent (paper: 50)")
+                        help="iterations of Algorithm 1 per agent (default 100, chosen on validation takes: "
+                             "docs/results/realmocap_length.md; paper: 50)")
     parser.add_argument("--preset", default=DEFAULTS.preset)
     parser.add_argument("--seeds", type=int, nargs="+", default=list(DEFAULTS.seeds),
                         help="training seeds; the first seed's agents give the full tables and the figure")
