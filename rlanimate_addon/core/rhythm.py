@@ -143,10 +143,11 @@ class RhythmModel:
         log_kernel = _log_gaussian(self.examples[:, 0] - float(exaggeration), self.bandwidth)  # (K,)
         if not self.typical_tempo:
             return _normalised(log_kernel)
-        log_tempos = np.log(self._frequencies())  # (K,)
+        frequencies = self._frequencies()
+        log_tempos = np.log(frequencies)  # (K,)
         if tempo is None:
             nearby = np.exp(_log_gaussian(log_tempos[:, None] - log_tempos[None, :], TEMPO_BANDWIDTH))  # (K, K)
-            tempo = self._frequencies()[np.argmax(nearby @ _normalised(log_kernel))]  # the densest tempo
+            tempo = frequencies[np.argmax(nearby @ _normalised(log_kernel))]  # the densest tempo
         return _normalised(log_kernel + _log_gaussian(log_tempos - math.log(max(float(tempo), _SLOWEST)),
                                                       TEMPO_BANDWIDTH))
 

@@ -140,24 +140,20 @@ def variant_methods(agents, train_clips, variants):
                                   v.rhythm_seed, v.state_seed) for v in variants}
 
 
-def style_phases(train_clips):
+def style_phases(read):
     """{style: {phase (circular mean, radians), concentration (its resultant length, 0-1), waves}} of the
-    phases at which the training waves that swing start their swing (wave_rhythm.clip_rhythm)."""
+    phases at which the training waves that swing start their swing (`read`: wave_rhythm.swinging)."""
     by_style = defaultdict(list)
-    for clip in train_clips:
-        read = wave_rhythm.clip_rhythm(clip)
-        if read is not None:
-            by_style[clip.style].append(read.phase)
+    for clip, rhythm in read:
+        by_style[clip.style].append(rhythm.phase)
     means = {style: np.mean(np.exp(1j * np.array(phases))) for style, phases in by_style.items()}
     return {style: {"phase": float(np.angle(mean)), "concentration": float(abs(mean)), "waves": len(by_style[style])}
             for style, mean in sorted(means.items())}
 
 
-def rule_checks(train_clips):
-    """{rule: rhythm_leave_one_out.leave_one_out} over the training waves that swing, for the typical tempo and
-    the mean rhythm: the rule judged on training waves alone."""
-    read = [(clip, r) for clip in train_clips
-            if clip.behaviour == behaviours.WAVE and (r := wave_rhythm.clip_rhythm(clip)) is not None]
+def rule_checks(read):
+    """{rule: rhythm_leave_one_out.leave_one_out} over the training waves that swing (`read`:
+    wave_rhythm.swinging), for the typical tempo and the mean rhythm: the rule judged on training waves alone."""
     arguments = ([float(np.ravel(c.attributes)[0]) for c, _ in read], [r for _, r in read],
                  [len(c.rotvecs) for c, _ in read])
     return {"typical tempo": leave_one_out(*arguments, typical_tempo=True),
@@ -199,6 +195,7 @@ def run_ablation(settings: AblationSettings) -> dict:
         agents = {key: baselines.AgentMethod(Path(runs[name, key].settings.output) / "agent.npz") for key in presets}
         methods = variant_methods(agents, train, variants)
         retrieval = baselines.NearestClip(train)
+        read = wave_rhythm.swinging([clip for clip in train if clip.behaviour == behaviours.WAVE])  # read once
         scored = {**compare({**{v.name: methods[v.name] for v in variants if not v.tempo}, RETRIEVAL: retrieval},
                             test, env, references),
                   **compare({**{v.name: methods[v.name] for v in variants if v.tempo}, RETRIEVAL_TEMPO: retrieval},
@@ -207,7 +204,7 @@ def run_ablation(settings: AblationSettings) -> dict:
         results["experiments"][name] = {
             "test_set": EXPERIMENTS[name][1], "train_clips": len(train), "test_clips": len(test),
             "train_seconds": report["train_seconds"], "phase_of_all": agents[None].agent.rhythm_model.phase,
-            "style_phases": style_phases(train), "rule_checks": rule_checks(train),
+            "style_phases": style_phases(read), "rule_checks": rule_checks(read),
             "summaries": {method: seed_summary(scored[method]) for method in [v.name for v in variants]
                           + [RETRIEVAL, RETRIEVAL_TEMPO]}}
         shown = {f"{settings.preset}, as exported": (methods[VARIANTS[0].name], False),

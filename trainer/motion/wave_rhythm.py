@@ -93,8 +93,13 @@ def clip_tempo(clip):
     return None if read is None else read.frequency * clip.fps
 
 
+def swinging(waves):
+    """[(clip, its Rhythm)] of the wave clips whose hand swings side to side (clip_rhythm), in their order."""
+    return [(clip, read) for clip in waves if (read := clip_rhythm(clip)) is not None]
+
+
 def fit_rhythm_model(waves):
-    """The RhythmModel of wave clips, fitted on those whose hand swings (clip_rhythm) by their exaggeration
+    """The RhythmModel of wave clips, fitted on those whose hand swings (`swinging`) by their exaggeration
     (`.attributes`)."""
-    swinging = [(clip.attributes, read) for clip in waves if (read := clip_rhythm(clip)) is not None]
-    return rhythm.RhythmModel.fit([e for e, _ in swinging], [r for _, r in swinging])
+    read = swinging(waves)
+    return rhythm.RhythmModel.fit([clip.attributes for clip, _ in read], [r for _, r in read])

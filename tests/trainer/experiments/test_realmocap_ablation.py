@@ -37,7 +37,7 @@ def test_an_agent_file_without_phases_gets_its_training_waves_phases_read_again(
         realmocap_ablation.rhythm_with_phases(older, waves[::-1])
     for clip in waves:
         clip.style = "normal" if clip.arm == "LEFT" else "active"
-    phases = realmocap_ablation.style_phases(waves)
+    phases = realmocap_ablation.style_phases(wave_rhythm.swinging(waves))
     left = np.exp(1j * fitted.phases[::2])
     assert phases["normal"] == {"phase": pytest.approx(np.angle(left.mean())),
                                 "concentration": pytest.approx(abs(left.mean())), "waves": 3}
