@@ -528,7 +528,7 @@ def gesture_rotations(agent, request, rig):
     rest_heads = rig.rest_heads
     check_length(request.frame_count)
     span = request.agent_frames  # M: the gesture's seconds at the agent's rate
-    rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed, request.tempo)
+    rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed, request.tempo, request.arm)
               if request.behaviour == behaviours.WAVE else None)
     if request.targets is not None:
         check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))

@@ -11,7 +11,7 @@ into a still arm. Here the wave's attributes are [exaggeration, A_t sin(phi_t), 
 with start and stop in frames (given as fractions of the gesture, so a longer gesture swings for
 proportionally longer). During training the task module reads these from each clip
 (trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves near
-the request: near its exaggeration, and near its tempo in log Hz. The tempo is the one the request names
+the request: of its arm, near its exaggeration, and near its tempo in log Hz. The tempo is the one the request names
 (the panel's Tempo), or else the typical tempo of the waves near its exaggeration: the mode of their
 tempos, not their mean. Styles of one exaggeration can swing at different rates (real masculine and
 normal waves: 0.67 ± 0.06 and 0.62 ± 0.10, at 0.85 and 1.6 Hz; docs/REALMOCAP.md), and the mean of two
@@ -21,7 +21,10 @@ one of them (by weight) at any phase, so seeds vary the phase, rate and number o
 those waves do. A named tempo sets the rate.
 Files exported before the training waves' phases were kept (`phases` None) play as they were made: the
 rate, start and stop near the exaggeration alone at the circular mean phase of all the training waves
-(`typical_tempo` False; docs/results/realmocap_ablation.md compares the two).
+(`typical_tempo` False; docs/results/realmocap_ablation.md compares the two), and files exported before
+the waves' arms were kept (`arms` None) take the waves of both arms. A left-arm and a right-arm wave are two
+takes, as retrieval treats them: on real capture a request of one arm near the other arm's waves of another
+style swung at their rate (docs/results/realmocap_length.md).
 """
 import math
 from collections.abc import Sequence
@@ -30,6 +33,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from .errors import RLAnimateError
+from .skeleton import ARMS
 
 #: The parameters of a rhythm that a request takes from the training waves of nearby exaggeration.
 PARAMETERS = ("frequency", "start", "stop")
@@ -40,8 +44,10 @@ TEMPO_MARGIN = 1.25
 #: rhythm is a local average, not a line through all the waves.
 BANDWIDTH = 0.05
 #: Log Hz: the training waves within about this of a request's tempo (asked or typical) weigh in its rhythm
-#: (a Gaussian kernel's sd): a rate within the frequency ratio's tolerance of 1.25 is the same tempo.
-TEMPO_BANDWIDTH = math.log(1.25)
+#: (a Gaussian kernel's sd; a file may keep its own, `tempo_bandwidth`). Chosen among log 1.05-1.25 on
+#: validation takes (docs/results/realmocap_length.md): at log 1.25 the fast normal waves (1.6 Hz) beside
+#: youthful's label (1.1 Hz) still weighed enough to make youthful swing 15% fast and drift out of step.
+TEMPO_BANDWIDTH = math.log(1.1)
 
 
 @dataclass(frozen=True)
@@ -78,37 +84,51 @@ class RhythmModel:
     the envelope ramp in frames; the kernel bandwidth in exaggeration; `phases` (K,): each training
     wave's phase (None in files exported before they were kept); `typical_tempo`: the waves near the
     request's tempo weigh in its rhythm, and theirs is its phase (it needs `phases`; None: on when they
-    are there).
+    are there); `tempo_bandwidth`: that tempo kernel's sd in log Hz; `arms` (K,): each training wave's arm
+    ("LEFT" or "RIGHT"; None in files exported before they were kept), a request weighing only its own arm's.
     """
 
-    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, typical_tempo=None):
+    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, typical_tempo=None,
+                 tempo_bandwidth=TEMPO_BANDWIDTH, arms=None):
         self.examples = np.asarray(examples, dtype=np.float64)
         self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
         self.phases = None if phases is None else np.asarray(phases, dtype=np.float64)
         self.typical_tempo = self.phases is not None if typical_tempo is None else typical_tempo
+        self.tempo_bandwidth = float(tempo_bandwidth)
+        self.arms = None if arms is None else tuple(arms)
 
     @classmethod
-    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm]) -> "RhythmModel":
-        """From the training clips' exaggerations (K,) and their Rhythms (K)."""
+    def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm],
+            arms: Sequence[str] | None = None) -> "RhythmModel":
+        """From the training clips' exaggerations (K,), their Rhythms (K) and arms (K; None: not known)."""
         if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
                                  "side: add such wave clips.")
         examples = [[float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms)]
         phases = np.array([r.phase for r in rhythms])
         phase = float(np.angle(np.mean(np.exp(1j * phases))))
-        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases)
+        return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases, arms=arms)
 
-    def with_settings(self, bandwidth=None, typical_tempo=None) -> "RhythmModel":
-        """The same training waves with another kernel bandwidth and/or choice of `typical_tempo` (None: keep
-        this one's)."""
+    def with_settings(self, bandwidth=None, typical_tempo=None, tempo_bandwidth=None) -> "RhythmModel":
+        """The same training waves with another kernel bandwidth, choice of `typical_tempo` and/or tempo kernel
+        (None: keep this one's)."""
         return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth if bandwidth is None else bandwidth,
-                           self.phases, self.typical_tempo if typical_tempo is None else typical_tempo)
+                           self.phases, self.typical_tempo if typical_tempo is None else typical_tempo,
+                           self.tempo_bandwidth if tempo_bandwidth is None else tempo_bandwidth, self.arms)
+
+    def without_arms(self) -> "RhythmModel":
+        """The same training waves, a request weighing both arms' (as files made before the arms were kept)."""
+        return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth, self.phases, self.typical_tempo,
+                           self.tempo_bandwidth)
 
     def to_dict(self) -> dict:
         values = {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
                   "bandwidth": self.bandwidth}
         if self.phases is not None:
-            values.update(phases=self.phases.tolist(), typical_tempo=self.typical_tempo)
+            values.update(phases=self.phases.tolist(), typical_tempo=self.typical_tempo,
+                          tempo_bandwidth=self.tempo_bandwidth)
+        if self.arms is not None:
+            values["arms"] = list(self.arms)
         return values
 
     @classmethod
@@ -118,7 +138,8 @@ class RhythmModel:
             model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
                         float(values["ramp"]), float(values["bandwidth"]),
                         None if phases is None else np.asarray(phases, dtype=np.float64),
-                        values.get("typical_tempo"))
+                        values.get("typical_tempo"), values.get("tempo_bandwidth", TEMPO_BANDWIDTH),
+                        values.get("arms"))
             if not isinstance(model.typical_tempo, bool):
                 raise TypeError("typical_tempo must be true or false")
         except (KeyError, TypeError, ValueError) as error:
@@ -127,29 +148,35 @@ class RhythmModel:
         shape_ok = model.examples.ndim == 2 and model.examples.shape[0] >= 2 \
             and model.examples.shape[1] == 1 + len(PARAMETERS)
         phases_ok = model.phases is None or model.phases.shape == model.examples.shape[:1]
-        numbers = np.concatenate([model.examples.ravel(), [model.phase, model.ramp, model.bandwidth],
+        arms_ok = model.arms is None or (len(model.arms) == len(model.examples) and set(model.arms) <= set(ARMS))
+        numbers = np.concatenate([model.examples.ravel(),
+                                  [model.phase, model.ramp, model.bandwidth, model.tempo_bandwidth],
                                   [] if model.phases is None else model.phases])
-        if not (shape_ok and phases_ok) or not np.all(np.isfinite(numbers)) or model.ramp <= 0 \
-                or model.bandwidth <= 0 or (model.typical_tempo and model.phases is None):
+        positive = min(model.ramp, model.bandwidth, model.tempo_bandwidth) > 0
+        if not (shape_ok and phases_ok and arms_ok and positive) or not np.all(np.isfinite(numbers)) \
+                or (model.typical_tempo and model.phases is None):
             raise RLAnimateError(f"The agent's wave_rhythm metadata holds invalid numbers (need at least 2 "
                                  f"examples of {1 + len(PARAMETERS)} finite numbers, a finite phase for each "
-                                 f"when typical_tempo is on, and a positive ramp and bandwidth): re-export the "
-                                 f"agent.")
+                                 f"when typical_tempo is on, LEFT or RIGHT for each of any arms, and a positive ramp, "
+                                 f"bandwidth and tempo_bandwidth): re-export the agent.")
         return model
 
-    def weights(self, exaggeration: float, tempo: float | None = None) -> np.ndarray:
-        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1); with
+    def weights(self, exaggeration: float, tempo: float | None = None, arm: str | None = None) -> np.ndarray:
+        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1): only those of
+        its `arm` when the file keeps the arms and has any of that arm (None: both arms'); with
         `typical_tempo`, near its tempo too (cycles per frame; None: the typical one)."""
         log_kernel = _log_gaussian(self.examples[:, 0] - float(exaggeration), self.bandwidth)  # (K,)
+        if self.arms is not None and arm in self.arms:
+            log_kernel = np.where(np.array(self.arms) == arm, log_kernel, -np.inf)
         if not self.typical_tempo:
             return _normalised(log_kernel)
         frequencies = self._frequencies()
         log_tempos = np.log(frequencies)  # (K,)
         if tempo is None:
-            nearby = np.exp(_log_gaussian(log_tempos[:, None] - log_tempos[None, :], TEMPO_BANDWIDTH))  # (K, K)
+            nearby = np.exp(_log_gaussian(log_tempos[:, None] - log_tempos[None, :], self.tempo_bandwidth))  # (K, K)
             tempo = frequencies[np.argmax(nearby @ _normalised(log_kernel))]  # the densest tempo
         return _normalised(log_kernel + _log_gaussian(log_tempos - math.log(max(float(tempo), _SLOWEST)),
-                                                      TEMPO_BANDWIDTH))
+                                                      self.tempo_bandwidth))
 
     def _frequencies(self):
         return np.maximum(self.examples[:, 1 + PARAMETERS.index("frequency")], _SLOWEST)
@@ -160,11 +187,12 @@ class RhythmModel:
         frequencies = self.examples[:, 1 + PARAMETERS.index("frequency")]
         return float(frequencies.min() / TEMPO_MARGIN), float(frequencies.max() * TEMPO_MARGIN)
 
-    def draw(self, exaggeration: float, seed: int | None = None, tempo: float | None = None) -> Rhythm:
-        """The Rhythm for a wave of this exaggeration: for seed None the weighted mean of the training
+    def draw(self, exaggeration: float, seed: int | None = None, tempo: float | None = None,
+             arm: str | None = None) -> Rhythm:
+        """The Rhythm for a wave of this exaggeration by `arm`: for seed None the weighted mean of the training
         waves' rhythms (`weights`), else a seeded draw of one training wave's (by weight) at any phase; at
         `tempo` (cycles per frame; the caller keeps it within tempo_range) when given."""
-        weights = self.weights(exaggeration, tempo)
+        weights = self.weights(exaggeration, tempo, arm)
         if seed is None:
             values = weights @ self.examples[:, 1:]
             phase = float(np.angle(weights @ np.exp(1j * self.phases))) if self.typical_tempo else self.phase

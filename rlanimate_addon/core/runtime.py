@@ -164,10 +164,10 @@ class GestureAgent:
         self._from_a = cell_a  # (A, 3E)
 
     def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None,
-                    tempo: float | None = None) -> np.ndarray | None:
+                    tempo: float | None = None, arm: str | None = None) -> np.ndarray | None:
         """(N, 2) rhythm signals for a wave's objectives (ObjectiveSpace.make_objective), drawn as core/rhythm.py
-        says (the training waves' mean for seed None) at `tempo` (Hz; None: the training waves'), or None for
-        an agent without a rhythm model."""
+        says (the training waves' mean for seed None; those of `arm` where the file keeps them) at `tempo` (Hz;
+        None: the training waves'), or None for an agent without a rhythm model."""
         if self.rhythm_model is None:
             if tempo is not None:
                 raise RLAnimateError("This agent was trained without the waves' rhythm, so it cannot wave at a "
@@ -179,7 +179,7 @@ class GestureAgent:
                 raise RLAnimateError(f"A tempo of {float(tempo):.2f} Hz is outside what this agent learned: set "
                                      f"Tempo between {low:.2f} and {high:.2f} Hz, or to 0 to let the agent choose.")
             tempo = float(tempo) / frame_rate.AGENT_FPS
-        return rhythm.signals(self.rhythm_model.draw(exaggeration, seed, tempo), frame_count)
+        return rhythm.signals(self.rhythm_model.draw(exaggeration, seed, tempo, arm), frame_count)
 
     def tempo_range(self) -> tuple[float, float] | None:
         """(slowest, fastest) wave tempo in Hz a request may ask (RhythmModel.tempo_range), or None for an agent

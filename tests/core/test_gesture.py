@@ -31,7 +31,7 @@ class ReplayAgent:
         self.calls.append((np.array(objectives), seed))
         return gesture.resample(self.actions, len(objectives))
 
-    def wave_rhythm(self, exaggeration, frame_count, seed=None, tempo=None):
+    def wave_rhythm(self, exaggeration, frame_count, seed=None, tempo=None, arm=None):
         return None  # the paper's wave objective
 
 

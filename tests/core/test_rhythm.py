@@ -63,6 +63,8 @@ def test_the_model_round_trips_through_its_dict_and_refuses_a_broken_one():
         rhythm.RhythmModel.from_dict({**model.to_dict(), "examples": [[0.5, 0.07, 0.2]] * 3})
     with pytest.raises(RLAnimateError, match="wave_rhythm"):
         rhythm.RhythmModel.from_dict({**model.to_dict(), "ramp": float("nan")})
+    with pytest.raises(RLAnimateError, match="tempo_bandwidth"):
+        rhythm.RhythmModel.from_dict({**model.to_dict(), "tempo_bandwidth": 0.0})
     with pytest.raises(RLAnimateError, match="at least 2"):
         rhythm.RhythmModel.fit([0.5], rhythms[:1])
 
@@ -125,9 +127,14 @@ def test_the_typical_tempo_is_one_styles_not_the_mean_of_two():
 def test_the_rhythm_settings_round_trip_and_broken_ones_are_refused():
     e, rhythms = _two_styles_of_one_exaggeration()
     model = rhythm.RhythmModel.fit(e, rhythms)
-    for settings in (model, model.with_settings(typical_tempo=False)):
+    for settings in (model, model.with_settings(typical_tempo=False), model.with_settings(tempo_bandwidth=0.5)):
         again = rhythm.RhythmModel.from_dict(settings.to_dict())
         assert again.typical_tempo == settings.typical_tempo and again.draw(0.51) == settings.draw(0.51)
+        assert again.tempo_bandwidth == settings.tempo_bandwidth
+    unkept = {key: value for key, value in model.to_dict().items() if key != "tempo_bandwidth"}
+    assert rhythm.RhythmModel.from_dict(unkept).tempo_bandwidth == rhythm.TEMPO_BANDWIDTH  # files before it was kept
+    wide = model.with_settings(tempo_bandwidth=np.log(2.5))  # so wide that the fast style weighs in the slow one's
+    assert wide.draw(0.51).frequency > 1.05 * model.draw(0.51).frequency
     older = {key: value for key, value in model.to_dict().items() if key not in ("phases", "typical_tempo")}
     for broken in ({**older, "typical_tempo": True}, {**model.to_dict(), "phases": [0.1, 0.2]},
                    {**model.to_dict(), "typical_tempo": "yes"}):
@@ -138,9 +145,40 @@ def test_the_rhythm_settings_round_trip_and_broken_ones_are_refused():
 def test_a_requested_tempo_sets_the_rate_and_the_training_waves_the_rest():
     e, rhythms = _training_rhythms()
     model = rhythm.RhythmModel.fit(e, rhythms)
-    for seed in (None, 5):  # one style near 0.52: the tempo changes the rate, and weighs its takes a little
+    for seed in (None, 5):  # one style near 0.52: the tempo changes the rate, and weighs its faster takes more
         own, asked = model.draw(0.52, seed), model.draw(0.52, seed, tempo=0.05)
         assert asked.frequency == 0.05
         assert (asked.start, asked.stop, asked.ramp) == pytest.approx((own.start, own.stop, own.ramp))
-        assert abs(np.angle(np.exp(1j * (asked.phase - own.phase)))) < (0.1 if seed is None else np.pi)
+    assert 0.45 < model.draw(0.52).phase < model.draw(0.52, tempo=0.05).phase < 0.9  # within the style's takes'
     assert model.tempo_range() == pytest.approx((0.028 / rhythm.TEMPO_MARGIN, 0.075 * 1.06 * rhythm.TEMPO_MARGIN))
+
+
+def _two_arms_of_one_exaggeration():
+    """At exaggeration 0.5, left-arm takes that swing slowly and right-arm takes of another style that swing
+    fast, and a right-arm style far away."""
+    e, rhythms, arms = [], [], []
+    for exaggeration, rate, phase, arm in ((0.5, 0.03, 1.0, "LEFT"), (0.5, 0.06, -2.0, "RIGHT"),
+                                           (0.9, 0.07, 0.0, "RIGHT")):
+        for take in range(4):
+            e.append(exaggeration + 0.005 * take)
+            rhythms.append(rhythm.Rhythm(rate * (1.0 + 0.02 * take), 0.1, 0.8, phase, 9.0))
+            arms.append(arm)
+    return np.array(e), rhythms, arms
+
+
+def test_a_request_weighs_the_waves_of_its_own_arm_when_the_file_keeps_them():
+    e, rhythms, arms = _two_arms_of_one_exaggeration()
+    model = rhythm.RhythmModel.fit(e, rhythms, arms)
+    left, right = model.draw(0.51, arm="LEFT"), model.draw(0.51, arm="RIGHT")
+    assert left.frequency == pytest.approx(0.0309, rel=0.02) and left.phase == pytest.approx(1.0)
+    assert right.frequency == pytest.approx(0.0618, rel=0.02) and right.phase == pytest.approx(-2.0)
+    assert model.weights(0.51, arm="LEFT")[4:].sum() == 0.0  # no right-arm wave weighs in a left-arm request
+    assert {model.draw(0.51, seed, arm="LEFT").frequency for seed in range(1, 20)} <= {r.frequency for r in rhythms[:4]}
+    assert model.draw(0.51) == model.without_arms().draw(0.51, arm="LEFT")  # no arm, or no arms kept: both arms'
+    assert model.without_arms().arms is None and model.with_settings(bandwidth=0.02).arms == model.arms
+    again = rhythm.RhythmModel.from_dict(model.to_dict())
+    assert again.arms == tuple(arms) and again.draw(0.51, arm="RIGHT") == right
+    assert "arms" not in model.without_arms().to_dict()
+    for broken in (arms[:-1], arms[:-1] + ["MIDDLE"]):
+        with pytest.raises(RLAnimateError, match="LEFT or RIGHT for each of any arms"):
+            rhythm.RhythmModel.from_dict({**model.to_dict(), "arms": broken})

@@ -152,16 +152,18 @@ class AgentMethod:
         return agent_motion(self.agent, behaviour, arm, attributes, frame_count, seed, seed, tempo)
 
 
-def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=None, state_seed=None, tempo=None):
+def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=None, state_seed=None, tempo=None,
+                 rhythm_signals=None):
     """(F, 15, 3) rotations the runtime agent (core.runtime.GestureAgent) plays for the request: a wave's
-    rhythm drawn with `rhythm_seed` (RhythmModel.draw) at `tempo` (Hz; None: the agent's), the stochastic
-    states sampled with `state_seed` (None: their means). A tempo beyond what the agent learned is played at
-    the nearest it allows, as an animator would set it when the panel refuses theirs (real goodbye waves
-    reach 4.5 Hz)."""
+    rhythm drawn with `rhythm_seed` (RhythmModel.draw) at `tempo` (Hz; None: the agent's), or the
+    `rhythm_signals` given ((F, 2), core.rhythm.signals), the stochastic states sampled with `state_seed`
+    (None: their means). A tempo beyond what the agent learned is played at the nearest it allows, as an
+    animator would set it when the panel refuses theirs (real goodbye waves reach 4.5 Hz)."""
     if tempo is not None and agent.tempo_range() is not None:
         tempo = float(np.clip(tempo, *agent.tempo_range()))
-    signals = (agent.wave_rhythm(attributes, frame_count, rhythm_seed, tempo) if behaviour == behaviours.WAVE
-               else None)
+    signals = rhythm_signals
+    if signals is None and behaviour == behaviours.WAVE:
+        signals = agent.wave_rhythm(attributes, frame_count, rhythm_seed, tempo, arm)
     objectives = agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
     return spaces.decode_action(agent.rollout(objectives, seed=state_seed), np.asarray(agent.action_bounds))
 

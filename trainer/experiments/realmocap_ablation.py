@@ -10,8 +10,13 @@ against that take as trainer.experiments.realmocap scores it (realmocap.compare)
                                       exaggeration and near the typical tempo of those, at their weighted
                                       circular mean phase
     mean rhythm, all waves' phase     as files without their waves' phases play: the weighted mean of the
-                                      waves near the exaggeration alone, at the circular mean phase of all
+                                      waves of both arms near the exaggeration alone, at the circular mean
+                                      phase of all
     ..., kernel sd 0.02               the typical tempo with a tighter exaggeration kernel than BANDWIDTH
+    ..., tempo kernel sd log 1.25     the typical tempo with the wider tempo kernel it had before
+                                      TEMPO_BANDWIDTH was chosen on validation takes
+    ..., both arms' waves             the typical tempo from the training waves of both arms, as files made
+                                      before the waves' arms were kept play it
     sampled states N                  the typical tempo, the stochastic states sampled with seed N
     seed N                            a seeded draw, as the panel plays a Variation Seed N > 0: one nearby
                                       training wave's rhythm at a random phase, and sampled stochastic states
@@ -19,9 +24,11 @@ against that take as trainer.experiments.realmocap scores it (realmocap.compare)
                                       baselines.request_tempo), the rest as the typical tempo [mean rhythm]
     preset P[, tempo asked]           the agent trained with another preset (`compare_presets`), as exported
 Nearest-clip retrieval from the same training clips is the bar, for the plain request and for the one naming the
-tempo. No variant retrains anything.
+tempo. No variant retrains anything. Beside them, OWN_RHYTHM plays each take's own rhythm: not a method (the request
+cannot say it), but how much of the agent's gap is its rhythm rather than its poses.
 """
 import copy
+import math
 import time
 from collections import defaultdict
 from dataclasses import dataclass, replace
@@ -29,11 +36,11 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, spaces
+from rlanimate_addon.core import behaviours, rhythm, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rhythm import RhythmModel
 from trainer.evaluation import baselines
-from trainer.evaluation.rhythm_leave_one_out import leave_one_out
+from trainer.evaluation.rhythm_leave_one_out import swinging_check
 from trainer.experiments.realmocap import compare, real_run, train_real_runs, waves_and_env
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
@@ -49,14 +56,17 @@ EXPERIMENTS = {"wave": (wave_split, "takes 009-010"), "holdout": (style_holdout_
 
 @dataclass(frozen=True)
 class Variant:
-    """A play-time setting of the agent's rhythm model: `bandwidth` and `typical_tempo` as
-    RhythmModel.with_settings takes them (None: the file's); `rhythm_seed` draws the rhythm
+    """A play-time setting of the agent's rhythm model: `bandwidth`, `typical_tempo` and `tempo_bandwidth` as
+    RhythmModel.with_settings takes them (None: the file's), `by_arm` False the waves of both arms
+    (RhythmModel.without_arms); `rhythm_seed` draws the rhythm
     (RhythmModel.draw's seed) and `state_seed` samples the stochastic states (GestureAgent.rollout's), the
     panel's Variation Seed setting both; `tempo`: the request names the take's tempo; `preset`: the agent
     trained with this preset (None: the ablation's own)."""
     name: str
     bandwidth: float | None = None
     typical_tempo: bool | None = None
+    tempo_bandwidth: float | None = None
+    by_arm: bool = True
     rhythm_seed: int | None = None
     state_seed: int | None = None
     tempo: bool = False
@@ -64,14 +74,19 @@ class Variant:
 
 
 SEEDS = (1, 2, 3)
+#: The tempo kernel's sd (log Hz) before it was chosen on validation takes (core/rhythm.py TEMPO_BANDWIDTH).
+WIDE_TEMPO_BANDWIDTH = math.log(1.25)
 VARIANTS = (Variant("typical tempo (as exported)", typical_tempo=True),
-            Variant("mean rhythm, all waves' phase", typical_tempo=False),
+            Variant("mean rhythm, all waves' phase", typical_tempo=False, by_arm=False),
             Variant("typical tempo, kernel sd 0.02", bandwidth=0.02, typical_tempo=True),
+            Variant("typical tempo, tempo kernel sd log 1.25", typical_tempo=True,
+                    tempo_bandwidth=WIDE_TEMPO_BANDWIDTH),
+            Variant("typical tempo, both arms' waves", typical_tempo=True, by_arm=False),
             *(Variant(f"sampled states {seed}: typical tempo", typical_tempo=True, state_seed=seed) for seed in SEEDS),
             *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", typical_tempo=True,
                       rhythm_seed=seed, state_seed=seed) for seed in SEEDS),
             Variant("tempo asked: typical-tempo rhythm at the take's tempo", typical_tempo=True, tempo=True),
-            Variant("tempo asked, mean rhythm", typical_tempo=False, tempo=True))
+            Variant("tempo asked, mean rhythm", typical_tempo=False, tempo=True, by_arm=False))
 
 
 def preset_variants(preset):
@@ -81,7 +96,9 @@ def preset_variants(preset):
 
 
 #: The styles whose first test take (right arm) the hand-path figure shows, per experiment.
-PATH_STYLES = {"wave": ("feminine", "masculine", "normal", "active"), "holdout": ("elderly", "exhausted")}
+PATH_STYLES = {"wave": ("masculine", "youthful", "normal", "active"), "holdout": ("elderly", "exhausted")}
+#: The agent as exported, given each held-out take's own rhythm (OwnRhythm).
+OWN_RHYTHM = "each take's own rhythm (not a method: the request cannot say it)"
 
 
 @dataclass(frozen=True)
@@ -119,6 +136,25 @@ class VariantMethod:
                                       self.state_seed, tempo)
 
 
+class OwnRhythm:
+    """The agent of an AgentMethod playing each of `clips` with the rhythm read from that take itself
+    (wave_rhythm.clip_rhythm, as training reads a clip's; no swing for a take that has none): what the agent's
+    poses give when its rhythm is right. It answers only the requests of `clips`."""
+
+    def __init__(self, method, clips):
+        self.agent = method.agent
+        self.rhythms = {self._key(c.arm, c.attributes, len(c.rotvecs)): wave_rhythm.clip_rhythm(c) for c in clips}
+
+    @staticmethod
+    def _key(arm, attributes, frame_count):
+        return arm, float(np.ravel(attributes)[0]), int(frame_count)
+
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
+        own = self.rhythms[self._key(arm, attributes, frame_count)]
+        signals = np.zeros((frame_count, 2)) if own is None else rhythm.signals(own, frame_count)
+        return baselines.agent_motion(self.agent, behaviour, arm, attributes, frame_count, rhythm_signals=signals)
+
+
 def rhythm_with_phases(model, train_clips):
     """`model` (the agent's RhythmModel) with each training wave's phase: its own, or, for a file exported
     before they were kept, read again from `train_clips` (the waves it was fitted on, in their order),
@@ -136,8 +172,14 @@ def variant_methods(agents, train_clips, variants):
     """{variant name: VariantMethod} for each Variant, of the AgentMethod in `agents` ({preset: AgentMethod}; None
     the ablation's own) it names."""
     models = {preset: rhythm_with_phases(agent.agent.rhythm_model, train_clips) for preset, agent in agents.items()}
-    return {v.name: VariantMethod(agents[v.preset], models[v.preset].with_settings(v.bandwidth, v.typical_tempo),
-                                  v.rhythm_seed, v.state_seed) for v in variants}
+    return {v.name: VariantMethod(agents[v.preset], _played(models[v.preset], v), v.rhythm_seed, v.state_seed)
+            for v in variants}
+
+
+def _played(model, variant):
+    """`model` with the Variant's rhythm settings."""
+    played = model.with_settings(variant.bandwidth, variant.typical_tempo, variant.tempo_bandwidth)
+    return played if variant.by_arm else played.without_arms()
 
 
 def style_phases(read):
@@ -153,11 +195,12 @@ def style_phases(read):
 
 def rule_checks(read):
     """{rule: rhythm_leave_one_out.leave_one_out} over the training waves that swing (`read`:
-    wave_rhythm.swinging), for the typical tempo and the mean rhythm: the rule judged on training waves alone."""
-    arguments = ([float(np.ravel(c.attributes)[0]) for c, _ in read], [r for _, r in read],
-                 [len(c.rotvecs) for c, _ in read])
-    return {"typical tempo": leave_one_out(*arguments, typical_tempo=True),
-            "mean rhythm": leave_one_out(*arguments, typical_tempo=False)}
+    wave_rhythm.swinging), for the typical tempo (as files play it; with the earlier, wider tempo kernel; from
+    both arms' waves) and the mean rhythm: the rule judged on training waves alone."""
+    return {"typical tempo": swinging_check(read, typical_tempo=True),
+            "typical tempo, tempo kernel sd log 1.25": swinging_check(read, True, WIDE_TEMPO_BANDWIDTH),
+            "typical tempo, both arms' waves": swinging_check(read, True, by_arm=False),
+            "mean rhythm": swinging_check(read, typical_tempo=False, by_arm=False)}
 
 
 def hand_path_panels(methods, clips, styles, env, references):
@@ -188,7 +231,7 @@ def run_ablation(settings: AblationSettings) -> dict:
     reports = train_real_runs(runs.values(), workers=settings.workers)
     variants = VARIANTS + tuple(v for preset in settings.compare_presets for v in preset_variants(preset))
     results = {"command": command_line(settings), "seed": settings.seed, "epochs": settings.epochs,
-               "preset": settings.preset, "variants": [v.name for v in variants], "experiments": {}}
+               "preset": settings.preset, "variants": [v.name for v in variants] + [OWN_RHYTHM], "experiments": {}}
     panels = []
     for name, (train, test) in splits.items():
         started = time.process_time()
@@ -196,8 +239,9 @@ def run_ablation(settings: AblationSettings) -> dict:
         methods = variant_methods(agents, train, variants)
         retrieval = baselines.NearestClip(train)
         read = wave_rhythm.swinging([clip for clip in train if clip.behaviour == behaviours.WAVE])  # read once
-        scored = {**compare({**{v.name: methods[v.name] for v in variants if not v.tempo}, RETRIEVAL: retrieval},
-                            test, env, references),
+        own = OwnRhythm(agents[None], test)
+        scored = {**compare({**{v.name: methods[v.name] for v in variants if not v.tempo}, OWN_RHYTHM: own,
+                             RETRIEVAL: retrieval}, test, env, references),
                   **compare({**{v.name: methods[v.name] for v in variants if v.tempo}, RETRIEVAL_TEMPO: retrieval},
                             test, env, references, with_tempo=True)}
         report = reports[runs[name, None].settings.output]
@@ -205,13 +249,13 @@ def run_ablation(settings: AblationSettings) -> dict:
             "test_set": EXPERIMENTS[name][1], "train_clips": len(train), "test_clips": len(test),
             "train_seconds": report["train_seconds"], "phase_of_all": agents[None].agent.rhythm_model.phase,
             "style_phases": style_phases(read), "rule_checks": rule_checks(read),
-            "summaries": {method: seed_summary(scored[method]) for method in [v.name for v in variants]
+            "summaries": {method: seed_summary(scored[method]) for method in results["variants"]
                           + [RETRIEVAL, RETRIEVAL_TEMPO]}}
         shown = {f"{settings.preset}, as exported": (methods[VARIANTS[0].name], False),
-                 f"{settings.preset}, mean rhythm": (methods[VARIANTS[1].name], False),
                  **{f"{preset}, as exported": (methods[preset_variants(preset)[0].name], False)
                     for preset in settings.compare_presets},
                  f"{settings.preset}, tempo asked": (methods[VARIANTS[-2].name], True),
+                 f"{settings.preset}, the take's own rhythm": (own, False),
                  "nearest clip": (retrieval, False), "nearest clip, tempo asked": (retrieval, True)}
         panels += hand_path_panels(shown, test, PATH_STYLES[name], env, references)
         results["experiments"][name]["evaluation_cpu_seconds"] = time.process_time() - started

@@ -12,17 +12,27 @@ epochs, so a run resumed to a longer length is not the run of that length), scor
 (the paper's request, and naming each take's tempo). The chosen length has the best mean of the
 score and DTW score over both validation sets for the paper's request (the shorter on a tie). Nearest-clip
 retrieval from the same training takes is scored beside it.
+
+The play-time rhythm rule is chosen the same way, after the length: the chosen length's agents play the paper's
+requests with each tempo kernel of `tempo_kernels` (core/rhythm.py TEMPO_BANDWIDTH), from the training waves of
+the request's arm and from both arms', nothing retrained; each rule is also judged on the training waves alone
+(rhythm_leave_one_out).
 """
+import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.evaluation import baselines
+from trainer.evaluation.rhythm_leave_one_out import swinging_check
 from trainer.experiments.realmocap import (REQUESTS, RealMocapSettings, compare, real_run, train_real_runs,
                                            waves_and_env)
+from trainer.experiments.realmocap_ablation import VariantMethod
+from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import style_validation_split, take_validation_split
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
@@ -30,12 +40,16 @@ from trainer.reporting.realmocap_report import seed_summary
 
 #: {name: (split, what it validates)}.
 EXPERIMENTS = {"takes": (take_validation_split, "takes 007-008"), "style": (style_validation_split, "style normal")}
+#: The tempo kernels compared, each as the rate factor whose logarithm is the kernel's sd in log Hz.
+TEMPO_KERNELS = (1.05, 1.1, 1.15, 1.25)
 
 
 @dataclass(frozen=True)
 class LengthSettings:
-    """What the length search runs: the lengths (epochs, rising), one training seed and preset."""
+    """What the length search runs: the lengths (epochs, rising), one training seed and preset, and the tempo
+    kernels (TEMPO_KERNELS) the chosen length's agents play."""
     lengths: tuple[int, ...] = (50, 100, 200)
+    tempo_kernels: tuple[float, ...] = TEMPO_KERNELS
     seed: int = 0
     preset: str = "end_chunks"
     realmocap: str = str(REALMOCAP_DIR)
@@ -47,14 +61,17 @@ class LengthSettings:
         if not self.lengths or any(b <= a for a, b in zip(self.lengths, self.lengths[1:])) or self.lengths[0] < 1:
             raise RLAnimateError(f"--lengths {' '.join(map(str, self.lengths))}: give rising epoch counts of at "
                                  f"least 1, such as 50 100 200.")
+        if not self.tempo_kernels or min(self.tempo_kernels) <= 1:
+            raise RLAnimateError(f"--tempo-kernels {' '.join(map(str, self.tempo_kernels))}: give rate factors "
+                                 f"above 1, such as 1.05 1.1 1.25.")
 
 
-def choose_length(by_length):
-    """The length (a key of `by_length`, {length: {set: seed_summary of the paper's request}}) with the best mean
-    score and DTW score over the sets; the shorter on a tie."""
+def choose(candidates):
+    """The key of `candidates` ({length or rhythm rule: {set: seed_summary of the paper's request}}, the simpler
+    first) with the best mean score and DTW score over the sets; the first on a tie."""
     def merit(summaries):
         return float(np.mean([(s["score"] + s["aligned_score"]) / 2 for s in summaries.values()]))
-    return max(sorted(by_length, key=int), key=lambda length: merit(by_length[length]))
+    return max(candidates, key=lambda key: merit(candidates[key]))
 
 
 def run_lengths(settings: LengthSettings) -> dict:
@@ -90,11 +107,38 @@ def length_results(splits, settings, env, references):
             "scoring_cpu_seconds": time.process_time() - started}
     paper = {length: {name: entry["by_length"][str(length)]["paper"]
                       for name, entry in results["experiments"].items()} for length in settings.lengths}
-    results["chosen"] = choose_length(paper)
+    results["chosen"] = choose(paper)
+    results["rhythm_rules"] = rhythm_rule_results(splits, runs, results["chosen"], settings.tempo_kernels, env,
+                                                  references)
+    results["chosen_rhythm_rule"] = choose({rule: {name: entry["sets"][name]["paper"] for name in splits}
+                                            for rule, entry in results["rhythm_rules"].items()})
     return results
 
+
+def rhythm_rule(factor, by_arm):
+    """A rhythm rule's name: its tempo kernel, and whose waves a request weighs."""
+    return f"log {factor}" + ("" if by_arm else ", both arms' waves")
+
+
+def rhythm_rule_results(splits, runs, length, factors, env, references):
+    """{rule name: {'tempo_kernel': factor, 'by_arm', 'sets': {experiment: {'paper': seed_summary, 'leave_one_out':
+    rhythm_leave_one_out.leave_one_out}}}}: the `length` agents of `runs` playing the paper's requests with each
+    tempo kernel, from their arm's training waves and from both arms', and each rule on the training waves alone."""
+    results = {rhythm_rule(factor, by_arm): {"tempo_kernel": factor, "by_arm": by_arm, "sets": {}}
+               for by_arm in (True, False) for factor in factors}
+    for name, (train, validation) in splits.items():
+        agent = baselines.AgentMethod(Path(runs[name, length].settings.output) / "agent.npz")
+        read = wave_rhythm.swinging([clip for clip in train if clip.behaviour == behaviours.WAVE])  # read once
+        for entry in results.values():
+            model = agent.agent.rhythm_model.with_settings(tempo_bandwidth=math.log(entry["tempo_kernel"]))
+            played = VariantMethod(agent, model if entry["by_arm"] else model.without_arms())
+            entry["sets"][name] = {
+                "paper": seed_summary(compare({"a": played}, validation, env, references)["a"]),
+                "leave_one_out": swinging_check(read, True, math.log(entry["tempo_kernel"]), entry["by_arm"])}
+    return results
 
 def command_line(settings):
     """The command that regenerates these results."""
     return (f"nice -n 15 python -m trainer.scripts.realmocap_length --lengths "
-            f"{' '.join(map(str, settings.lengths))} --seed {settings.seed} --preset {settings.preset}")
+            f"{' '.join(map(str, settings.lengths))} --tempo-kernels {' '.join(map(str, settings.tempo_kernels))} "
+            f"--seed {settings.seed} --preset {settings.preset}")

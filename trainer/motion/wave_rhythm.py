@@ -100,6 +100,7 @@ def swinging(waves):
 
 def fit_rhythm_model(waves):
     """The RhythmModel of wave clips, fitted on those whose hand swings (`swinging`) by their exaggeration
-    (`.attributes`)."""
+    (`.attributes`) and arm."""
     read = swinging(waves)
-    return rhythm.RhythmModel.fit([clip.attributes for clip, _ in read], [r for _, r in read])
+    return rhythm.RhythmModel.fit([clip.attributes for clip, _ in read], [r for _, r in read],
+                                  [clip.arm for clip, _ in read])

@@ -1,11 +1,16 @@
 """The rhythm ablation on real capture as a page (docs/results/realmocap_ablation.md)."""
+import math
+
 import numpy as np
 
+from rlanimate_addon.core.rhythm import TEMPO_BANDWIDTH
 from trainer.reporting.realmocap_report import SEED_METRICS, STYLE_METRICS, metric_cells
 from trainer.reporting.tables import markdown_table
 
 #: Retrieval's results: for the plain request, and for the one naming the take's tempo.
 RETRIEVAL, RETRIEVAL_TEMPO = "nearest_clip", "nearest_clip, tempo asked"
+#: The tempo kernel the agent files play (core/rhythm.py).
+TEMPO_KERNEL = f"log {math.exp(TEMPO_BANDWIDTH):g}"
 _RETRIEVAL_LABELS = {RETRIEVAL: "Nearest clip (retrieval)", RETRIEVAL_TEMPO: "Nearest clip (retrieval), tempo asked"}
 
 
@@ -101,13 +106,20 @@ def ablation_markdown(results):
              "docs/results/realmocap.md. Regenerate: "
              f"`{results['command']}` ({timing}; one torch thread).", "",
              "- *typical tempo*: what the agent file plays for Variation Seed 0 (the panel's seed 0 is no seed): "
-             "the weighted mean rate, start and stop of the training waves near the request's exaggeration (kernel "
-             "sd 0.05) and near the typical tempo of those (the mode of their log tempos; kernel sd log 1.25), at "
+             "the weighted mean rate, start and stop of the training waves of the request's arm near its "
+             "exaggeration (kernel "
+             f"sd 0.05) and near the typical tempo of those (the mode of their log tempos; kernel sd "
+             f"{TEMPO_KERNEL}), at "
              "their weighted circular mean phase (core/rhythm.py).",
              "- *mean rhythm, all waves' phase*: as files exported without their waves' phases play, and as every "
-             "agent played before: the weighted mean of the waves near the exaggeration alone, whatever their "
+             "agent played before: the weighted mean of the waves of both arms near the exaggeration alone, "
+             "whatever their "
              "tempo, at the circular mean phase of all training waves.",
              "- *kernel sd 0.02*: the typical tempo with a tighter exaggeration kernel.",
+             "- *tempo kernel sd log 1.25*: the typical tempo with the wider tempo kernel it had before "
+             f"{TEMPO_KERNEL} was chosen on validation takes (docs/results/realmocap_length.md).",
+             "- *both arms' waves*: the typical tempo from the training waves of both arms, as files made before "
+             "the waves' arms were kept play it (today's files weigh only the request's arm's).",
              "- *sampled states N*: the typical tempo, with the stochastic states sampled (seed N) instead "
              "of their means.",
              "- *seed N*: the panel's Variation Seed N > 0: one nearby training wave's rhythm at a uniformly random "
@@ -116,6 +128,9 @@ def ablation_markdown(results):
              "it: the panel's Tempo); the agent swings at it, its start, stop and phase those of the training "
              "waves near its exaggeration and that tempo (*mean rhythm*: of those near its exaggeration alone). "
              "Retrieval, tempo asked, ranks the training waves by exaggeration and log tempo, each in units of its sd.",
+             "- *each take's own rhythm*: the agent as exported, its rhythm read from the held-out take itself (as "
+             "training reads a clip's): not a method, since no request can say it, but what the agent's poses give "
+             "when its rhythm is right; the gap between it and *as exported* is the rhythm's.",
              "- *preset P*: the agent trained with preset P instead, playing the typical tempo (`end_chunks` is `default` with a fifth of the "
              "update's chunks ending at the gesture's last frame, trainer/agent/buffer.py).", "",
              *findings(results),

@@ -21,6 +21,20 @@ def length_rows(results):
     return rows
 
 
+def rhythm_rule_rows(results):
+    """Per validation set and rhythm rule: the chosen length's agent's measures for the paper's request, and the
+    rule on the training waves alone (rate within 0.8-1.25x, median |log rate ratio|)."""
+    rows = []
+    for name, entry in results["experiments"].items():
+        label = f"{entry['validates']} ({entry['validation_clips']})"
+        for rule, played in results["rhythm_rules"].items():
+            *cells, accepted = metric_cells(played["sets"][name]["paper"], SEED_METRICS)
+            check = played["sets"][name]["leave_one_out"]
+            rows.append([label, rule, *cells, f"{accepted}/{entry['validation_clips']}",
+                         f"{check['rate_within']:.0%}", f"{check['median_log_rate_error']:.3f}"])
+    return rows
+
+
 def length_markdown(results):
     """docs/results/realmocap_length.md from run_lengths's results."""
     sets = "; ".join(f"*{entry['validates']}*: {entry['train_clips']} training clips, {entry['validation_clips']} "
@@ -36,5 +50,17 @@ def length_markdown(results):
              "sets with the paper's request (the shorter on a tie).", "",
              *markdown_table(["validation set", "request", "method", "score", "DTW score", "swing ratio",
                               "frequency ratio", "last-frame elevation error (deg)", "accepted",
-                              "training CPU s"], length_rows(results)), ""]
+                              "training CPU s"], length_rows(results)), "",
+             "## The rhythm at play time", "",
+             f"The {results['chosen']}-epoch agents played with each rhythm rule, nothing retrained, on the paper's "
+             "requests (core/rhythm.py): the tempo kernel's sd in log Hz (the training waves near the request's tempo "
+             "weigh in its rhythm by a Gaussian of it), and whether a request weighs the training waves of its own "
+             "arm or of both; and each rule judged on the agents' training waves alone, each left out in turn and "
+             "its rate predicted from the rest (trainer/evaluation/rhythm_leave_one_out.py). "
+             f"**Chosen: {results['chosen_rhythm_rule']}**, the best mean of score and DTW score over both "
+             "validation sets (the first listed on a tie).", "",
+             *markdown_table(["validation set", "rhythm rule", "score", "DTW score", "swing ratio",
+                              "frequency ratio", "last-frame elevation error (deg)", "accepted",
+                              "training waves: rate within 0.8-1.25x", "median abs log rate ratio"],
+                             rhythm_rule_rows(results)), ""]
     return "\n".join(lines)

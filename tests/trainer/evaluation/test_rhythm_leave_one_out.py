@@ -30,3 +30,12 @@ def test_with_one_rate_both_rules_predict_it():
     typical, mean = (leave_one_out(*_waves(0.03), typical_tempo=flag) for flag in (True, False))
     assert typical["rate_within"] == mean["rate_within"] == 1.0
     assert typical["signal_correlation"] > 0.9 and mean["signal_correlation"] > 0.9
+
+
+def test_where_each_arm_swings_at_its_own_rate_the_arms_predict_every_left_out_wave():
+    e, rhythms, frames = _waves(0.06)
+    arms = ["LEFT"] * 6 + ["RIGHT"] * 4  # the slow waves are the left arm's, the fast ones the right arm's
+    by_arm = leave_one_out(e, rhythms, frames, typical_tempo=True, arms=arms)
+    assert by_arm["rate_within"] == 1.0
+    assert by_arm["rate_within"] > leave_one_out(e, rhythms, frames, typical_tempo=True)["rate_within"]
+    assert leave_one_out(e, rhythms, frames, True, tempo_bandwidth=np.log(1.05))["waves"] == 10

@@ -3,6 +3,7 @@ agent files that lack them, and the variant methods (trainer/experiments/realmoc
 import numpy as np
 import pytest
 
+from rlanimate_addon.core import rhythm
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rhythm import RhythmModel
 from tests.trainer.synthetic_library import make_clip
@@ -57,3 +58,19 @@ def test_a_variant_plays_its_own_rhythm_model_and_seed_and_leaves_the_agent_alon
     turned = realmocap_ablation.VariantMethod(agent, shifted)
     assert agent.agent.rhythm_model is model
     assert not np.allclose(turned.generate("WAVE", "LEFT", 0.6, 60), agent.generate("WAVE", "LEFT", 0.6, 60))
+
+
+@pytest.mark.skipif(not INSTALLED_AGENT.is_file(), reason="no shipped agent")
+def test_the_own_rhythm_diagnostic_plays_each_take_at_the_rhythm_read_from_it():
+    agent = baselines.AgentMethod(INSTALLED_AGENT)
+    takes = [make_clip(f"wave_{k}", "WAVE", arm, 0.3 + 0.2 * k, 90 + 10 * k) for k, arm in enumerate(("LEFT", "RIGHT"))]
+    own = realmocap_ablation.OwnRhythm(agent, takes)
+    for clip in takes:
+        read = wave_rhythm.clip_rhythm(clip)
+        signals = rhythm.signals(read, len(clip.rotvecs))
+        played = own.generate("WAVE", clip.arm, clip.attributes, len(clip.rotvecs))
+        assert np.array_equal(played, baselines.agent_motion(agent.agent, "WAVE", clip.arm, clip.attributes,
+                                                             len(clip.rotvecs), rhythm_signals=signals))
+        assert not np.allclose(played, agent.generate("WAVE", clip.arm, clip.attributes, len(clip.rotvecs)))
+    with pytest.raises(KeyError):  # only the takes it was given
+        own.generate("WAVE", "LEFT", 0.31, 90)

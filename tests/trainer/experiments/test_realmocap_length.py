@@ -7,6 +7,7 @@ import pytest
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.rig_session import new_empty_scene
+from trainer.evaluation import baselines
 from trainer.experiments import realmocap, realmocap_length
 from trainer.motion import realmocap_takes
 from trainer.motion.fk import ClipReferences
@@ -51,18 +52,31 @@ def test_the_chosen_length_has_the_best_mean_over_both_sets_and_the_shorter_wins
     by_length = {50: {"takes": _summary(70, 80), "style": _summary(60, 62)},
                  100: {"takes": _summary(76, 86), "style": _summary(56, 58)},  # better seen, worse unseen: +1 in all
                  200: {"takes": _summary(80, 90), "style": _summary(50, 52)}}
-    assert realmocap_length.choose_length(by_length) == 100
+    assert realmocap_length.choose(by_length) == 100
     by_length[50]["style"] = _summary(62, 64)  # now level with 100
-    assert realmocap_length.choose_length(by_length) == 50
+    assert realmocap_length.choose(by_length) == 50
+
+
+def test_the_rhythm_rules_are_each_tempo_kernel_from_the_requests_arm_then_from_both_and_the_first_wins_a_tie():
+    assert realmocap_length.rhythm_rule(1.1, True) == "log 1.1"
+    assert realmocap_length.rhythm_rule(1.1, False) == "log 1.1, both arms' waves"
+    rules = {"log 1.05": {"takes": _summary(69, 80)}, "log 1.1": {"takes": _summary(72, 78)},
+             "log 1.1, both arms' waves": {"takes": _summary(70, 80)}}
+    assert realmocap_length.choose(rules) == "log 1.1"  # level with both arms' at 75, and listed first
 
 
 def test_the_script_takes_rising_lengths_only():
-    settings = parse_settings(["prog", "--lengths", "5", "10", "--seed", "2"])
-    assert (settings.lengths, settings.seed) == ((5, 10), 2)
-    assert "--lengths 5 10 --seed 2 --preset end_chunks" in realmocap_length.command_line(settings)
+    settings = parse_settings(["prog", "--lengths", "5", "10", "--tempo-kernels", "1.1", "1.2", "--seed", "2"])
+    assert (settings.lengths, settings.tempo_kernels, settings.seed) == ((5, 10), (1.1, 1.2), 2)
+    assert ("--lengths 5 10 --tempo-kernels 1.1 1.2 --seed 2 --preset end_chunks"
+            in realmocap_length.command_line(settings))
+    assert parse_settings(["prog"]).tempo_kernels == realmocap_length.TEMPO_KERNELS
     for lengths in ((10, 5), (), (0, 5)):
         with pytest.raises(RLAnimateError, match="rising epoch counts"):
             realmocap_length.LengthSettings(lengths=lengths)
+    for kernels in ((), (1.0, 1.1)):
+        with pytest.raises(RLAnimateError, match="rate factors above 1"):
+            realmocap_length.LengthSettings(tempo_kernels=kernels)
 
 
 def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval():
@@ -70,11 +84,17 @@ def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval()
              "retrieval": {"paper": _summary(74, 90), "_tempo": _summary(80, 96)},
              "by_length": {str(n): {"train_cpu_seconds": 5.0 * n, "paper": _summary(60 + n / 10, 80),
                                     "_tempo": _summary(70, 85), "scoring_cpu_seconds": 1.0} for n in (50, 100)}}
+    check = {"waves": 200, "rate_within": 0.9, "median_log_rate_error": 0.0625, "signal_correlation": 0.2}
+    rules = {rule: {"tempo_kernel": 1.1, "by_arm": rule == "log 1.1",
+                    "sets": {"takes": {"paper": _summary(score, 80), "leave_one_out": check}}}
+             for rule, score in (("log 1.1", 71), ("log 1.1, both arms' waves", 70))}
     page = length_markdown({"command": "cmd", "seed": 0, "preset": "end_chunks", "lengths": [50, 100],
-                            "experiments": {"takes": entry}, "chosen": 100})
-    assert "**Chosen: 100 epochs**" in page
+                            "experiments": {"takes": entry}, "chosen": 100, "rhythm_rules": rules,
+                            "chosen_rhythm_rule": "log 1.1"})
+    assert "**Chosen: 100 epochs**" in page and "**Chosen: log 1.1**" in page
     rows = [line for line in page.splitlines() if line.startswith("| takes 007-008 (28) |")]
-    assert len(rows) == 6
+    assert len(rows) == 6 + 2
+    assert rows[-2] == "| takes 007-008 (28) | log 1.1 | 71.0 | 80.0 | 1.00 | 1.00 | 3.0 | 2/28 | 90% | 0.062 |"
     assert rows[1] == ("| takes 007-008 (28) | the paper's | RLAnimate, 100 epochs | 70.0 | 80.0 | 1.00 | 1.00 | 3.0 "
                        "| 2/28 | 500 |")
     assert rows[2].startswith("| takes 007-008 (28) | the paper's | Nearest clip | 74.0 | 90.0 |")
@@ -86,17 +106,25 @@ def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval()
 def test_each_length_is_trained_from_the_start_and_scored_on_the_validation_takes(tmp_path):
     new_empty_scene()
     clips = [realmocap.import_real_clip(REALMOCAP_DIR / "wave" / f"dataset-2_wave-left-hand_{name}.bvh",
-                                        tmp_path / "cache") for name in ("feminine_001", "active_002", "active_007")]
-    settings = realmocap_length.LengthSettings(lengths=(1, 2), preset="debug", runs=str(tmp_path), workers=1)
+                                        tmp_path / "cache")
+             for name in ("feminine_001", "feminine_002", "active_002", "active_007")]
+    settings = realmocap_length.LengthSettings(lengths=(1, 2), tempo_kernels=(1.1, 1.25), preset="debug",
+                                               runs=str(tmp_path), workers=1)
     env = FKEnvironment(instances=4)
     results = realmocap_length.length_results({"takes": realmocap_takes.take_validation_split(clips)}, settings, env,
                                               ClipReferences(env))
     entry = results["experiments"]["takes"]
-    assert (entry["train_clips"], entry["validation_clips"]) == (2, 1) and list(entry["by_length"]) == ["1", "2"]
+    assert (entry["train_clips"], entry["validation_clips"]) == (3, 1) and list(entry["by_length"]) == ["1", "2"]
     for length in (1, 2):
         report = (tmp_path / f"takes_validation_{length}_debug" / "report.json").read_text()
         assert f'"epochs": {length}' in report
         scored = entry["by_length"][str(length)]
         assert scored["paper"]["clips"] == scored["_tempo"]["clips"] == 1 and scored["train_cpu_seconds"] > 0
     assert entry["retrieval"]["paper"]["score"] > 90.0  # active 002 is the nearest clip to active 007
-    assert results["chosen"] in (1, 2)
+    assert results["chosen"] in (1, 2) and results["chosen_rhythm_rule"] in results["rhythm_rules"]
+    assert list(results["rhythm_rules"]) == ["log 1.1", "log 1.25", "log 1.1, both arms' waves",
+                                             "log 1.25, both arms' waves"]
+    for played in results["rhythm_rules"].values():  # the chosen length's agent, played with each rule
+        assert played["sets"]["takes"]["paper"]["clips"] == 1 and played["sets"]["takes"]["leave_one_out"]["waves"] == 3
+    exported = (tmp_path / f"takes_validation_{results['chosen']}_debug" / "agent.npz")
+    assert baselines.AgentMethod(exported).agent.rhythm_model.arms == ("LEFT",) * 3  # the waves' arms, kept

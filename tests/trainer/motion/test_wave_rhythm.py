@@ -50,3 +50,15 @@ def test_a_clip_without_a_swing_has_no_rhythm_and_a_still_objective():
     assert wave_rhythm.clip_rhythm(clip) is None
     objective = clip_objective(spaces.PAPER_SPACE, clip)
     assert np.all(objective[:, spaces.OBJECTIVE_ATTRIBUTES][:, 1:] == 0.0)  # the rhythm signals: no swing
+
+
+def test_the_fitted_model_keeps_each_swinging_waves_arm_in_order_and_skips_a_still_one():
+    waves = []
+    for arm, seed in (("LEFT", 3), ("RIGHT", 11), ("LEFT", 5)):
+        clip, _ = _clip(gs.GestureSpec("WAVE", arm, exaggeration=0.5, seed=seed))
+        clip.attributes = 0.5
+        waves.append(clip)
+    still, _ = _clip(gs.GestureSpec("WAVE", "RIGHT", exaggeration=0.5, seed=1))
+    still.rotvecs, still.attributes = np.repeat(still.rotvecs[:1], still.frames, axis=0), 0.5
+    model = wave_rhythm.fit_rhythm_model(waves[:2] + [still] + waves[2:])
+    assert model.arms == ("LEFT", "RIGHT", "LEFT")
