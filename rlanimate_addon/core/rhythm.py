@@ -11,7 +11,7 @@ into a still arm. Here the wave's attributes are [exaggeration, A_t sin(phi_t), 
 with start and stop in frames (given as fractions of the gesture, so a longer gesture swings for
 proportionally longer). During training the task module reads these from each clip
 (trainer/motion/wave_rhythm.py); at play time `RhythmModel.draw` takes them from the training waves near
-the request: of its arm, near its exaggeration, and near its tempo in log Hz. The tempo is the one the request names
+the request: near its exaggeration, and near its tempo in log Hz. The tempo is the one the request names
 (the panel's Tempo), or else the typical tempo of the waves near its exaggeration: the mode of their
 tempos, not their mean. Styles of one exaggeration can swing at different rates (real masculine and
 normal waves: 0.67 ± 0.06 and 0.62 ± 0.10, at 0.85 and 1.6 Hz; docs/REALMOCAP.md), and the mean of two
@@ -21,10 +21,9 @@ one of them (by weight) at any phase, so seeds vary the phase, rate and number o
 those waves do. A named tempo sets the rate.
 Files exported before the training waves' phases were kept (`phases` None) play as they were made: the
 rate, start and stop near the exaggeration alone at the circular mean phase of all the training waves
-(`typical_tempo` False; docs/results/realmocap_ablation.md compares the two), and files exported before
-the waves' arms were kept (`arms` None) take the waves of both arms. A left-arm and a right-arm wave are two
-takes, as retrieval treats them: on real capture a request of one arm near the other arm's waves of another
-style swung at their rate (docs/results/realmocap_length.md).
+(`typical_tempo` False; docs/results/realmocap_ablation.md compares the two). The kernels, and whether a
+request weighs only the training waves of its own arm (`by_arm`, as retrieval fetches only that arm's), are
+chosen on real-capture validation takes (docs/results/realmocap_length.md) and kept in the file.
 """
 import math
 from collections.abc import Sequence
@@ -40,14 +39,19 @@ PARAMETERS = ("frequency", "start", "stop")
 #: A requested tempo may lie this factor beyond the slowest and fastest training waves' (tempo_range).
 TEMPO_MARGIN = 1.25
 #: Exaggeration: the training waves within about this of a request's weigh in its rhythm (a Gaussian
-#: kernel's sd). Styles of one exaggeration can swing at different rates (docs/REALMOCAP.md), so the
-#: rhythm is a local average, not a line through all the waves.
-BANDWIDTH = 0.05
+#: kernel's sd; each file keeps its own). Styles of one exaggeration can swing at different rates
+#: (docs/REALMOCAP.md), so the rhythm is a local average, not a line through all the waves.
+BANDWIDTH = 0.15
 #: Log Hz: the training waves within about this of a request's tempo (asked or typical) weigh in its rhythm
-#: (a Gaussian kernel's sd; a file may keep its own, `tempo_bandwidth`). Chosen among log 1.05-1.25 on
-#: validation takes (docs/results/realmocap_length.md): at log 1.25 the fast normal waves (1.6 Hz) beside
-#: youthful's label (1.1 Hz) still weighed enough to make youthful swing 15% fast and drift out of step.
-TEMPO_BANDWIDTH = math.log(1.1)
+#: (a Gaussian kernel's sd; a file may keep its own, `tempo_bandwidth`): a narrow one, so that the rate
+#: played is the typical tempo's, not pulled towards another style's.
+TEMPO_BANDWIDTH = math.log(1.05)
+#: Whether a request weighs only the training waves of its own arm (when the file keeps the arms).
+BY_ARM = False
+#: The three above were chosen together on real-capture validation takes, over three seeds (sd 0.05-0.15, log
+#: 1.05-1.25, own arm or both; docs/results/realmocap_length.md); files made before keep theirs (0.05, log 1.25).
+#: Log Hz: the tempo kernel of the files made before they kept theirs.
+_EARLIER_TEMPO_BANDWIDTH = math.log(1.25)
 
 
 @dataclass(frozen=True)
@@ -85,17 +89,19 @@ class RhythmModel:
     wave's phase (None in files exported before they were kept); `typical_tempo`: the waves near the
     request's tempo weigh in its rhythm, and theirs is its phase (it needs `phases`; None: on when they
     are there); `tempo_bandwidth`: that tempo kernel's sd in log Hz; `arms` (K,): each training wave's arm
-    ("LEFT" or "RIGHT"; None in files exported before they were kept), a request weighing only its own arm's.
+    ("LEFT" or "RIGHT"; None in files exported before they were kept); `by_arm`: a request weighs only its
+    own arm's waves (it needs `arms`).
     """
 
     def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, typical_tempo=None,
-                 tempo_bandwidth=TEMPO_BANDWIDTH, arms=None):
+                 tempo_bandwidth=TEMPO_BANDWIDTH, arms=None, by_arm=BY_ARM):
         self.examples = np.asarray(examples, dtype=np.float64)
         self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
         self.phases = None if phases is None else np.asarray(phases, dtype=np.float64)
         self.typical_tempo = self.phases is not None if typical_tempo is None else typical_tempo
         self.tempo_bandwidth = float(tempo_bandwidth)
         self.arms = None if arms is None else tuple(arms)
+        self.by_arm = by_arm
 
     @classmethod
     def fit(cls, exaggerations: Sequence[float], rhythms: Sequence[Rhythm],
@@ -109,17 +115,13 @@ class RhythmModel:
         phase = float(np.angle(np.mean(np.exp(1j * phases))))
         return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases, arms=arms)
 
-    def with_settings(self, bandwidth=None, typical_tempo=None, tempo_bandwidth=None) -> "RhythmModel":
-        """The same training waves with another kernel bandwidth, choice of `typical_tempo` and/or tempo kernel
-        (None: keep this one's)."""
+    def with_settings(self, bandwidth=None, typical_tempo=None, tempo_bandwidth=None, by_arm=None) -> "RhythmModel":
+        """The same training waves with another kernel bandwidth, choice of `typical_tempo`, tempo kernel and/or
+        `by_arm` (None: keep this one's)."""
         return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth if bandwidth is None else bandwidth,
                            self.phases, self.typical_tempo if typical_tempo is None else typical_tempo,
-                           self.tempo_bandwidth if tempo_bandwidth is None else tempo_bandwidth, self.arms)
-
-    def without_arms(self) -> "RhythmModel":
-        """The same training waves, a request weighing both arms' (as files made before the arms were kept)."""
-        return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth, self.phases, self.typical_tempo,
-                           self.tempo_bandwidth)
+                           self.tempo_bandwidth if tempo_bandwidth is None else tempo_bandwidth, self.arms,
+                           self.by_arm if by_arm is None else by_arm)
 
     def to_dict(self) -> dict:
         values = {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
@@ -128,7 +130,7 @@ class RhythmModel:
             values.update(phases=self.phases.tolist(), typical_tempo=self.typical_tempo,
                           tempo_bandwidth=self.tempo_bandwidth)
         if self.arms is not None:
-            values["arms"] = list(self.arms)
+            values.update(arms=list(self.arms), by_arm=self.by_arm)
         return values
 
     @classmethod
@@ -138,10 +140,10 @@ class RhythmModel:
             model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
                         float(values["ramp"]), float(values["bandwidth"]),
                         None if phases is None else np.asarray(phases, dtype=np.float64),
-                        values.get("typical_tempo"), values.get("tempo_bandwidth", TEMPO_BANDWIDTH),
-                        values.get("arms"))
-            if not isinstance(model.typical_tempo, bool):
-                raise TypeError("typical_tempo must be true or false")
+                        values.get("typical_tempo"), values.get("tempo_bandwidth", _EARLIER_TEMPO_BANDWIDTH),
+                        values.get("arms"), values.get("by_arm", False))
+            if not isinstance(model.typical_tempo, bool) or not isinstance(model.by_arm, bool):
+                raise TypeError("typical_tempo and by_arm must be true or false")
         except (KeyError, TypeError, ValueError) as error:
             raise RLAnimateError(f"The agent's wave_rhythm metadata is invalid ({error!r}): re-export the "
                                  f"agent with trainer/agent/agent_export.py.") from error
@@ -154,19 +156,20 @@ class RhythmModel:
                                   [] if model.phases is None else model.phases])
         positive = min(model.ramp, model.bandwidth, model.tempo_bandwidth) > 0
         if not (shape_ok and phases_ok and arms_ok and positive) or not np.all(np.isfinite(numbers)) \
-                or (model.typical_tempo and model.phases is None):
+                or (model.typical_tempo and model.phases is None) or (model.by_arm and model.arms is None):
             raise RLAnimateError(f"The agent's wave_rhythm metadata holds invalid numbers (need at least 2 "
                                  f"examples of {1 + len(PARAMETERS)} finite numbers, a finite phase for each "
-                                 f"when typical_tempo is on, LEFT or RIGHT for each of any arms, and a positive ramp, "
-                                 f"bandwidth and tempo_bandwidth): re-export the agent.")
+                                 f"when typical_tempo is on, LEFT or RIGHT for each wave when by_arm is on or "
+                                 f"any arms are given, and a positive ramp, bandwidth and tempo_bandwidth): "
+                                 f"re-export the agent.")
         return model
 
     def weights(self, exaggeration: float, tempo: float | None = None, arm: str | None = None) -> np.ndarray:
-        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1): only those of
-        its `arm` when the file keeps the arms and has any of that arm (None: both arms'); with
-        `typical_tempo`, near its tempo too (cycles per frame; None: the typical one)."""
+        """(K,) how much each training wave weighs in a request of this exaggeration (sum 1): with `by_arm`, only
+        those of its `arm` where there are any (None: both arms'); with `typical_tempo`, near its tempo too
+        (cycles per frame; None: the typical one)."""
         log_kernel = _log_gaussian(self.examples[:, 0] - float(exaggeration), self.bandwidth)  # (K,)
-        if self.arms is not None and arm in self.arms:
+        if self.by_arm and self.arms is not None and arm in self.arms:
             log_kernel = np.where(np.array(self.arms) == arm, log_kernel, -np.inf)
         if not self.typical_tempo:
             return _normalised(log_kernel)

@@ -129,15 +129,15 @@ def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with
     assert load_agent(plain).wave_rhythm(0.4, 90) is None  # the paper's objective
 
 
-def test_a_file_that_keeps_its_waves_arms_plays_each_arm_from_its_own_arms_waves(tmp_path):
+def test_a_file_with_by_arm_plays_each_arm_from_its_own_arms_waves(tmp_path):
     by_arm = rhythm.RhythmModel.fit(RHYTHM.examples[:, 0], [rhythm.Rhythm(*row[1:], phase, RHYTHM.ramp)
                                                            for row, phase in zip(RHYTHM.examples, RHYTHM.phases)],
-                                    ["LEFT", "RIGHT", "LEFT"])
+                                    ["LEFT", "RIGHT", "LEFT"]).with_settings(by_arm=True)
     torch.manual_seed(0)
     path = tmp_path / "by_arm.npz"
     export_agent(RLAnimateAgent(load_preset("debug")[0]), path, {"wave_rhythm": by_arm.to_dict()})
     agent = load_agent(path)
-    assert agent.rhythm_model.arms == ("LEFT", "RIGHT", "LEFT")
+    assert agent.rhythm_model.arms == ("LEFT", "RIGHT", "LEFT") and agent.rhythm_model.by_arm
     for arm in ("LEFT", "RIGHT"):
         assert np.array_equal(agent.wave_rhythm(0.4, 90, arm=arm), rhythm.signals(by_arm.draw(0.4, arm=arm), 90))
     assert not np.allclose(agent.wave_rhythm(0.4, 90, arm="LEFT"), agent.wave_rhythm(0.4, 90, arm="RIGHT"))

@@ -14,17 +14,18 @@ from rlanimate_addon.core import rhythm
 RATE_TOLERANCE = (0.8, 1.25)
 
 
-def leave_one_out(exaggerations, rhythms, frame_counts, typical_tempo, tempo_bandwidth=None, arms=None):
+def leave_one_out(exaggerations, rhythms, frame_counts, typical_tempo, tempo_bandwidth=None, arms=None,
+                  bandwidth=None, by_arm=None):
     """{'waves', 'rate_within', 'median_log_rate_error', 'signal_correlation'} over the (K,) training waves'
-    exaggerations, Rhythms and frame counts, for the model with `typical_tempo` on or off, its tempo kernel's sd
-    in log Hz (None: rhythm.TEMPO_BANDWIDTH), and the waves' arms (K; None: each request weighs both arms')."""
+    exaggerations, Rhythms and frame counts and arms (K; None: not known), for the model with `typical_tempo` on
+    or off, its tempo kernel's sd in log Hz, exaggeration kernel's sd and `by_arm` (None: rhythm's defaults)."""
     exaggerations = np.asarray(exaggerations, dtype=np.float64)
     within, log_errors, correlations = [], [], []
     for left_out, (own, frames) in enumerate(zip(rhythms, frame_counts)):
         keep = [k for k in range(len(rhythms)) if k != left_out]
         model = rhythm.RhythmModel.fit(exaggerations[keep], [rhythms[k] for k in keep],
                                        None if arms is None else [arms[k] for k in keep])
-        drawn = model.with_settings(typical_tempo=typical_tempo, tempo_bandwidth=tempo_bandwidth).draw(
+        drawn = model.with_settings(bandwidth, typical_tempo, tempo_bandwidth, by_arm).draw(
             exaggerations[left_out], arm=None if arms is None else arms[left_out])
         ratio = drawn.frequency / own.frequency
         within.append(RATE_TOLERANCE[0] <= ratio <= RATE_TOLERANCE[1])
@@ -35,9 +36,9 @@ def leave_one_out(exaggerations, rhythms, frame_counts, typical_tempo, tempo_ban
             "median_log_rate_error": float(np.median(log_errors)), "signal_correlation": float(np.mean(correlations))}
 
 
-def swinging_check(read, typical_tempo, tempo_bandwidth=None, by_arm=True):
+def swinging_check(read, typical_tempo, tempo_bandwidth=None, by_arm=None, bandwidth=None):
     """leave_one_out over the training waves that swing (`read`: wave_rhythm.swinging's (clip, Rhythm) pairs),
     each predicted from its own arm's (`by_arm`) or both arms'."""
     return leave_one_out([float(np.ravel(clip.attributes)[0]) for clip, _ in read], [r for _, r in read],
                          [len(clip.rotvecs) for clip, _ in read], typical_tempo, tempo_bandwidth,
-                         [clip.arm for clip, _ in read] if by_arm else None)
+                         [clip.arm for clip, _ in read], bandwidth, by_arm)

@@ -10,13 +10,11 @@ against that take as trainer.experiments.realmocap scores it (realmocap.compare)
                                       exaggeration and near the typical tempo of those, at their weighted
                                       circular mean phase
     mean rhythm, all waves' phase     as files without their waves' phases play: the weighted mean of the
-                                      waves of both arms near the exaggeration alone, at the circular mean
-                                      phase of all
-    ..., kernel sd 0.02               the typical tempo with a tighter exaggeration kernel than BANDWIDTH
-    ..., tempo kernel sd log 1.25     the typical tempo with the wider tempo kernel it had before
-                                      TEMPO_BANDWIDTH was chosen on validation takes
-    ..., both arms' waves             the typical tempo from the training waves of both arms, as files made
-                                      before the waves' arms were kept play it
+                                      waves near the exaggeration alone (kernel sd 0.05), at the circular
+                                      mean phase of all
+    ..., the kernels before           the typical tempo with the exaggeration and tempo kernels it had before
+                                      BANDWIDTH and TEMPO_BANDWIDTH were chosen on validation takes
+    ..., the request's arm's waves    the typical tempo from the training waves of the request's arm alone
     sampled states N                  the typical tempo, the stochastic states sampled with seed N
     seed N                            a seeded draw, as the panel plays a Variation Seed N > 0: one nearby
                                       training wave's rhythm at a random phase, and sampled stochastic states
@@ -56,9 +54,8 @@ EXPERIMENTS = {"wave": (wave_split, "takes 009-010"), "holdout": (style_holdout_
 
 @dataclass(frozen=True)
 class Variant:
-    """A play-time setting of the agent's rhythm model: `bandwidth`, `typical_tempo` and `tempo_bandwidth` as
-    RhythmModel.with_settings takes them (None: the file's), `by_arm` False the waves of both arms
-    (RhythmModel.without_arms); `rhythm_seed` draws the rhythm
+    """A play-time setting of the agent's rhythm model: `bandwidth`, `typical_tempo`, `tempo_bandwidth` and
+    `by_arm` as RhythmModel.with_settings takes them (None: the file's); `rhythm_seed` draws the rhythm
     (RhythmModel.draw's seed) and `state_seed` samples the stochastic states (GestureAgent.rollout's), the
     panel's Variation Seed setting both; `tempo`: the request names the take's tempo; `preset`: the agent
     trained with this preset (None: the ablation's own)."""
@@ -66,7 +63,7 @@ class Variant:
     bandwidth: float | None = None
     typical_tempo: bool | None = None
     tempo_bandwidth: float | None = None
-    by_arm: bool = True
+    by_arm: bool | None = None
     rhythm_seed: int | None = None
     state_seed: int | None = None
     tempo: bool = False
@@ -74,19 +71,19 @@ class Variant:
 
 
 SEEDS = (1, 2, 3)
-#: The tempo kernel's sd (log Hz) before it was chosen on validation takes (core/rhythm.py TEMPO_BANDWIDTH).
-WIDE_TEMPO_BANDWIDTH = math.log(1.25)
+#: The exaggeration and tempo kernels' sd before they were chosen on validation takes (core/rhythm.py BANDWIDTH,
+#: TEMPO_BANDWIDTH): as files made before play.
+EARLIER_KERNELS = {"bandwidth": 0.05, "tempo_bandwidth": math.log(1.25)}
 VARIANTS = (Variant("typical tempo (as exported)", typical_tempo=True),
-            Variant("mean rhythm, all waves' phase", typical_tempo=False, by_arm=False),
-            Variant("typical tempo, kernel sd 0.02", bandwidth=0.02, typical_tempo=True),
-            Variant("typical tempo, tempo kernel sd log 1.25", typical_tempo=True,
-                    tempo_bandwidth=WIDE_TEMPO_BANDWIDTH),
-            Variant("typical tempo, both arms' waves", typical_tempo=True, by_arm=False),
+            Variant("mean rhythm, all waves' phase", typical_tempo=False, bandwidth=EARLIER_KERNELS["bandwidth"]),
+            Variant("typical tempo, the kernels before (sd 0.05, log 1.25)", typical_tempo=True, **EARLIER_KERNELS),
+            Variant("typical tempo, the request's arm's waves", typical_tempo=True, by_arm=True),
             *(Variant(f"sampled states {seed}: typical tempo", typical_tempo=True, state_seed=seed) for seed in SEEDS),
             *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", typical_tempo=True,
                       rhythm_seed=seed, state_seed=seed) for seed in SEEDS),
             Variant("tempo asked: typical-tempo rhythm at the take's tempo", typical_tempo=True, tempo=True),
-            Variant("tempo asked, mean rhythm", typical_tempo=False, tempo=True, by_arm=False))
+            Variant("tempo asked, mean rhythm", typical_tempo=False, tempo=True,
+                    bandwidth=EARLIER_KERNELS["bandwidth"]))
 
 
 def preset_variants(preset):
@@ -172,14 +169,8 @@ def variant_methods(agents, train_clips, variants):
     """{variant name: VariantMethod} for each Variant, of the AgentMethod in `agents` ({preset: AgentMethod}; None
     the ablation's own) it names."""
     models = {preset: rhythm_with_phases(agent.agent.rhythm_model, train_clips) for preset, agent in agents.items()}
-    return {v.name: VariantMethod(agents[v.preset], _played(models[v.preset], v), v.rhythm_seed, v.state_seed)
-            for v in variants}
-
-
-def _played(model, variant):
-    """`model` with the Variant's rhythm settings."""
-    played = model.with_settings(variant.bandwidth, variant.typical_tempo, variant.tempo_bandwidth)
-    return played if variant.by_arm else played.without_arms()
+    return {v.name: VariantMethod(agents[v.preset], models[v.preset].with_settings(
+        v.bandwidth, v.typical_tempo, v.tempo_bandwidth, v.by_arm), v.rhythm_seed, v.state_seed) for v in variants}
 
 
 def style_phases(read):
@@ -195,12 +186,12 @@ def style_phases(read):
 
 def rule_checks(read):
     """{rule: rhythm_leave_one_out.leave_one_out} over the training waves that swing (`read`:
-    wave_rhythm.swinging), for the typical tempo (as files play it; with the earlier, wider tempo kernel; from
-    both arms' waves) and the mean rhythm: the rule judged on training waves alone."""
+    wave_rhythm.swinging), for the typical tempo (as files play it; with the kernels before; from the request's
+    arm's waves) and the mean rhythm: the rule judged on training waves alone."""
     return {"typical tempo": swinging_check(read, typical_tempo=True),
-            "typical tempo, tempo kernel sd log 1.25": swinging_check(read, True, WIDE_TEMPO_BANDWIDTH),
-            "typical tempo, both arms' waves": swinging_check(read, True, by_arm=False),
-            "mean rhythm": swinging_check(read, typical_tempo=False, by_arm=False)}
+            "typical tempo, the kernels before": swinging_check(read, True, **EARLIER_KERNELS),
+            "typical tempo, the request's arm's waves": swinging_check(read, True, by_arm=True),
+            "mean rhythm": swinging_check(read, typical_tempo=False, bandwidth=EARLIER_KERNELS["bandwidth"])}
 
 
 def hand_path_panels(methods, clips, styles, env, references):

@@ -14,9 +14,9 @@ score and DTW score over both validation sets for the paper's request (the short
 retrieval from the same training takes is scored beside it.
 
 The play-time rhythm rule is chosen the same way, after the length: the chosen length's agents play the paper's
-requests with each tempo kernel of `tempo_kernels` (core/rhythm.py TEMPO_BANDWIDTH), from the training waves of
-the request's arm and from both arms', nothing retrained; each rule is also judged on the training waves alone
-(rhythm_leave_one_out).
+requests with each exaggeration kernel of `exaggeration_kernels` (core/rhythm.py BANDWIDTH) and tempo kernel of
+`tempo_kernels` (TEMPO_BANDWIDTH), from the training waves of both arms and from the request's arm's alone
+(BY_ARM), nothing retrained; each rule is also judged on the training waves alone (rhythm_leave_one_out).
 """
 import math
 import time
@@ -40,15 +40,18 @@ from trainer.reporting.realmocap_report import seed_summary
 
 #: {name: (split, what it validates)}.
 EXPERIMENTS = {"takes": (take_validation_split, "takes 007-008"), "style": (style_validation_split, "style normal")}
-#: The tempo kernels compared, each as the rate factor whose logarithm is the kernel's sd in log Hz.
+#: The exaggeration kernels compared (their sd), and the tempo kernels, each as the rate factor whose logarithm
+#: is the kernel's sd in log Hz.
+EXAGGERATION_KERNELS = (0.05, 0.1, 0.15)
 TEMPO_KERNELS = (1.05, 1.1, 1.15, 1.25)
 
 
 @dataclass(frozen=True)
 class LengthSettings:
-    """What the length search runs: the lengths (epochs, rising), one training seed and preset, and the tempo
-    kernels (TEMPO_KERNELS) the chosen length's agents play."""
+    """What the length search runs: the lengths (epochs, rising), one training seed and preset, and the
+    exaggeration and tempo kernels the chosen length's agents play."""
     lengths: tuple[int, ...] = (50, 100, 200)
+    exaggeration_kernels: tuple[float, ...] = EXAGGERATION_KERNELS
     tempo_kernels: tuple[float, ...] = TEMPO_KERNELS
     seed: int = 0
     preset: str = "end_chunks"
@@ -61,6 +64,9 @@ class LengthSettings:
         if not self.lengths or any(b <= a for a, b in zip(self.lengths, self.lengths[1:])) or self.lengths[0] < 1:
             raise RLAnimateError(f"--lengths {' '.join(map(str, self.lengths))}: give rising epoch counts of at "
                                  f"least 1, such as 50 100 200.")
+        if not self.exaggeration_kernels or min(self.exaggeration_kernels) <= 0:
+            raise RLAnimateError(f"--exaggeration-kernels {' '.join(map(str, self.exaggeration_kernels))}: give "
+                                 f"positive kernel widths, such as 0.05 0.1.")
         if not self.tempo_kernels or min(self.tempo_kernels) <= 1:
             raise RLAnimateError(f"--tempo-kernels {' '.join(map(str, self.tempo_kernels))}: give rate factors "
                                  f"above 1, such as 1.05 1.1 1.25.")
@@ -108,37 +114,42 @@ def length_results(splits, settings, env, references):
     paper = {length: {name: entry["by_length"][str(length)]["paper"]
                       for name, entry in results["experiments"].items()} for length in settings.lengths}
     results["chosen"] = choose(paper)
-    results["rhythm_rules"] = rhythm_rule_results(splits, runs, results["chosen"], settings.tempo_kernels, env,
-                                                  references)
+    results["rhythm_rules"] = rhythm_rule_results(splits, runs, results["chosen"], settings.exaggeration_kernels,
+                                                  settings.tempo_kernels, env, references)
     results["chosen_rhythm_rule"] = choose({rule: {name: entry["sets"][name]["paper"] for name in splits}
                                             for rule, entry in results["rhythm_rules"].items()})
     return results
 
 
-def rhythm_rule(factor, by_arm):
-    """A rhythm rule's name: its tempo kernel, and whose waves a request weighs."""
-    return f"log {factor}" + ("" if by_arm else ", both arms' waves")
+def rhythm_rule(bandwidth, factor, by_arm):
+    """A rhythm rule's name: its exaggeration and tempo kernels, and whose waves a request weighs."""
+    return f"sd {bandwidth}, log {factor}" + (", the request's arm's waves" if by_arm else "")
 
 
-def rhythm_rule_results(splits, runs, length, factors, env, references):
-    """{rule name: {'tempo_kernel': factor, 'by_arm', 'sets': {experiment: {'paper': seed_summary, 'leave_one_out':
-    rhythm_leave_one_out.leave_one_out}}}}: the `length` agents of `runs` playing the paper's requests with each
-    tempo kernel, from their arm's training waves and from both arms', and each rule on the training waves alone."""
-    results = {rhythm_rule(factor, by_arm): {"tempo_kernel": factor, "by_arm": by_arm, "sets": {}}
-               for by_arm in (True, False) for factor in factors}
+def rhythm_rule_results(splits, runs, length, bandwidths, factors, env, references):
+    """{rule name: {'exaggeration_kernel', 'tempo_kernel': factor, 'by_arm', 'sets': {experiment: {'paper':
+    seed_summary, 'leave_one_out': rhythm_leave_one_out.leave_one_out}}}}: the `length` agents of `runs` playing
+    the paper's requests with each exaggeration kernel and tempo kernel, from both arms' training waves and from
+    the request's arm's, and each rule on the training waves alone."""
+    results = {rhythm_rule(bandwidth, factor, by_arm): {"exaggeration_kernel": bandwidth, "tempo_kernel": factor,
+                                                        "by_arm": by_arm, "sets": {}}
+               for by_arm in (False, True) for bandwidth in bandwidths for factor in factors}
     for name, (train, validation) in splits.items():
         agent = baselines.AgentMethod(Path(runs[name, length].settings.output) / "agent.npz")
         read = wave_rhythm.swinging([clip for clip in train if clip.behaviour == behaviours.WAVE])  # read once
         for entry in results.values():
-            model = agent.agent.rhythm_model.with_settings(tempo_bandwidth=math.log(entry["tempo_kernel"]))
-            played = VariantMethod(agent, model if entry["by_arm"] else model.without_arms())
+            rule = {"bandwidth": entry["exaggeration_kernel"], "tempo_bandwidth": math.log(entry["tempo_kernel"]),
+                    "by_arm": entry["by_arm"]}
+            played = VariantMethod(agent, agent.agent.rhythm_model.with_settings(**rule))
             entry["sets"][name] = {
                 "paper": seed_summary(compare({"a": played}, validation, env, references)["a"]),
-                "leave_one_out": swinging_check(read, True, math.log(entry["tempo_kernel"]), entry["by_arm"])}
+                "leave_one_out": swinging_check(read, True, **rule)}
     return results
 
 def command_line(settings):
     """The command that regenerates these results."""
     return (f"nice -n 15 python -m trainer.scripts.realmocap_length --lengths "
-            f"{' '.join(map(str, settings.lengths))} --tempo-kernels {' '.join(map(str, settings.tempo_kernels))} "
+            f"{' '.join(map(str, settings.lengths))} --exaggeration-kernels "
+            f"{' '.join(map(str, settings.exaggeration_kernels))} --tempo-kernels "
+            f"{' '.join(map(str, settings.tempo_kernels))} "
             f"--seed {settings.seed} --preset {settings.preset}")

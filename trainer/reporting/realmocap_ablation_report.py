@@ -3,7 +3,7 @@ import math
 
 import numpy as np
 
-from rlanimate_addon.core.rhythm import TEMPO_BANDWIDTH
+from rlanimate_addon.core.rhythm import BANDWIDTH, TEMPO_BANDWIDTH
 from trainer.reporting.realmocap_report import SEED_METRICS, STYLE_METRICS, metric_cells
 from trainer.reporting.tables import markdown_table
 
@@ -106,20 +106,17 @@ def ablation_markdown(results):
              "docs/results/realmocap.md. Regenerate: "
              f"`{results['command']}` ({timing}; one torch thread).", "",
              "- *typical tempo*: what the agent file plays for Variation Seed 0 (the panel's seed 0 is no seed): "
-             "the weighted mean rate, start and stop of the training waves of the request's arm near its "
-             "exaggeration (kernel "
-             f"sd 0.05) and near the typical tempo of those (the mode of their log tempos; kernel sd "
-             f"{TEMPO_KERNEL}), at "
-             "their weighted circular mean phase (core/rhythm.py).",
+             f"the weighted mean rate, start and stop of the training waves near the request's exaggeration (kernel "
+             f"sd {BANDWIDTH:g}) and near the typical tempo of those (the mode of their log tempos; kernel sd "
+             f"{TEMPO_KERNEL}), of both arms, at their weighted circular mean phase (core/rhythm.py; the kernels "
+             "and arms chosen on validation takes, docs/results/realmocap_length.md).",
              "- *mean rhythm, all waves' phase*: as files exported without their waves' phases play, and as every "
-             "agent played before: the weighted mean of the waves of both arms near the exaggeration alone, "
-             "whatever their "
-             "tempo, at the circular mean phase of all training waves.",
-             "- *kernel sd 0.02*: the typical tempo with a tighter exaggeration kernel.",
-             "- *tempo kernel sd log 1.25*: the typical tempo with the wider tempo kernel it had before "
-             f"{TEMPO_KERNEL} was chosen on validation takes (docs/results/realmocap_length.md).",
-             "- *both arms' waves*: the typical tempo from the training waves of both arms, as files made before "
-             "the waves' arms were kept play it (today's files weigh only the request's arm's).",
+             "agent played before: the weighted mean of the waves near the exaggeration alone (kernel sd 0.05), "
+             "whatever their tempo, at the circular mean phase of all training waves.",
+             "- *the kernels before*: the typical tempo with the kernels of the files made before they were chosen "
+             "(sd 0.05, log 1.25).",
+             "- *the request's arm's waves*: the typical tempo from the training waves of the request's arm alone, "
+             "as retrieval fetches only that arm's.",
              "- *sampled states N*: the typical tempo, with the stochastic states sampled (seed N) instead "
              "of their means.",
              "- *seed N*: the panel's Variation Seed N > 0: one nearby training wave's rhythm at a uniformly random "

@@ -53,10 +53,11 @@ def length_markdown(results):
                               "training CPU s"], length_rows(results)), "",
              "## The rhythm at play time", "",
              f"The {results['chosen']}-epoch agents played with each rhythm rule, nothing retrained, on the paper's "
-             "requests (core/rhythm.py): the tempo kernel's sd in log Hz (the training waves near the request's tempo "
-             "weigh in its rhythm by a Gaussian of it), and whether a request weighs the training waves of its own "
-             "arm or of both; and each rule judged on the agents' training waves alone, each left out in turn and "
-             "its rate predicted from the rest (trainer/evaluation/rhythm_leave_one_out.py). "
+             "requests (core/rhythm.py): the exaggeration kernel's sd and the tempo kernel's sd in log Hz (the "
+             "training waves near the request's exaggeration and tempo weigh in its rhythm by Gaussians of these), "
+             "and whether a request weighs the training waves of its own arm or of both; and each rule judged on "
+             "the agents' training waves alone, each left out in turn and its rate predicted from the rest "
+             "(trainer/evaluation/rhythm_leave_one_out.py). "
              f"**Chosen: {results['chosen_rhythm_rule']}**, the best mean of score and DTW score over both "
              "validation sets (the first listed on a tie).", "",
              *markdown_table(["validation set", "rhythm rule", "score", "DTW score", "swing ratio",

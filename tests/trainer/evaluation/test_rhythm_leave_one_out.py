@@ -35,7 +35,9 @@ def test_with_one_rate_both_rules_predict_it():
 def test_where_each_arm_swings_at_its_own_rate_the_arms_predict_every_left_out_wave():
     e, rhythms, frames = _waves(0.06)
     arms = ["LEFT"] * 6 + ["RIGHT"] * 4  # the slow waves are the left arm's, the fast ones the right arm's
-    by_arm = leave_one_out(e, rhythms, frames, typical_tempo=True, arms=arms)
+    by_arm = leave_one_out(e, rhythms, frames, typical_tempo=True, arms=arms, by_arm=True)
     assert by_arm["rate_within"] == 1.0
-    assert by_arm["rate_within"] > leave_one_out(e, rhythms, frames, typical_tempo=True)["rate_within"]
+    pooled = leave_one_out(e, rhythms, frames, typical_tempo=True, arms=arms, by_arm=False)
+    assert by_arm["rate_within"] > pooled["rate_within"]
+    assert pooled == leave_one_out(e, rhythms, frames, typical_tempo=True)  # by_arm off: the arms do not count
     assert leave_one_out(e, rhythms, frames, True, tempo_bandwidth=np.log(1.05))["waves"] == 10

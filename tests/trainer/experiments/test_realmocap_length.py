@@ -57,26 +57,33 @@ def test_the_chosen_length_has_the_best_mean_over_both_sets_and_the_shorter_wins
     assert realmocap_length.choose(by_length) == 50
 
 
-def test_the_rhythm_rules_are_each_tempo_kernel_from_the_requests_arm_then_from_both_and_the_first_wins_a_tie():
-    assert realmocap_length.rhythm_rule(1.1, True) == "log 1.1"
-    assert realmocap_length.rhythm_rule(1.1, False) == "log 1.1, both arms' waves"
-    rules = {"log 1.05": {"takes": _summary(69, 80)}, "log 1.1": {"takes": _summary(72, 78)},
-             "log 1.1, both arms' waves": {"takes": _summary(70, 80)}}
-    assert realmocap_length.choose(rules) == "log 1.1"  # level with both arms' at 75, and listed first
+def test_the_rhythm_rules_name_their_kernels_and_arms_and_the_first_listed_wins_a_tie():
+    assert realmocap_length.rhythm_rule(0.1, 1.1, False) == "sd 0.1, log 1.1"
+    assert realmocap_length.rhythm_rule(0.1, 1.1, True) == "sd 0.1, log 1.1, the request's arm's waves"
+    rules = {"sd 0.1, log 1.05": {"takes": _summary(69, 80)}, "sd 0.1, log 1.1": {"takes": _summary(72, 78)},
+             "sd 0.1, log 1.1, the request's arm's waves": {"takes": _summary(70, 80)}}
+    assert realmocap_length.choose(rules) == "sd 0.1, log 1.1"  # level with the arm's at 75, and listed first
 
 
 def test_the_script_takes_rising_lengths_only():
-    settings = parse_settings(["prog", "--lengths", "5", "10", "--tempo-kernels", "1.1", "1.2", "--seed", "2"])
-    assert (settings.lengths, settings.tempo_kernels, settings.seed) == ((5, 10), (1.1, 1.2), 2)
-    assert ("--lengths 5 10 --tempo-kernels 1.1 1.2 --seed 2 --preset end_chunks"
+    settings = parse_settings(["prog", "--lengths", "5", "10", "--exaggeration-kernels", "0.1", "--tempo-kernels",
+                               "1.1", "1.2", "--seed", "2"])
+    assert (settings.lengths, settings.exaggeration_kernels, settings.tempo_kernels, settings.seed) == (
+        (5, 10), (0.1,), (1.1, 1.2), 2)
+    assert ("--lengths 5 10 --exaggeration-kernels 0.1 --tempo-kernels 1.1 1.2 --seed 2 --preset end_chunks"
             in realmocap_length.command_line(settings))
-    assert parse_settings(["prog"]).tempo_kernels == realmocap_length.TEMPO_KERNELS
+    defaults = parse_settings(["prog"])
+    assert (defaults.exaggeration_kernels, defaults.tempo_kernels) == (realmocap_length.EXAGGERATION_KERNELS,
+                                                                     realmocap_length.TEMPO_KERNELS)
     for lengths in ((10, 5), (), (0, 5)):
         with pytest.raises(RLAnimateError, match="rising epoch counts"):
             realmocap_length.LengthSettings(lengths=lengths)
     for kernels in ((), (1.0, 1.1)):
         with pytest.raises(RLAnimateError, match="rate factors above 1"):
             realmocap_length.LengthSettings(tempo_kernels=kernels)
+    for kernels in ((), (0.0, 0.1)):
+        with pytest.raises(RLAnimateError, match="positive kernel widths"):
+            realmocap_length.LengthSettings(exaggeration_kernels=kernels)
 
 
 def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval():
@@ -85,16 +92,16 @@ def test_the_page_states_the_choice_and_a_row_per_length_request_and_retrieval()
              "by_length": {str(n): {"train_cpu_seconds": 5.0 * n, "paper": _summary(60 + n / 10, 80),
                                     "_tempo": _summary(70, 85), "scoring_cpu_seconds": 1.0} for n in (50, 100)}}
     check = {"waves": 200, "rate_within": 0.9, "median_log_rate_error": 0.0625, "signal_correlation": 0.2}
-    rules = {rule: {"tempo_kernel": 1.1, "by_arm": rule == "log 1.1",
+    rules = {rule: {"exaggeration_kernel": 0.1, "tempo_kernel": 1.1, "by_arm": rule != "sd 0.1, log 1.1",
                     "sets": {"takes": {"paper": _summary(score, 80), "leave_one_out": check}}}
-             for rule, score in (("log 1.1", 71), ("log 1.1, both arms' waves", 70))}
+             for rule, score in (("sd 0.1, log 1.1", 71), ("sd 0.1, log 1.1, the request's arm's waves", 70))}
     page = length_markdown({"command": "cmd", "seed": 0, "preset": "end_chunks", "lengths": [50, 100],
                             "experiments": {"takes": entry}, "chosen": 100, "rhythm_rules": rules,
-                            "chosen_rhythm_rule": "log 1.1"})
-    assert "**Chosen: 100 epochs**" in page and "**Chosen: log 1.1**" in page
+                            "chosen_rhythm_rule": "sd 0.1, log 1.1"})
+    assert "**Chosen: 100 epochs**" in page and "**Chosen: sd 0.1, log 1.1**" in page
     rows = [line for line in page.splitlines() if line.startswith("| takes 007-008 (28) |")]
     assert len(rows) == 6 + 2
-    assert rows[-2] == "| takes 007-008 (28) | log 1.1 | 71.0 | 80.0 | 1.00 | 1.00 | 3.0 | 2/28 | 90% | 0.062 |"
+    assert rows[-2] == "| takes 007-008 (28) | sd 0.1, log 1.1 | 71.0 | 80.0 | 1.00 | 1.00 | 3.0 | 2/28 | 90% | 0.062 |"
     assert rows[1] == ("| takes 007-008 (28) | the paper's | RLAnimate, 100 epochs | 70.0 | 80.0 | 1.00 | 1.00 | 3.0 "
                        "| 2/28 | 500 |")
     assert rows[2].startswith("| takes 007-008 (28) | the paper's | Nearest clip | 74.0 | 90.0 |")
@@ -108,8 +115,8 @@ def test_each_length_is_trained_from_the_start_and_scored_on_the_validation_take
     clips = [realmocap.import_real_clip(REALMOCAP_DIR / "wave" / f"dataset-2_wave-left-hand_{name}.bvh",
                                         tmp_path / "cache")
              for name in ("feminine_001", "feminine_002", "active_002", "active_007")]
-    settings = realmocap_length.LengthSettings(lengths=(1, 2), tempo_kernels=(1.1, 1.25), preset="debug",
-                                               runs=str(tmp_path), workers=1)
+    settings = realmocap_length.LengthSettings(lengths=(1, 2), exaggeration_kernels=(0.1,), tempo_kernels=(1.1, 1.25),
+                                               preset="debug", runs=str(tmp_path), workers=1)
     env = FKEnvironment(instances=4)
     results = realmocap_length.length_results({"takes": realmocap_takes.take_validation_split(clips)}, settings, env,
                                               ClipReferences(env))
@@ -122,8 +129,9 @@ def test_each_length_is_trained_from_the_start_and_scored_on_the_validation_take
         assert scored["paper"]["clips"] == scored["_tempo"]["clips"] == 1 and scored["train_cpu_seconds"] > 0
     assert entry["retrieval"]["paper"]["score"] > 90.0  # active 002 is the nearest clip to active 007
     assert results["chosen"] in (1, 2) and results["chosen_rhythm_rule"] in results["rhythm_rules"]
-    assert list(results["rhythm_rules"]) == ["log 1.1", "log 1.25", "log 1.1, both arms' waves",
-                                             "log 1.25, both arms' waves"]
+    assert list(results["rhythm_rules"]) == ["sd 0.1, log 1.1", "sd 0.1, log 1.25",
+                                             "sd 0.1, log 1.1, the request's arm's waves",
+                                             "sd 0.1, log 1.25, the request's arm's waves"]
     for played in results["rhythm_rules"].values():  # the chosen length's agent, played with each rule
         assert played["sets"]["takes"]["paper"]["clips"] == 1 and played["sets"]["takes"]["leave_one_out"]["waves"] == 3
     exported = (tmp_path / f"takes_validation_{results['chosen']}_debug" / "agent.npz")
