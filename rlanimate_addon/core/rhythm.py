@@ -48,10 +48,10 @@ BANDWIDTH = 0.15
 TEMPO_BANDWIDTH = math.log(1.05)
 #: Whether a request weighs only the training waves of its own arm (when the file keeps the arms).
 BY_ARM = False
-#: The three above were chosen together on real-capture validation takes, over three seeds (sd 0.05-0.15, log
-#: 1.05-1.25, own arm or both; docs/results/realmocap_length.md); files made before keep theirs (0.05, log 1.25).
-#: Log Hz: the tempo kernel of the files made before they kept theirs.
-_EARLIER_TEMPO_BANDWIDTH = math.log(1.25)
+# The three above were chosen together on real-capture validation takes, over three seeds (sd 0.05-0.15, log
+# 1.05-1.25, own arm or both; docs/results/realmocap_length.md); files made before keep theirs (0.05, log 1.25).
+#: Log Hz: the tempo kernel of the files made before they kept theirs, which they play.
+EARLIER_TEMPO_BANDWIDTH = math.log(1.25)
 
 
 @dataclass(frozen=True)
@@ -140,7 +140,7 @@ class RhythmModel:
             model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
                         float(values["ramp"]), float(values["bandwidth"]),
                         None if phases is None else np.asarray(phases, dtype=np.float64),
-                        values.get("typical_tempo"), values.get("tempo_bandwidth", _EARLIER_TEMPO_BANDWIDTH),
+                        values.get("typical_tempo"), values.get("tempo_bandwidth", EARLIER_TEMPO_BANDWIDTH),
                         values.get("arms"), values.get("by_arm", False))
             if not isinstance(model.typical_tempo, bool) or not isinstance(model.by_arm, bool):
                 raise TypeError("typical_tempo and by_arm must be true or false")

@@ -60,9 +60,8 @@ def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm
     frames = len(clip.rotvecs) if frame_count is None else frame_count
     signals = None
     if clip.behaviour == behaviours.WAVE and with_rhythm:
-        drawn = (wave_rhythm.clip_rhythm(clip) if rhythm_model is None
-                 else rhythm_model.draw(clip.attributes, arm=clip.arm))
-        signals = np.zeros((frames, 2)) if drawn is None else rhythm.signals(drawn, frames)
+        signals = (wave_rhythm.clip_signals(clip, frames) if rhythm_model is None
+                   else rhythm.signals(rhythm_model.draw(clip.attributes, arm=clip.arm), frames))
     return space.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
 
 

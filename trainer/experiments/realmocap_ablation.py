@@ -26,7 +26,6 @@ tempo. No variant retrains anything. Beside them, OWN_RHYTHM plays each take's o
 cannot say it), but how much of the agent's gap is its rhythm rather than its poses.
 """
 import copy
-import math
 import time
 from collections import defaultdict
 from dataclasses import dataclass, replace
@@ -34,9 +33,9 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, rhythm, spaces
+from rlanimate_addon.core import behaviours, spaces
 from rlanimate_addon.core.errors import RLAnimateError
-from rlanimate_addon.core.rhythm import RhythmModel
+from rlanimate_addon.core.rhythm import EARLIER_TEMPO_BANDWIDTH, RhythmModel
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import swinging_check
 from trainer.experiments.realmocap import compare, real_run, train_real_runs, waves_and_env
@@ -73,7 +72,7 @@ class Variant:
 SEEDS = (1, 2, 3)
 #: The exaggeration and tempo kernels' sd before they were chosen on validation takes (core/rhythm.py BANDWIDTH,
 #: TEMPO_BANDWIDTH): as files made before play.
-EARLIER_KERNELS = {"bandwidth": 0.05, "tempo_bandwidth": math.log(1.25)}
+EARLIER_KERNELS = {"bandwidth": 0.05, "tempo_bandwidth": EARLIER_TEMPO_BANDWIDTH}
 VARIANTS = (Variant("typical tempo (as exported)", typical_tempo=True),
             Variant("mean rhythm, all waves' phase", typical_tempo=False, bandwidth=EARLIER_KERNELS["bandwidth"]),
             Variant("typical tempo, the kernels before (sd 0.05, log 1.25)", typical_tempo=True, **EARLIER_KERNELS),
@@ -135,21 +134,21 @@ class VariantMethod:
 
 class OwnRhythm:
     """The agent of an AgentMethod playing each of `clips` with the rhythm read from that take itself
-    (wave_rhythm.clip_rhythm, as training reads a clip's; no swing for a take that has none): what the agent's
-    poses give when its rhythm is right. It answers only the requests of `clips`."""
+    (wave_rhythm.clip_signals, as training reads a clip's): what the agent's poses give when its rhythm is right.
+    It answers only the requests of `clips`."""
 
     def __init__(self, method, clips):
         self.agent = method.agent
-        self.rhythms = {self._key(c.arm, c.attributes, len(c.rotvecs)): wave_rhythm.clip_rhythm(c) for c in clips}
+        self.signals = {self._key(c.arm, c.attributes, len(c.rotvecs)): wave_rhythm.clip_signals(c, len(c.rotvecs))
+                        for c in clips}
 
     @staticmethod
     def _key(arm, attributes, frame_count):
         return arm, float(np.ravel(attributes)[0]), int(frame_count)
 
     def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
-        own = self.rhythms[self._key(arm, attributes, frame_count)]
-        signals = np.zeros((frame_count, 2)) if own is None else rhythm.signals(own, frame_count)
-        return baselines.agent_motion(self.agent, behaviour, arm, attributes, frame_count, rhythm_signals=signals)
+        return baselines.agent_motion(self.agent, behaviour, arm, attributes, frame_count,
+                                      rhythm_signals=self.signals[self._key(arm, attributes, frame_count)])
 
 
 def rhythm_with_phases(model, train_clips):

@@ -146,6 +146,7 @@ def rhythm_rule_results(splits, runs, length, bandwidths, factors, env, referenc
                 "leave_one_out": swinging_check(read, True, **rule)}
     return results
 
+
 def command_line(settings):
     """The command that regenerates these results."""
     return (f"nice -n 15 python -m trainer.scripts.realmocap_length --lengths "

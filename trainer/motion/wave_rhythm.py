@@ -86,6 +86,13 @@ def clip_rhythm(clip):
                          stop=float(stop / span), phase=float(offset), ramp=float(ramp))
 
 
+def clip_signals(clip, frame_count):
+    """(frame_count, 2) rhythm signals (core.rhythm.signals) of a wave clip's own rhythm (clip_rhythm): what the
+    task module knows in training; zeros, no swing, for a wave whose hand does not swing."""
+    read = clip_rhythm(clip)
+    return np.zeros((frame_count, 2)) if read is None else rhythm.signals(read, frame_count)
+
+
 def clip_tempo(clip):
     """Hz: how fast a wave clip's hand swings side to side (clip_rhythm), the tempo a request for it names;
     None for a wave whose hand does not swing."""
