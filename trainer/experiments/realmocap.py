@@ -47,9 +47,9 @@ from trainer.evaluation import baselines, scoring
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
-from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, parse_name,
-                                            relaxed_hand, require_realmocap, style_holdout_split, take_paths,
-                                            wave_split)
+from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, TAKE_GROUPS,
+                                            parse_name, relaxed_hand, require_realmocap, style_holdout_split,
+                                            take_group, take_paths, wave_split)
 from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
                            shown)
 from trainer.reporting.realmocap_report import frames_figure, seed_summary
@@ -229,24 +229,37 @@ def label_table(clips):
 
 
 def tempo_table(clips, references):
-    """{style: {takes, spectrum_hz, strokes_hz, stroke_cm}} over wave clips: the median tempo of a style's takes
-    as the trainer reads it (the peak of the swing's spectrum, wave_rhythm.clip_tempo; a request's Tempo) and
+    """{style: {takes, spectrum_hz, strokes_hz, stroke_cm, by_takes}} over wave clips: the median tempo of a style's
+    takes as the trainer reads it (the peak of the swing's spectrum, wave_rhythm.clip_tempo; a request's Tempo) and
     as the report's stroke count reads it (core.behaviour_metrics.wave_measures, whose frequency ratio the bars
-    judge), and the median stroke between turning points. A take neither reads a tempo in is left out of that
-    median."""
+    judge), and the median stroke between turning points; `by_takes` {group of realmocap_takes.TAKE_GROUPS:
+    {takes, exaggeration (mean), spectrum_hz}}, the label and tempo of each group of takes the style has. A take
+    neither reads a tempo in is left out of that median."""
     readings = {}
     for clip in clips:
         measures = behaviour_metrics.wave_measures(spaces.description_joint_positions(references.get(clip)[0]),
                                                    clip.arm)
         spectrum = wave_rhythm.clip_tempo(clip)
-        entry = readings.setdefault(clip.style, {"spectrum": [], "strokes": [], "stroke": []})
+        entry = readings.setdefault(clip.style, {"spectrum": [], "strokes": [], "stroke": [], "groups": []})
         entry["spectrum"].append(np.nan if spectrum is None else spectrum)
         entry["strokes"].append(measures["frequency"] or np.nan)
         entry["stroke"].append(100.0 * measures["swing"])
+        entry["groups"].append((take_group(clip.take), clip.exaggeration, entry["spectrum"][-1]))
     return {style: {"takes": len(entry["spectrum"]), "spectrum_hz": float(np.nanmedian(entry["spectrum"])),
                     "strokes_hz": float(np.nanmedian(entry["strokes"])),
-                    "stroke_cm": float(np.median(entry["stroke"]))}
+                    "stroke_cm": float(np.median(entry["stroke"])), "by_takes": _by_take_group(entry["groups"])}
             for style, entry in sorted(readings.items())}
+
+
+def _by_take_group(readings):
+    """{group: {takes, exaggeration, spectrum_hz}} of [(group, exaggeration, spectrum tempo)], in TAKE_GROUPS order."""
+    table = {}
+    for group in TAKE_GROUPS:
+        rows = np.array([(e, hz) for name, e, hz in readings if name == group]).reshape(-1, 2)
+        if len(rows):
+            table[group] = {"takes": len(rows), "exaggeration": float(rows[:, 0].mean()),
+                            "spectrum_hz": float(np.nanmedian(rows[:, 1])) if np.isfinite(rows[:, 1]).any() else None}
+    return table
 
 
 def point_agent_and_library(point_agent, runs, epochs, seed):

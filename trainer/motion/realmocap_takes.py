@@ -13,8 +13,10 @@ from trainer.motion.synthesis import FINGER_BONES, neutral_pose
 from trainer.paths import REALMOCAP_DIR
 
 STYLES = ("active", "elderly", "exhausted", "feminine", "masculine", "normal", "youthful")
-#: Takes 001-008 and 021-036 (the later takes exist for some styles and arms only; README there).
-TRAIN_TAKES = tuple(f"{k:03d}" for k in (*range(1, 9), *range(21, 37)))
+#: Takes 021-036 (they exist for some styles and arms only; README there).
+LATER_TAKES = tuple(f"{k:03d}" for k in range(21, 37))
+#: Takes 001-008 and the later takes.
+TRAIN_TAKES = tuple(f"{k:03d}" for k in range(1, 9)) + LATER_TAKES
 TEST_TAKES = ("009", "010")
 #: Takes 011-020 are held out for evaluation outside the project: never read, even where present.
 WITHHELD_TAKES = tuple(f"{k:03d}" for k in range(11, 21))
@@ -31,6 +33,10 @@ HOLDOUT_STYLES = ("elderly", "exhausted")
 #: 0.67), as exhausted's (0.53) fall beside normal's.
 VALIDATION_TAKES = ("007", "008")
 VALIDATION_STYLE = "normal"
+#: The groups of takes the report compares a style's label and tempo over, {name: takes}: the training takes
+#: before the validation ones, the validation takes, the test takes and the later takes.
+TAKE_GROUPS = {"001-006": tuple(f"{k:03d}" for k in range(1, 7)), "007-008": VALIDATION_TAKES,
+               "009-010": TEST_TAKES, "021-036": LATER_TAKES}
 #: The 14 styles of dataset 1's guide and bye takes (one take, 001, each; licenses/dataset-1_style_label.txt
 #: but "not-confident", which has neither).
 GESTURE_STYLES = ("active", "angry", "childish", "chimpira", "feminine", "giant", "happy", "masculinity", "musical",
@@ -96,6 +102,11 @@ def relaxed_hand(clip):
         else:
             fingers[name] = np.tile(rotvec, (len(rotvecs), 1))
     return replace(clip, rotvecs=rotvecs, fingers=fingers)
+
+
+def take_group(take):
+    """The name of the TAKE_GROUPS group that holds `take` ('001'), or None."""
+    return next((name for name, takes in TAKE_GROUPS.items() if take in takes), None)
 
 
 def wave_split(clips):

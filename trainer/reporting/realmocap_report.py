@@ -5,7 +5,7 @@ import matplotlib
 import numpy as np
 
 from rlanimate_addon.core import skeleton
-from trainer.motion.realmocap_takes import HOLDOUT_STYLES, parse_name
+from trainer.motion.realmocap_takes import HOLDOUT_STYLES, TAKE_GROUPS, parse_name
 from trainer.reporting.baselines_report import METHOD_LABELS
 from trainer.reporting.tables import markdown_table
 
@@ -160,6 +160,18 @@ def cpu_list(entry):
     return ", ".join(f"{seconds:.0f} s (seed {seed})" for seed, seconds in entry["train_cpu_seconds"].items())
 
 
+#: What the report says a group of takes is for, beside its name.
+TAKE_GROUP_ROLES = {"007-008": " (validation)", "009-010": " (test)"}
+
+
+def _take_group_cell(entry):
+    """'0.73, 1.29 Hz (16)' for a tempo_table `by_takes` entry; '' for none."""
+    if entry is None:
+        return ""
+    tempo = "no swing" if entry["spectrum_hz"] is None else f"{entry['spectrum_hz']:.2f} Hz"
+    return f"{entry['exaggeration']:.2f}, {tempo} ({entry['takes']})"
+
+
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
     tempos = results["tempos"]
@@ -168,6 +180,8 @@ def realmocap_markdown(results):
                    f"{tempos[style]['spectrum_hz']:.2f}", f"{tempos[style]['strokes_hz']:.2f}",
                    f"{tempos[style]['stroke_cm']:.1f}"]
                   for style, row in results["labels"]["wave"].items()]
+    take_group_rows = [[style, *(_take_group_cell(tempos[style]["by_takes"].get(group)) for group in TAKE_GROUPS)]
+                       for style in results["labels"]["wave"]]
     score_rows, behaviour_rows, style_rows = [], [], []
     for name, label in (("wave", f"wave agent, takes 001-008 and 021-036 ({results['wave']['train_clips']} clips)"),
                         ("holdout", f"wave agent, 5 styles ({results['holdout']['train_clips']} clips; unseen: "
@@ -208,6 +222,14 @@ def realmocap_markdown(results):
              "(`core.behaviour_metrics.wave_measures`, whose frequency ratio the tables below report); stroke: "
              "their median length. Where the strokes are small (a tremble) the two disagree, and the frequency "
              "ratio judges a wave by the second.",
+             "", "### Label and tempo by group of takes", "",
+             *markdown_table(["style", *(f"takes {group}" + TAKE_GROUP_ROLES.get(group, "") for group in TAKE_GROUPS)],
+                             take_group_rows),
+             "", "Each cell: the mean exaggeration, the median tempo as the trainer reads it (spectrum), and the "
+             "takes. Takes 007-008 validate what takes 009-010 test (trainer/experiments/realmocap_length.py). Where a "
+             "style's tempo moves from one group of takes to another while its label barely does, a rhythm drawn "
+             "from the label cannot follow it, and validation on takes 007-008 cannot show what it costs on takes "
+             "009-010.",
              "", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), "",
              "## Score and smoothness", "",
              "Every method answers each test take's request twice: with the take's auto-label and length (the "

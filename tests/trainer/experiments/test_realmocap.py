@@ -67,6 +67,9 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     assert set(tempos) == {"feminine", "active", "normal"} and tempos["active"]["takes"] == 1
     assert tempos["active"]["spectrum_hz"] == pytest.approx(tempos["active"]["strokes_hz"], rel=0.1)  # a clear swing
     assert tempos["normal"]["spectrum_hz"] == pytest.approx(tempo) and tempos["active"]["stroke_cm"] > 10.0
+    assert tempos["normal"]["by_takes"] == {"009-010": {"takes": 1, "exaggeration": test[0].exaggeration,
+                                                        "spectrum_hz": pytest.approx(tempo)}}
+    assert list(tempos["feminine"]["by_takes"]) == ["001-006"]
     summary = seed_summary(comparison["rlanimate"])
     assert summary["clips"] == len(test) and 0 <= summary["accepted"] <= len(test)
     assert summary["aligned_score"] == comparison["rlanimate"]["by_behaviour"]["wave"]["aligned_score"]

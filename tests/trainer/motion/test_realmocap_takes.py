@@ -36,6 +36,14 @@ def test_splits_match_the_experiments():
     assert {c.take for c in test} == {f"{k:03d}" for k in range(1, 11)}
 
 
+def test_take_groups_hold_every_read_take_once_and_name_validation_and_test():
+    groups = [realmocap_takes.take_group(realmocap_takes.parse_name(name)["take"]) for name in WAVE_NAMES + LATER_NAMES]
+    assert None not in groups and set(groups) == set(realmocap_takes.TAKE_GROUPS)
+    assert realmocap_takes.TAKE_GROUPS["007-008"] == realmocap_takes.VALIDATION_TAKES
+    assert realmocap_takes.TAKE_GROUPS["009-010"] == realmocap_takes.TEST_TAKES
+    assert realmocap_takes.take_group("015") is None  # a withheld take is in no group
+
+
 def test_take_selection_never_reads_the_withheld_takes_011_to_020(tmp_path):
     withheld = [f"dataset-2_wave-left-hand_normal_{take:03d}.bvh" for take in range(11, 21)]
     for name in WAVE_NAMES[:12] + LATER_NAMES[:2] + withheld:
