@@ -5,7 +5,7 @@ import matplotlib
 import numpy as np
 
 from rlanimate_addon.core import skeleton
-from trainer.motion.realmocap_takes import HOLDOUT_STYLES, TAKE_GROUPS, parse_name
+from trainer.motion.realmocap_takes import HOLDOUT_STYLES, TAKE_GROUPS, TEST_TAKES, VALIDATION_TAKES, parse_name
 from trainer.reporting.baselines_report import METHOD_LABELS
 from trainer.reporting.tables import markdown_table
 
@@ -160,8 +160,8 @@ def cpu_list(entry):
     return ", ".join(f"{seconds:.0f} s (seed {seed})" for seed, seconds in entry["train_cpu_seconds"].items())
 
 
-#: What the report says a group of takes is for, beside its name.
-TAKE_GROUP_ROLES = {"007-008": " (validation)", "009-010": " (test)"}
+#: What the report says a group of takes is for, beside its name, by its takes.
+TAKE_GROUP_ROLES = {VALIDATION_TAKES: " (validation)", TEST_TAKES: " (test)"}
 
 
 def _take_group_cell(entry):
@@ -223,8 +223,8 @@ def realmocap_markdown(results):
              "their median length. Where the strokes are small (a tremble) the two disagree, and the frequency "
              "ratio judges a wave by the second.",
              "", "### Label and tempo by group of takes", "",
-             *markdown_table(["style", *(f"takes {group}" + TAKE_GROUP_ROLES.get(group, "") for group in TAKE_GROUPS)],
-                             take_group_rows),
+             *markdown_table(["style", *(f"takes {group}" + TAKE_GROUP_ROLES.get(takes, "")
+                                         for group, takes in TAKE_GROUPS.items())], take_group_rows),
              "", "Each cell: the mean exaggeration, the median tempo as the trainer reads it (spectrum), and the "
              "takes. Takes 007-008 validate what takes 009-010 test (trainer/experiments/realmocap_length.py). Where a "
              "style's tempo moves from one group of takes to another while its label barely does, a rhythm drawn "
