@@ -106,8 +106,11 @@ def swinging(waves):
 
 
 def fit_rhythm_model(waves):
-    """The RhythmModel of wave clips, fitted on those whose hand swings (`swinging`) by their exaggeration
-    (`.attributes`) and arm."""
-    read = swinging(waves)
+    """The RhythmModel of wave clips, fitted on those whose hand swings (`swinging`)."""
+    return rhythm_model(swinging(waves))
+
+
+def rhythm_model(read):
+    """The RhythmModel of `swinging`'s (clip, Rhythm) pairs, by the clips' exaggeration (`.attributes`) and arm."""
     return rhythm.RhythmModel.fit([clip.attributes for clip, _ in read], [r for _, r in read],
                                   [clip.arm for clip, _ in read])
