@@ -19,7 +19,9 @@ Takes 011-020 are never read (motion/realmocap_takes.py, WITHHELD_TAKES). Every 
 twice (REQUESTS): with its auto-label and length, and naming its wave's tempo as well. Both baselines
 (trainer/evaluation/baselines.py) answer the same requests, retrieval from the same training clips; the
 agents are scored through their exported agent.npz (the numpy runtime the add-on plays). The first seed's
-agents give the full tables and the figure; every seed's agents are scored on the wave sets ("seeds").
+agents give the full tables and the figure; every seed's agents are scored on the wave sets ("seeds"). What tempo a
+request's label can reach on each test, from the training waves alone, is read beside them
+(trainer/evaluation/label_reach.py).
 Writes docs/results/realmocap.json and .md, the real-data section of docs/results/baselines.json and .md,
 and docs/results/realmocap_frames.png (generated and real frames side by side).
 """
@@ -44,6 +46,7 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation import baselines, scoring
+from trainer.evaluation.label_reach import label_reach
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
@@ -333,6 +336,8 @@ def run_experiments(settings: RealMocapSettings) -> dict:
                "tempos": tempo_table(waves, references)}
 
     experiments = {"wave": wave_split(waves), "holdout": style_holdout_split(waves)}
+    results["label_reach"] = {name: label_reach(wave_rhythm.swinging(train_clips), wave_rhythm.swinging(test_clips))
+                              for name, (train_clips, test_clips) in experiments.items()}
     evaluation_started = time.process_time()
     runs = {(name, seed): real_run(name, train_clips, test_clips, seed, settings)
             for name, (train_clips, test_clips) in experiments.items() for seed in seeds}

@@ -172,6 +172,33 @@ def _take_group_cell(entry):
     return f"{entry['exaggeration']:.2f}, {tempo} ({entry['takes']})"
 
 
+#: The test sets of the label-reach table: (experiment, what the report calls its test).
+REACH_SETS = (("wave", "takes 009-010"), ("holdout", "unseen styles"))
+
+
+def reach_widths(results):
+    """The label neighbourhoods' half-widths (as keyed) of the label-reach table, narrowest first."""
+    return list(next(iter(results["label_reach"]["wave"]["styles"].values()))["near"])
+
+
+def reach_rows(results):
+    """Rows of the label-reach table (trainer/evaluation/label_reach.py), per test set and style; the styles of the
+    training waves are named for the widest neighbourhood."""
+    widest = reach_widths(results)[-1]
+    rows = []
+    for name, set_label in REACH_SETS:
+        reach = results["label_reach"][name]
+        for style, entry in reach["styles"].items():
+            near, rules = entry["near"], entry["rules"]
+            rows.append([set_label, style, str(entry["takes"]), "{:.2f}-{:.2f}".format(*entry["labels"]),
+                         f"{entry['tempo_hz']:.2f}",
+                         ", ".join(f"{cell['in_reach']}/{cell['waves']}" for cell in near.values()),
+                         ", ".join(near[widest]["styles"]) or "none",
+                         ", ".join(near[widest]["in_reach_styles"]) or "none",
+                         f"{rules['lowest']:.2f}-{rules['highest']:.2f} ({rules['in_band']}/{reach['rules']})"])
+    return rows
+
+
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
     tempos = results["tempos"]
@@ -230,6 +257,22 @@ def realmocap_markdown(results):
              "style's tempo moves from one group of takes to another while its label barely does, a rhythm drawn "
              "from the label cannot follow it, and validation on takes 007-008 cannot show what it costs on takes "
              "009-010.",
+             "", "### What tempo the label can reach", "",
+             *markdown_table(["test set", "style", "takes", "labels", "tempo (Hz)",
+                              "training waves within ±" + ", ±".join(reach_widths(results)) +
+                              " of its labels: within 0.8-1.25x of its tempo / all",
+                              f"styles within ±{reach_widths(results)[-1]}",
+                              f"styles within ±{reach_widths(results)[-1]} and 0.8-1.25x",
+                              "rate played / its own, median over its takes: lowest-highest over the rules "
+                              "(rules within 0.8-1.25x)"], reach_rows(results)),
+             "", "From the training waves and the test takes alone, no agent (trainer/evaluation/label_reach.py): "
+             "a rhythm taken from the training waves near a request's exaggeration, as RLAnimate's and retrieval's "
+             "are, can only swing at a rate those waves swing at. The rules are the rhythm model's exaggeration "
+             "kernels of sd 0.01-1, with the mean rhythm or the typical tempo (tempo kernels log 1.05, 1.25, 2), "
+             "from both arms' waves or the request's arm's. Rules whose median lies within 0.8-1.25x in every "
+             "style: " + ", ".join(f"{label} {results['label_reach'][name]['in_band_in_every_style']} of "
+                                   f"{results['label_reach'][name]['rules']}" for name, label in REACH_SETS) +
+             ". A diagnosis of the tests, nothing chosen from it.",
              "", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), "",
              "## Score and smoothness", "",
              "Every method answers each test take's request twice: with the take's auto-label and length (the "

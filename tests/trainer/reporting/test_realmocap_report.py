@@ -1,8 +1,8 @@
 """docs/results/realmocap.md's per-style table (takes grouped by the style in their file names) and
-seeds table (each seed, their mean ± sd, and retrieval)."""
+seeds table (each seed, their mean ± sd, and retrieval), and what tempo each test style's label can reach."""
 import numpy as np
 
-from trainer.reporting.realmocap_report import per_style_rows, seed_rows, style_summaries
+from trainer.reporting.realmocap_report import per_style_rows, reach_rows, seed_rows, style_summaries
 
 
 def _clip(style, take, score, swing, accepted, elevation=2.0):
@@ -71,3 +71,20 @@ def test_seed_rows_give_each_seed_then_their_mean_and_sd_then_retrieval():
     assert rows[2][6] == "**3.0 ± 0.0**" and rows[3][3] == "81.0" and rows[3][6:] == ["2.0", "1"]
     # One seed: no mean row.
     assert [row[1] for row in rows[4:6]] == ["RLAnimate, seed 0", "Nearest clip"]
+
+
+def _reach(style, in_reach_styles, lowest, in_band):
+    near = {str(w): {"waves": 10 * k, "styles": ["feminine", "normal"][:k], "in_reach": len(in_reach_styles) * k,
+                     "in_reach_styles": in_reach_styles} for k, w in enumerate((0.05, 0.1, 0.2), start=0)}
+    return {"styles": {style: {"takes": 20, "labels": (0.2, 0.34), "tempo_hz": 0.87, "near": near,
+                               "rules": {"in_band": in_band, "lowest": lowest, "highest": lowest + 1.0}}},
+            "rules": 72, "in_band_in_every_style": in_band}
+
+
+def test_reach_rows_give_each_test_style_its_neighbours_in_reach_and_the_rules_range():
+    rows = reach_rows({"label_reach": {"wave": _reach("masculine", ["masculine"], 1.04, 27),
+                                       "holdout": _reach("elderly", [], 1.91, 0)}})
+    assert rows[0] == ["takes 009-010", "masculine", "20", "0.20-0.34", "0.87", "0/0, 1/10, 2/20",
+                       "feminine, normal", "masculine", "1.04-2.04 (27/72)"]
+    assert rows[1][:2] == ["unseen styles", "elderly"] and rows[1][5:] == ["0/0, 0/10, 0/20", "feminine, normal",
+                                                                          "none", "1.91-2.91 (0/72)"]
