@@ -209,6 +209,7 @@ def realmocap_markdown(results):
                   for style, row in results["labels"]["wave"].items()]
     take_group_rows = [[style, *(_take_group_cell(tempos[style]["by_takes"].get(group)) for group in TAKE_GROUPS)]
                        for style in results["labels"]["wave"]]
+    widths = reach_widths(results)
     score_rows, behaviour_rows, style_rows = [], [], []
     for name, label in (("wave", f"wave agent, takes 001-008 and 021-036 ({results['wave']['train_clips']} clips)"),
                         ("holdout", f"wave agent, 5 styles ({results['holdout']['train_clips']} clips; unseen: "
@@ -259,10 +260,9 @@ def realmocap_markdown(results):
              "009-010.",
              "", "### What tempo the label can reach", "",
              *markdown_table(["test set", "style", "takes", "labels", "tempo (Hz)",
-                              "training waves within ±" + ", ±".join(reach_widths(results)) +
-                              " of its labels: within 0.8-1.25x of its tempo / all",
-                              f"styles within ±{reach_widths(results)[-1]}",
-                              f"styles within ±{reach_widths(results)[-1]} and 0.8-1.25x",
+                              f"training waves within ±{', ±'.join(widths)} of its labels: within 0.8-1.25x of "
+                              f"its tempo / all", f"styles within ±{widths[-1]}",
+                              f"styles within ±{widths[-1]} and 0.8-1.25x",
                               "rate played / its own, median over its takes: lowest-highest over the rules "
                               "(rules within 0.8-1.25x)"], reach_rows(results)),
              "", "From the training waves and the test takes alone, no agent (trainer/evaluation/label_reach.py): "
