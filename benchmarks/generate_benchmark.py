@@ -71,7 +71,7 @@ def key_idle(rig):
 def remove_gesture(rig, idle):
     """Remove the baked gesture; the idle (None: no animation) active again, as before Generate."""
     data = rig.animation_data
-    for action in [a for a in bpy.data.actions if gestures.RECORD in a]:
+    for action in [a for a in bpy.data.actions if gestures.RECORD in a or gestures.TORSO_OF in a]:
         bpy.data.actions.remove(action)
     for track in list(data.nla_tracks):
         data.nla_tracks.remove(track)

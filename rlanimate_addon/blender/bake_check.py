@@ -146,7 +146,7 @@ def verify(scene, plan):
     scale = float(np.cbrt(abs(np.linalg.det(np.array(obj.matrix_world.to_3x3())))))
     rest_points, carrier_rests = bake_measure.rest_points(rig, arm), _rest_matrices(obj, carriers)
     start = int(plan.settings.start_frame)
-    for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0]):
+    for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0], plan.shown):
         frame = start + index
         scene.frame_set(frame)
         played = bake_measure.carried(_armature_matrices(obj, carriers)[None], carrier_rests, rest_points)

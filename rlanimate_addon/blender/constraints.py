@@ -65,9 +65,10 @@ def against_gesture(obj, bone_names):
     return overriding(obj, bone_names) + held_below(obj, bone_names)
 
 
-def driven_bones(names, behaviour, arm):
-    """The rig's names of the bones a gesture keys: the action joints, and for Point the pointing hand."""
-    canonical = list(skeleton.ACTION_JOINTS)
+def driven_bones(names, behaviour, arm, still=True):
+    """The rig's names of the bones a gesture keys: the action joints it owns (the other arm only made as on a
+    still rig: gesture.owned_joints), and for Point the pointing hand."""
+    canonical = list(gesture.owned_joints(arm, still))
     if behaviour == "POINT":
         canonical += [skeleton.ARM_PREFIX[arm] + bone for bone in gesture.POINTING_HAND]
     return [names[name] for name in canonical if name in names]

@@ -73,14 +73,16 @@ def turned(a, b):
     return np.degrees(np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0)))
 
 
-def check_frames(count, hand_path):
+def check_frames(count, hand_path, shown=None):
     """Indices of three frames of a gesture of `count` frames to check: its apex (where the planned hand
     (N, 3) is farthest from where it starts), and the frames a third and two thirds of the way through
     the frames the gesture plays at full weight (no blend with the pose underneath, so constraints the
-    bake mutes are fully off)."""
-    full = np.flatnonzero(blend_weights(count) == 1.0)
+    bake mutes are fully off), of its first `shown` frames (all when None; fewer where a later gesture
+    takes over from it)."""
+    shown = count if shown is None else min(count, int(shown))
+    full = np.flatnonzero(blend_weights(count)[:shown] == 1.0)
     if not len(full):
-        full = np.arange(count)
+        full = np.arange(shown)
     apex = full[int(np.argmax(np.linalg.norm(hand_path[full] - hand_path[0], axis=1)))]
     return sorted({int(apex), int(full[len(full) // 3]), int(full[(2 * len(full)) // 3])})
 

@@ -53,6 +53,14 @@ def rotvec_to_quat(rotvec: ArrayLike) -> np.ndarray:
     return _joined([np.cos(half), x * scale, y * scale, z * scale], r.shape[:-1])
 
 
+def quat_multiply(a: ArrayLike, b: ArrayLike) -> np.ndarray:
+    """Hamilton product a b of (..., 4) quaternions (w, x, y, z): the rotation b, then a."""
+    aw, ax, ay, az = np.moveaxis(np.asarray(a, dtype=np.float64), -1, 0)
+    bw, bx, by, bz = np.moveaxis(np.asarray(b, dtype=np.float64), -1, 0)
+    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
+                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=-1)
+
+
 def quat_to_matrix(quat: ArrayLike) -> np.ndarray:
     """(..., 4) quaternions -> (..., 3, 3) rotation matrices (columns are the rotated axes)."""
     q = np.asarray(quat, dtype=np.float64)

@@ -338,13 +338,20 @@ def _generate(rig, settings, mute, **values):
 
 def point(rig, settings, arm, target, start, frames=120, exact=True, mute=False):
     """Generate a Point; returns (operator result, miss in degrees of the deformed finger at its hold
-    (median over behaviour_metrics.hold_frames of the finger base, else at the apex), the deformed wrist's
-    greatest travel from its start in arm lengths)."""
+    (`point_miss`), the deformed wrist's greatest travel from its start in arm lengths)."""
     empty = helpers.add_empty(f"Target{start}", tuple(target))
     result = _generate(rig, settings, mute, behaviour="POINT", arm=arm, target=empty, start_frame=start,
                        frame_count=frames, exact_aim=exact)
     if result != {"FINISHED"}:
         return result, np.nan, np.nan
+    miss, travel = point_miss(rig, settings, arm, target, start, frames)
+    return result, miss, travel
+
+
+def point_miss(rig, settings, arm, target, start, frames):
+    """(miss in degrees of the deformed finger (median over behaviour_metrics.hold_frames of the finger base,
+    else at the apex), the deformed wrist's greatest travel from its start in arm lengths) of a Point as it
+    plays on frames start to start + frames - 1."""
     joints, arm_length = played_joints(rig, settings, arm, start, frames)
     base, finger = joints[:, 1], joints[:, 2] - joints[:, 1]
     angles = behaviour_metrics.pointing_angles(base, finger, np.asarray(target))
@@ -352,7 +359,7 @@ def point(rig, settings, arm, target, start, frames=120, exact=True, mute=False)
     hold = behaviour_metrics.hold_frames(base, _shoulder_width(rig, settings), render.fps / render.fps_base)
     miss = (np.median(angles[hold[0]:hold[1] + 1]) if hold is not None
             else angles[int(np.argmax(np.linalg.norm(base - base[0], axis=1)))])
-    return result, float(miss), wrist_travel(joints, arm_length)
+    return float(miss), wrist_travel(joints, arm_length)
 
 
 def point_misses(rig, settings, count, exact, seed):
@@ -379,16 +386,23 @@ def _shoulder_width(rig, settings):
 
 def wave(rig, settings, arm, start, frames=150, exaggeration=0.8, mute=False):
     """Generate a Wave; returns (operator result, strokes of the deformed wrist's side-to-side motion
-    (test_rig_variants._strokes), its greatest travel from its start in arm lengths)."""
+    (`wave_strokes`), its greatest travel from its start in arm lengths)."""
     result = _generate(rig, settings, mute, behaviour="WAVE", arm=arm, exaggeration=exaggeration,
                        start_frame=start, frame_count=frames)
     if result != {"FINISHED"}:
         return result, 0, np.nan
+    strokes, travel = wave_strokes(rig, settings, arm, start, frames)
+    return result, strokes, travel
+
+
+def wave_strokes(rig, settings, arm, start, frames):
+    """(strokes of the deformed wrist's side-to-side motion (test_rig_variants._strokes), its greatest travel
+    from its start in arm lengths) of a Wave as it plays on frames start to start + frames - 1."""
     joints, arm_length = played_joints(rig, settings, arm, start, frames)
     frame, _ = _character_frame(rig, settings)
     to_character = frame @ np.linalg.inv(np.array(rig.matrix_world)[:3, :3])
     lateral = (joints[:, 0] - joints[:, 3]) @ to_character.T[:, 0] / arm_length
-    return result, _strokes(lateral), wrist_travel(joints, arm_length)
+    return _strokes(lateral), wrist_travel(joints, arm_length)
 
 
 def arm_drop(rig, settings, arm, frame):

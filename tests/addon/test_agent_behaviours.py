@@ -102,6 +102,6 @@ def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviour
     assert travel > 0.1, f"the hand moves ({travel:.3f} m)"
     assert addon_helpers.generate(rig, settings, behaviour="SHRUG", arm="LEFT", exaggeration=0.9,
                                   start_frame=200, frame_count=80) == {"FINISHED"}
-    raised = gestures.placed_gestures(rig)[0]
+    raised = gestures.placed_gestures(rig)[-1]  # the topmost
     assert (raised.record["behaviour"], raised.record["kind"]) == ("SHRUG", "intensity")
     assert gestures.last_targeted(rig).action == beckon.action, "Follow Target follows the target behaviour"

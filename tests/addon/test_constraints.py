@@ -108,9 +108,12 @@ def test_generate_again_over_a_muted_constraint_fades_it_once_as_the_first_click
     for frame in ramp[:3]:
         bpy.context.scene.frame_set(int(frame))
         assert ik.influence == pytest.approx(expected[frame - START], abs=1e-6)
-    # A replacing gesture at other frames gives back the old frames' influence and fades its own.
+    # The gesture selected in the panel's list, baked again at other frames, gives back the old frames' influence
+    # and fades its own.
+    assert bpy.ops.rlanimate.select_gesture(gesture="RLAnimate Wave Right") == {"FINISHED"}
     settings.start_frame = START + 10
     assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    assert len([a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Right")]) == 2, "main and torso"
     for frame, value in ((START + 2, 0.7), (START + 10 + COUNT // 2, 0.0), (START + 10 + COUNT - 1, 0.7)):
         bpy.context.scene.frame_set(frame)
         assert ik.influence == pytest.approx(value, abs=1e-6)

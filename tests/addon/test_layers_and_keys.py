@@ -59,8 +59,9 @@ def test_replace_and_combine_layers_point_on_target_over_the_animation(settings,
     target = helpers.add_empty("Target", location)
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, start_frame=40,
                             frame_count=120, blend_type=blend_type) == {"FINISHED"}
-    strip = rig.animation_data.nla_tracks[-1].strips[0]
+    strip = rig.animation_data.nla_tracks["RLAnimate Point Right"].strips[0]
     assert strip.blend_type == blend_type
+    assert rig.animation_data.nla_tracks["RLAnimate Point Right (torso)"].strips[0].blend_type == "COMBINE"
     angles, bases = finger_angles(rig, "RIGHT", location, np.arange(40, 160))
     apex = int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))
     print(f"{blend_type}: apex miss {angles[apex]:.3f} deg")

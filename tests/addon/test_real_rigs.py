@@ -167,8 +167,10 @@ def test_a_still_control_rig_stands_as_a_still_rig_does_through_a_muted_gesture(
 
     first = keys()
     assert real_rigs.wave(rig, settings, "RIGHT", start, count, mute=True)[0] == {"FINISHED"}
-    assert keys() == first and len(bpy.data.actions) == 1
-    # Regenerated later, the frames it left stand too: the muted influence is not given back there alone.
+    assert keys() == first and len(bpy.data.actions) == 2, "the gesture's main and torso actions"
+    # Selected in the list and regenerated later, the frames it left stand too: the muted influence is not
+    # given back there alone.
+    assert bpy.ops.rlanimate.select_gesture(gesture="RLAnimate Wave Right") == {"FINISHED"}
     assert real_rigs.wave(rig, settings, "RIGHT", start + 10, count, mute=True)[0] == {"FINISHED"}
     assert_stands((start, start + 10, end + 10))
     # A control the animator posed (the right hand's IK control) is a pose of theirs: the gesture fades

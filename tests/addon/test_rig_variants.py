@@ -7,7 +7,7 @@ import pytest
 import rig_variants
 from test_generate import random_target
 
-from rlanimate_addon.blender import action_adapter
+from rlanimate_addon.blender import action_adapter, gestures
 from rlanimate_addon.core import behaviour_metrics, gesture, rig_roles
 
 RNG = np.random.default_rng(11)
@@ -102,9 +102,13 @@ def _pose_snapshot(rig, frames):
     return {k: np.array(v) for k, v in out.items()}
 
 
-def _gesture_bones(action, rig):
-    target = action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None)
-    return {f.data_path.split('"')[1] for f in target.fcurves()}
+def _gesture_bones(actions, rig):
+    """The bones an action, or a list of actions, keys."""
+    bones = set()
+    for action in actions if isinstance(actions, list) else [actions]:
+        target = action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None)
+        bones |= {f.data_path.split('"')[1] for f in target.fcurves()}
+    return bones
 
 
 def _all_keys():
@@ -141,7 +145,9 @@ def test_point_with_exact_aim_hits_and_changes_nothing_it_does_not_own(settings,
 
 
 def _newest_gesture():
-    return max((a for a in bpy.data.actions if a.name.startswith("RLAnimate")), key=lambda a: a.session_uid)
+    """The actions of the gesture made last: its main action and its torso action."""
+    main = max((a for a in bpy.data.actions if gestures.RECORD in a), key=lambda a: a.session_uid)
+    return [main] + [a for a in bpy.data.actions if a.get(gestures.TORSO_OF) == main[gestures.RECORD]["id"]]
 
 
 def _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=120):
