@@ -119,7 +119,8 @@ class KeyMemory:
         for path, index, count, bezier in zip(kept["paths"], kept["indices"], kept["counts"], kept["bezier"],
                                               strict=True):
             co, interpolation = take(np.float32, (count, 2)), take(np.uint8, (count,))
-            memory.curves.append((path, int(index), co, interpolation, take(np.float32, (count, 4)) if bezier else None))
+            handles = take(np.float32, (count, 4)) if bezier else None
+            memory.curves.append((path, int(index), co, interpolation, handles))
         return memory
 
 

@@ -349,17 +349,25 @@ def point(rig, settings, arm, target, start, frames=120, exact=True, mute=False)
 
 
 def point_miss(rig, settings, arm, target, start, frames):
-    """(miss in degrees of the deformed finger (median over behaviour_metrics.hold_frames of the finger base,
-    else at the apex), the deformed wrist's greatest travel from its start in arm lengths) of a Point as it
-    plays on frames start to start + frames - 1."""
+    """(miss in degrees of the deformed finger (median over its hold, `finger_angles`), the deformed wrist's
+    greatest travel from its start in arm lengths) of a Point as it plays on frames start to start + frames - 1."""
+    angles, (first, last), travel = finger_angles(rig, settings, arm, target, start, frames)
+    return float(np.median(angles[first:last + 1])), travel
+
+
+def finger_angles(rig, settings, arm, target, start, frames):
+    """((F,) degrees between the deformed finger and the target at each frame, (first, last) index of the
+    point's hold (behaviour_metrics.hold_frames of the finger base; the apex alone without a hold), the
+    deformed wrist's greatest travel from its start in arm lengths) of a Point as it plays on frames start to
+    start + frames - 1."""
     joints, arm_length = played_joints(rig, settings, arm, start, frames)
     base, finger = joints[:, 1], joints[:, 2] - joints[:, 1]
     angles = behaviour_metrics.pointing_angles(base, finger, np.asarray(target))
     render = bpy.context.scene.render
     hold = behaviour_metrics.hold_frames(base, _shoulder_width(rig, settings), render.fps / render.fps_base)
-    miss = (np.median(angles[hold[0]:hold[1] + 1]) if hold is not None
-            else angles[int(np.argmax(np.linalg.norm(base - base[0], axis=1)))])
-    return float(miss), wrist_travel(joints, arm_length)
+    if hold is None:
+        hold = (int(np.argmax(np.linalg.norm(base - base[0], axis=1))),) * 2
+    return angles, hold, wrist_travel(joints, arm_length)
 
 
 def point_misses(rig, settings, count, exact, seed):

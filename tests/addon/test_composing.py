@@ -180,34 +180,43 @@ def _gesture_named(rig, prefix):
 @pytest.mark.parametrize("first", ["POINT", "WAVE"])
 @pytest.mark.parametrize("name", RIGS)
 def test_two_arms_play_together_as_each_played_alone_in_either_order(settings, tmp_path, name, first):
-    """A Point with the right arm and a Wave with the left on overlapping frames, in either order: the finger
-    stays within 1 degree of where it pointed alone, the wave keeps the strokes it makes alone (each measured
-    alone with the other one deleted, then put back by undo), and either can be baked again: the point then
-    hits within 3 degrees and the wave makes at least 4 strokes."""
+    """A Point with the right arm (frames 1-93) and a Wave with the left (20-112: at full weight over the
+    point's hold), in either order: over its hold the finger stays within 1 degree of where it pointed alone,
+    frame by frame (the point not aimed again over the wave's turn of the spine, it moved 4.3-4.6 degrees),
+    the wave keeps the strokes it makes alone (each measured alone with the other one deleted, then put back
+    by undo), and either can be baked again: the point then hits within 3 degrees and the wave makes at least
+    4 strokes."""
     rig = _load(name, tmp_path)
     rig_name = rig.name
-    make = {"POINT": lambda: _point(rig, settings, "RIGHT", 1, 4), "WAVE": lambda: _wave(rig, settings, "LEFT", 40)}
+    make = {"POINT": lambda: _point(rig, settings, "RIGHT", 1, 4), "WAVE": lambda: _wave(rig, settings, "LEFT", 20)}
     target = make[first]()
     second = make["WAVE" if first == "POINT" else "POINT"]()
     target = target if first == "POINT" else second
-    together = (real_rigs.point_miss(rig, settings, "RIGHT", target, 1, 93)[0],
-                real_rigs.wave_strokes(rig, settings, "LEFT", 40, 93)[0])
+
+    def finger(rig, settings):
+        return real_rigs.finger_angles(rig, settings, "RIGHT", target, 1, 93)[:2]
+
+    def strokes(rig, settings):
+        return real_rigs.wave_strokes(rig, settings, "LEFT", 20, 93)[0]
+
+    together = finger(rig, settings), strokes(rig, settings)
     alone = []
-    for deleted, measure in (("RLAnimate Wave Left", lambda r, s: real_rigs.point_miss(r, s, "RIGHT", target, 1, 93)),
-                             ("RLAnimate Point Right", lambda r, s: real_rigs.wave_strokes(r, s, "LEFT", 40, 93))):
+    for deleted, measure in (("RLAnimate Wave Left", finger), ("RLAnimate Point Right", strokes)):
         bpy.ops.ed.undo_push(message="before deleting")
         assert bpy.ops.rlanimate.delete_gesture("EXEC_DEFAULT", True, gesture=deleted) == {"FINISHED"}
-        alone.append(measure(bpy.data.objects[rig_name], bpy.context.scene.rlanimate)[0])
+        alone.append(measure(bpy.data.objects[rig_name], bpy.context.scene.rlanimate))
         assert bpy.ops.ed.undo() == {"FINISHED"}
     rig, settings = bpy.data.objects[rig_name], bpy.context.scene.rlanimate
-    print(f"{name}, {first} first: finger {together[0]:.2f} deg (alone {alone[0]:.2f}), "
-          f"{together[1]} strokes (alone {alone[1]})")
-    assert abs(together[0] - alone[0]) <= 1.0 and together[1] == alone[1] >= 4
+    (angles, (hold_first, hold_last)), (angles_alone, _) = together[0], alone[0]
+    moved = np.abs(angles - angles_alone)[hold_first:hold_last + 1].max()
+    print(f"{name}, {first} first: over its hold the finger moved at most {moved:.3f} deg from where it pointed "
+          f"alone; {together[1]} strokes (alone {alone[1]})")
+    assert moved <= 1.0 and together[1] == alone[1] >= 4
     for prefix in ("RLAnimate Point Right", "RLAnimate Wave Left"):
         assert bpy.ops.rlanimate.select_gesture(gesture=_gesture_named(rig, prefix)) == {"FINISHED"}
         assert _generate(rig, settings, seed=2) == {"FINISHED"}
         assert real_rigs.point_miss(rig, settings, "RIGHT", target, 1, 93)[0] <= 3.0
-        assert real_rigs.wave_strokes(rig, settings, "LEFT", 40, 93)[0] >= 4
+        assert strokes(rig, settings) >= 4
 
 
 def test_keys_edited_by_hand_are_not_overwritten_silently(settings):

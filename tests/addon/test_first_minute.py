@@ -24,7 +24,7 @@ def test_start_frame_follows_the_playhead_until_set(settings):
 
 
 def test_a_gesture_past_the_scenes_end_is_baked_with_a_warning_and_the_end_can_be_extended(settings):
-    rig = helpers.load_sample_rig()
+    helpers.load_sample_rig()
     scene = bpy.context.scene
     scene.frame_end = 100
     for key, value in dict(behaviour="WAVE", arm="LEFT", start_frame=60, frame_count=90).items():

@@ -129,14 +129,15 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
                       "green dots = finger line)", 0.98, out)
 
 
-def generated_sheet(rows, out, title, fps=30):
-    """One PNG of rendered frames: rows [(row title, [(frame offset, png path)])], a column per key frame."""
+def generated_sheet(rows, out, title, fps=30, frame_labels=False):
+    """One PNG of rendered frames: rows [(row title, [(frame offset, png path)])], a column per key frame, each
+    titled with its time (or, with frame_labels, its frame number)."""
     columns = max(len(frames) for _, frames in rows)
     fig, axes = plt.subplots(len(rows), columns, figsize=(columns * 1.9, len(rows) * 2.0), dpi=110, squeeze=False)
     for (row_title, frames), row_axes in zip(rows, axes):
         for ax, (offset, path) in zip(row_axes, frames):
             ax.imshow(plt.imread(str(path)))
-            ax.set_title(f"{offset / fps:.2f}s", fontsize=7, pad=2)
+            ax.set_title(f"frame {offset}" if frame_labels else f"{offset / fps:.2f}s", fontsize=7, pad=2)
         for ax in row_axes:
             ax.set_xticks([])
             ax.set_yticks([])
