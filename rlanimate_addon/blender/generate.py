@@ -421,7 +421,7 @@ def _write(plan, agent, scene):
         constraints.unmute(obj, gestures.influence_before(plan.previous))
         gesture_id = int(plan.previous.record.get("id", gestures.next_id(obj)))
         memories = key_layers.rewrite(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                      plan.properties)
+                                      plan.properties, gesture_id)
         plan.action = plan.previous.action
     else:
         gesture_id = gestures.next_id(obj)

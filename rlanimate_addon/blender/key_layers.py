@@ -11,7 +11,7 @@ import numpy as np
 
 from ..core import easing, key_reduction
 from . import action_adapter, armature_io
-from .gestures import MAIN, RECORD, TORSO, TORSO_OF
+from .gestures import MAIN, RECORD, TORSO, TORSO_OF, Layer
 
 #: What a gesture's torso layer is called after its main one.
 TORSO_SUFFIX = " (torso)"
@@ -69,11 +69,17 @@ def place(obj, name, start, layers, blend_type, played, properties, still, gestu
     return main.action, memories
 
 
-def rewrite(gesture, name, start, layers, blend_type, properties):
+def rewrite(gesture, name, start, layers, blend_type, properties, gesture_id):
     """Bake new keys (`place`'s layers) into the gesture's own actions where they play, renamed after `name`:
-    the F-curves it wrote are replaced, any other F-curve of its actions is kept. Returns {layer: KeyMemory}."""
+    the F-curves it wrote are replaced, any other F-curve of its actions is kept. A gesture without a torso layer
+    (made before gestures had one, or its torso action deleted) gets one. Returns {layer: KeyMemory}."""
     frames = _frames(start, layers)
     memories = {}
+    if TORSO not in gesture.layers:
+        torso = action_adapter.new_action(name + TORSO_SUFFIX, gesture.obj)
+        torso.action[TORSO_OF] = gesture_id
+        action_adapter.add_strip(gesture.obj, torso, frames, name + TORSO_SUFFIX).blend_type = "COMBINE"
+        gesture.torso = Layer(torso, gesture.obj.animation_data.nla_tracks[-1])
     for layer_name, keys in layers.items():
         layer = gesture.layers[layer_name]
         for fcurve in gesture.owned(layer_name):
