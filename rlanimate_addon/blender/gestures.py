@@ -302,9 +302,12 @@ def influence_before(gesture):
     """{influence path: {frame: value}} the gesture's mute overwrote (`record`; none in a record made before
     Generate kept them; a record made before it kept their frames holds values from the gesture's start)."""
     start = gesture.record["start"]
-    return {item["path"]: dict(zip(item.get("frames", range(start, start + len(item["values"]))), item["values"],
-                                   strict=True))
-            for item in gesture.record.get("influence_before", [])}
+    return {
+        item["path"]: dict(
+            zip(item.get("frames", range(start, start + len(item["values"]))), item["values"], strict=True)
+        )
+        for item in gesture.record.get("influence_before", [])
+    }
 
 
 def edited(gesture):
@@ -325,7 +328,7 @@ def edited(gesture):
     return found
 
 
-_edited_cache = {}
+_edited_cache: dict[int, tuple[float, bool]] = {}
 #: Seconds the panel's "edited" mark of a gesture is reused before its keys are read again.
 EDITED_CACHE_SECONDS = 1.0
 

@@ -225,7 +225,7 @@ def sample(obj, names, frames):
             continue
         times, played = mapping(frames)
         values = evaluate_fcurves([f for f, _ in curves], times)  # (F, N)
-        for (fcurve, key), row in zip(curves, values):
+        for (fcurve, key), row in zip(curves, values, strict=True):
             channels[key][played, fcurve.array_index] = row[played]
             covered[key] |= played
     # A channel the NLA plays on some frames only, or a connected bone's location: Blender's call.
@@ -251,7 +251,8 @@ def sample(obj, names, frames):
             path = _rotation_path(pose_bone.rotation_mode)
             value = {p: channels[name, p] if (name, p) in channels else _standing(pose_bone, p, count)
                      for p in ("location", "scale", path)}
-            basis[:, column, :3, :3] = rotation_matrices(pose_bone.rotation_mode, value[path]) * value["scale"][:, None, :]
+            rotation = rotation_matrices(pose_bone.rotation_mode, value[path])
+            basis[:, column, :3, :3] = rotation * value["scale"][:, None, :]
             basis[:, column, :3, 3] = value["location"]
         frames = slice(None) if name in keyed else slice(0, 1)  # an unkeyed bone's basis is the same every frame
         local = offsets[column] @ basis[frames, column]

@@ -9,6 +9,7 @@ layered with Keep Previous (it takes no part in handovers) and its place in the 
 its arm; two gestures on one arm hand over: the later-starting takes over at its start frame, and the earlier
 one is trimmed there.
 """
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 
@@ -33,7 +34,8 @@ class Span:
         return self.start <= other.end and other.start <= self.end
 
 
-def regenerated(spans: list[Span], arm: str, start: int, selected: str = "", keep_previous: bool = False):
+def regenerated(spans: list[Span], arm: str, start: int, selected: str = "",
+                keep_previous: bool = False) -> Span | None:
     """The gesture a Generate bakes again in place: the selected one (its id), else, with Keep Previous off,
     the topmost on the same arm that starts on the same frame; None for a new gesture."""
     if selected:
@@ -44,18 +46,19 @@ def regenerated(spans: list[Span], arm: str, start: int, selected: str = "", kee
     return max(same, key=lambda s: s.level, default=None)
 
 
-def _handing_over(spans, exclude):
-    return [s for s in spans if not s.layered and s.id not in exclude]
+def _handing_over(spans: list[Span], exclude: Iterable[str]) -> list[Span]:
+    excluded = set(exclude)
+    return [s for s in spans if not s.layered and s.id not in excluded]
 
 
-def taken_over(spans: list[Span], arm: str, start: int, exclude=()):
+def taken_over(spans: list[Span], arm: str, start: int, exclude: Iterable[str] = ()) -> Span | None:
     """The gesture that a gesture on `arm` from frame `start` takes over from: of those on that arm still
     playing at `start` (started before it), the latest-starting; None when there is none."""
     playing = [s for s in _handing_over(spans, exclude) if s.arm == arm and s.start < start <= s.until]
     return max(playing, key=lambda s: (s.start, s.level), default=None)
 
 
-def taking_over(spans: list[Span], arm: str, start: int, end: int, exclude=()):
+def taking_over(spans: list[Span], arm: str, start: int, end: int, exclude: Iterable[str] = ()) -> Span | None:
     """The gesture that takes over from a gesture on `arm` over frames start-end: of those on that arm that
     start after `start` and by `end`, the earliest-starting; None when there is none."""
     later = [s for s in _handing_over(spans, exclude) if s.arm == arm and start < s.start <= end]

@@ -154,7 +154,9 @@ def arm_reach(arm, rest_heads):
     if prefix + "HandIndex1" in rest_heads:
         return float(np.linalg.norm(np.subtract(rest_heads[prefix + "HandIndex1"], shoulder)))
     canonical = {name: np.asarray(skeleton.BONE_BY_NAME[prefix + name].head) for name in ("Arm", "Hand", "HandIndex1")}
-    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(canonical["Hand"] - canonical["Arm"])
+    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(
+        canonical["Hand"] - canonical["Arm"]
+    )
     return float(ratio * np.linalg.norm(np.subtract(rest_heads[prefix + "Hand"], shoulder)))
 
 
@@ -297,8 +299,16 @@ def rest_swings(roles, rest_heads, rest_tails, to_character):
     directed = [n for n in names if directions[n] is not None]
     rig = np.array([directions[n] for n in directed]).reshape(-1, 3) @ np.asarray(to_character).T
     canonical = np.array([_CANONICAL_DIRECTIONS[n] for n in directed]).reshape(-1, 3)
-    turns = dict(zip(directed, aim.rotation_between(rig / np.linalg.norm(rig, axis=1, keepdims=True),
-                                                     canonical / np.linalg.norm(canonical, axis=1, keepdims=True))))
+    turns = dict(
+        zip(
+            directed,
+            aim.rotation_between(
+                rig / np.linalg.norm(rig, axis=1, keepdims=True),
+                canonical / np.linalg.norm(canonical, axis=1, keepdims=True),
+            ),
+            strict=True,
+        )
+    )
     swings = {}
     for name in names:
         parent = _parent_role(name, roles)
@@ -719,7 +729,8 @@ class RigState:
             under_pose = skeleton_.pose_matrices(self.under, only=every)
         self.under_pose = np.asarray(under_pose, dtype=np.float64)
         self.still = (not animated) if still is None else bool(still)
-        self.held, self.resting, self.bare, self.above = int(held), dict(resting or {}), dict(bare or {}), dict(above or {})
+        self.held, self.resting = int(held), dict(resting or {})
+        self.bare, self.above = dict(bare or {}), dict(above or {})
 
     def with_pose(self, under, under_pose):
         """This rig with another pose underneath (basis, pose), its other settings kept."""

@@ -1,12 +1,12 @@
 """An animator's session, not one click: gestures on both arms, in sequence, over the animator's own keys,
 baked again, deleted and undone, on the sample character and on real rigs made by others (../shared/rigs),
 measured on the bones the mesh deforms with, as Blender plays them (tests/addon/real_rigs.py)."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import real_rigs
 
+import addon_helpers as helpers
+import real_rigs
 from rlanimate_addon.blender import action_adapter, gestures
 from rlanimate_addon.core import gesture
 

@@ -1,13 +1,13 @@
 """What an animator meets in the first minute: Start Frame at the playhead, a gesture past the scene's end, the
 character's mesh selected, each behaviour's own length, and Bone Map from VRM File only where it applies."""
-import addon_helpers as helpers
 import bpy
 import pytest
-import real_rigs
-from test_registration import _draw
 
+import addon_helpers as helpers
+import real_rigs
 from rlanimate_addon.blender import generate, gestures, preferences
 from rlanimate_addon.core import frame_rate
+from test_registration import _draw
 
 
 def test_start_frame_follows_the_playhead_until_set(settings):

@@ -8,8 +8,6 @@ through the registered operator, exactly as an animator runs it from the panel; 
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from trainer.blender_io.rig_session import blender_output, import_bpy, load_rig, new_empty_scene
 from trainer.paths import SAMPLE_RIG_BLEND
 
@@ -25,7 +23,8 @@ class RenderRequest:
     """One Generate Gesture call: the panel's settings (Scene.rlanimate names) and a row title."""
     title: str
     settings: dict
-    target: tuple = None  # character-frame position of a target sphere for a target behaviour (POINT, GUIDE)
+    #: character-frame position of a target sphere for a target behaviour (POINT, GUIDE)
+    target: tuple[float, ...] | None = None
     frames: list = field(default_factory=list)  # filled by render_requests: (frame, png path)
 
 
