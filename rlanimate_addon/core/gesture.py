@@ -753,13 +753,13 @@ class RigState:
         return pose
 
     def start_at(self, count):
-        """(N, B, 4, 4) basis matrices the gesture blends from and back to: `animation_at`, held at its first
-        frame over the `held` frames."""
+        """(N, B, 4, 4) basis matrices the gesture blends from and back to: `animation_at`, but over the `held`
+        frames the pose underneath at the first frame (where the gesture it takes over from is)."""
         start = self.animation_at(count)
         if not self.held:
             return start
         start = np.array(start)
-        start[:self.held] = start[0]
+        start[:self.held] = self.under_at(count)[0]
         return start
 
     def under_pose_at(self, count):
