@@ -112,7 +112,7 @@ class KeyMemory:
                         for part in (co, interpolation) + (() if handles is None else (handles,)))
         return {"paths": [path for path, *_ in self.curves], "indices": [i for _, i, *_ in self.curves],
                 "counts": [len(co) for _, _, co, *_ in self.curves],
-                "bezier": [handles is not None for *_, handles in self.curves], "keys": zlib.compress(data)}
+                "bezier": [handles is not None for *_, handles in self.curves], "keys": zlib.compress(data, 1)}
 
     @classmethod
     def unpack(cls, kept):
@@ -156,6 +156,9 @@ def changed_frames(written, now):
     curve that is gone: every written frame)."""
     if now is None:
         return sorted({int(round(f)) for f in written[0][:, 0]})
+    if all(a is None and b is None or a is not None and b is not None and np.array_equal(a, b)
+           for a, b in zip(written, now, strict=True)):
+        return []
 
     def by_frame(co, interpolation, handles):
         rows = [co, interpolation[:, None].astype(np.float32)] + ([] if handles is None else [handles])
