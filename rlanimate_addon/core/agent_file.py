@@ -389,8 +389,9 @@ def _check_metadata_values(path, metadata):
         raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
                              f"{', '.join(VARIANTS)}.")
     if metadata["variant"] not in VARIANTS:
-        raise RLAnimateError(f"The agent file {path} names an unknown agent variant {metadata['variant']!r:.40}: it "
-                             f"must name one of {', '.join(VARIANTS)}; re-export it with trainer/agent/agent_export.py.")
+        raise RLAnimateError(f"The agent file {path} names an unknown agent variant {metadata['variant']!r:.40}: "
+                             f"it must name one of {', '.join(VARIANTS)}; re-export it with "
+                             "trainer/agent/agent_export.py.")
     space = _checked_space(path, metadata)
     expected = expected_weight_shapes(config, metadata["variant"], space.size)
     parameters = sum(math.prod(shape) for shape in expected.values())

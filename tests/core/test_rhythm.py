@@ -152,8 +152,8 @@ def test_the_rhythm_settings_round_trip_and_broken_ones_are_refused():
     ("ramp", [9.0], "wave_rhythm.ramp"), ("bandwidth", -0.1, "wave_rhythm.bandwidth"),
     ("tempo_bandwidth", "x", "wave_rhythm.tempo_bandwidth"), ("phases", "x", "wave_rhythm.phases"),
     ("phases", [[0.1]] * 8, "wave_rhythm.phases"), ("arms", [["LEFT"]] * 8, "wave_rhythm.arms"),
-    ("arms", "LEFT", "wave_rhythm.arms"), ("arms", 5, "wave_rhythm.arms"), ("typical_tempo", 1, "wave_rhythm.typical_tempo"),
-    ("by_arm", "yes", "wave_rhythm.by_arm")])
+    ("arms", "LEFT", "wave_rhythm.arms"), ("arms", 5, "wave_rhythm.arms"),
+    ("typical_tempo", 1, "wave_rhythm.typical_tempo"), ("by_arm", "yes", "wave_rhythm.by_arm")])
 def test_every_field_of_the_model_is_checked_for_its_type_and_named(field, value, named):
     e, rhythms = _training_rhythms()
     values = value if field is None else {**rhythm.RhythmModel.fit(e, rhythms).to_dict(), field: value}
