@@ -102,6 +102,7 @@ class _Plan:
     def __init__(self, obj, family, roles, overriding, ik_share=None):
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
         self.ik_share = ik_share  # a Rigify arm in IK: its IK_FK value, switched to FK over the gesture
+        self.from_ik = False  # ... and whether it stands in IK (IK_FK below 1) on any of the gesture's frames
         self.properties = None
         self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.settings = None
         self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
@@ -164,6 +165,7 @@ def _compute(context, plan, settings, agent, frames):
                 rig, below_values = rig.standing_still(below_values) or (rig, below_values)
             if plan.ik_share is not None:  # the FK controls start where the arm stands in IK
                 played, switch = rigify.played_arm(context, obj, settings.arm, frames, rig.animated)
+                plan.from_ik = bool(np.any(switch < 1.0))
                 rig = rig_rigify.snap_fk(rig, rig_rigify.fk_controls(settings.arm), played)
         finally:
             if scene.frame_current != original_frame:
@@ -285,7 +287,7 @@ def _write(plan, agent, scene):
         action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
                                            (min(scene.frame_start, start), max(scene.frame_end, end)), digest,
                                            plan.properties)
-    if plan.ik_share is not None:
+    if plan.from_ik:  # an animated switch already at FK is keyed at FK, and nothing is said
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
     influence_before = constraints.mute(plan.obj, plan.overriding, start, end, plan.hold)
     gestures.record(action, gestures.snapshot(settings), kind, start, end, plan.under, plan.targets,
