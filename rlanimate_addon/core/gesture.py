@@ -24,6 +24,7 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
     and Point's aim is solved on the rig's own bones against that pose (`aim_rig`), so the finger
     line passes through the target whatever the rig's proportions and whatever moves underneath.
 """
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -421,9 +422,13 @@ def _standing_pose():
 
 #: Canonical local rotation vectors (3,) of the standing pose, by bone (others stay at rest).
 STANDING_POSE = _standing_pose()
-#: A bone whose rotation underneath is within this of its rest (sin of half the angle: 0.06 degrees) is
-#: at rest: a rest pose read back from float32 bind matrices (FBX, glTF) is a few 1e-5 radians off.
-AT_REST = 5e-4
+#: Degrees: a bone whose rotation underneath is within this of its rest is at rest. An importer's rounding
+#: leaves a rest pose off by up to about a degree (a VRM 0.x's arms 0.6-0.9 degrees, after Blender's glTF
+#: importer guessed its bind pose; float32 bind matrices a few 1e-5 radians), while a pose an animator sets
+#: turns a bone by more. (At 0.06 degrees, such a VRM started and ended every gesture in its T-pose.)
+AT_REST_DEGREES = 3.0
+#: ... as the sine of half that angle, the length of a unit quaternion's vector part.
+AT_REST = math.sin(math.radians(AT_REST_DEGREES) / 2)
 
 
 class FingerLine(NamedTuple):

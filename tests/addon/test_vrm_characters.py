@@ -2,6 +2,8 @@
 Blender's glTF importer, on a VRM 1.0 file made from it by rewriting its JSON chunk, and from the VRM
 add-on's data on the armature: accepted with no bone-map file, pointing and waving as measured on the
 bones the mesh deforms with."""
+import math
+
 import addon_helpers as helpers
 import bpy
 import numpy as np
@@ -41,6 +43,43 @@ def test_a_vrm0_file_imported_with_the_gltf_importer_points_and_waves(settings, 
     roles = real_rigs.roles(rig, settings)
     assert roles["RightArm"] == "upper_arm.R" and roles["RightHandIndex1"] == "index.proximal.R"
     _check_gestures(rig, settings, vrm.FAMILY)
+
+
+def _arms_off_rest(gltf):
+    """The robot with its arm nodes turned 0.6, 0.75 and 0.9 degrees (upper arm, forearm, hand) off their bind
+    pose, as an exporter's rounding leaves a VRM 0.x: Blender's glTF importer rests the bones at the bind pose
+    and poses them by the nodes."""
+    axis = np.array([0.3, 0.2, 0.93]) / np.linalg.norm([0.3, 0.2, 0.93])
+    for node in gltf["nodes"]:
+        part = node.get("name", "").split(".")[0]
+        if part in _ROUNDED:
+            half = math.radians(_ROUNDED[part]) / 2
+            node["rotation"] = [*(math.sin(half) * axis), math.cos(half)]
+    return gltf
+
+
+_ROUNDED = {"upper_arm": 0.6, "lower_arm": 0.75, "hand": 0.9}
+
+
+def _degrees_off_rest(pose_bone):
+    return math.degrees(2 * math.asin(min(1.0, np.linalg.norm(pose_bone.matrix_basis.to_quaternion()[1:]))))
+
+
+def test_a_vrm0_whose_arms_sit_a_rounding_off_rest_gestures_from_the_standing_pose(settings, tmp_path):
+    """Arms 0.6-0.9 degrees off rest are at rest (gesture.AT_REST, 3 degrees): a gesture starts and ends in the
+    standing pose, not in the T-pose. A pose an animator set, 10 degrees, is a pose: the gesture starts from it."""
+    source = real_rigs.require("vrm0_robot")
+    rig = real_rigs.import_gltf(real_rigs.rewrite_json(source, tmp_path / "rounded.vrm", _arms_off_rest), tmp_path)
+    off = {name: _degrees_off_rest(rig.pose.bones[f"{name}.R"]) for name in _ROUNDED}
+    assert off == pytest.approx(_ROUNDED, abs=0.01), off
+    turn = math.radians(5.0)  # the animator turns the left upper arm 10 degrees
+    posed = (math.cos(turn), 0.0, 0.0, math.sin(turn))
+    rig.pose.bones["upper_arm.L"].rotation_quaternion = posed
+    result, strokes, _ = real_rigs.wave(rig, settings, "RIGHT", 1)
+    assert result == {"FINISHED"} and strokes >= 4
+    for frame in (1, 150):  # the first and last frames: the standing pose (was: 0.6 degrees, the T-pose)
+        assert 60.0 < real_rigs.arm_drop(rig, settings, "RIGHT", frame) < 85.0
+        assert tuple(rig.pose.bones["upper_arm.L"].rotation_quaternion) == pytest.approx(posed, abs=1e-5)
 
 
 def test_a_vrm1_file_maps_bones_only_its_map_can_name(settings, tmp_path, vrm1_file):
