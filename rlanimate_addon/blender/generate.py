@@ -51,6 +51,14 @@ def check_keepable(obj):
                              "Editable) and generate again.")
 
 
+def check_not_editing(obj):
+    """RLAnimateError when the armature is in Edit mode: its pose is not evaluated there, so the bake would not
+    play, and Blender's undo in Edit mode keeps only bone edits, so the bake could not be undone."""
+    if obj.mode == "EDIT":
+        raise RLAnimateError(f"Armature {obj.name!r} is in Edit mode, where its pose does not play and a bake "
+                             "could not be undone: leave Edit mode (Tab, or choose Pose Mode) and generate again.")
+
+
 def check_inherited_rotation(obj, roles):
     """RLAnimateError when a bone playing a role does not inherit its parent's rotation: the gesture's
     retargeting and aim turn each bone relative to its parent."""
@@ -114,6 +122,7 @@ class _Plan:
 
 def _check(obj, settings, start, end, mute_constraints):
     """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
+    check_not_editing(obj)
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
     ik_share = rigify.ik_share(obj, settings.arm) if family == rig_roles.RIGIFY.name else None

@@ -1,6 +1,7 @@
 """Rigs and settings Generate cannot serve well: a zero-scale armature or bone is refused naming it and the fix,
-a bone-map file that is not one is refused before it is read whole, and a gesture far below the agent's
-supported length is baked with a warning. A refusal changes nothing."""
+a bone-map file that is not one is refused before it is read whole, an armature in Edit mode is refused naming
+the fix, and a gesture far below the agent's supported length is baked with a warning. A refusal changes
+nothing."""
 import addon_helpers as helpers
 import bpy
 import pytest
@@ -70,3 +71,18 @@ def test_a_gesture_far_below_the_supported_length_is_baked_with_a_warning(settin
             f"Frames to {shortest} or more)") in summary
     settings.frame_count, settings.start_frame = shortest, 10
     assert "warning" not in generate.generate(bpy.context, settings)
+
+
+def test_an_armature_in_edit_mode_is_refused_naming_the_fix_and_stays_in_edit_mode(settings):
+    """Generate in Edit mode failed the bake check with bone-map advice (the pose does not play there); Blender's
+    undo in Edit mode keeps only bone edits, so the bake is refused rather than done and returned to Edit mode."""
+    rig = helpers.activate(helpers.load_sample_rig())
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj is rig)
+    settings.behaviour, settings.arm = "WAVE", "LEFT"
+    bpy.ops.object.mode_set(mode="EDIT")
+    _assert_refused(rig, r"^Error: Armature 'RLAnimate_Character' is in Edit mode, where its pose does not play and a "
+                         r"bake could not be undone: leave Edit mode \(Tab, or choose Pose Mode\) and generate again.")
+    assert rig.mode == "EDIT" and bpy.context.mode == "EDIT_ARMATURE"
+    bpy.ops.object.mode_set(mode="POSE")
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"} and rig.animation_data.action is not None
