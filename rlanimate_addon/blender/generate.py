@@ -52,11 +52,12 @@ def check_keepable(obj):
 
 
 def check_not_editing(obj):
-    """RLAnimateError when the armature is in Edit mode: its pose is not evaluated there, so the bake would not
-    play, and Blender's undo in Edit mode keeps only bone edits, so the bake could not be undone."""
+    """RLAnimateError when the armature is in Edit mode, where its pose does not play (the bake check failed
+    there). Refused rather than left and returned to: the undo step Blender pushes in Edit mode is an Edit-mode
+    step, and that it takes back a gesture's action cannot be checked headless (ed.undo needs a window)."""
     if obj.mode == "EDIT":
-        raise RLAnimateError(f"Armature {obj.name!r} is in Edit mode, where its pose does not play and a bake "
-                             "could not be undone: leave Edit mode (Tab, or choose Pose Mode) and generate again.")
+        raise RLAnimateError(f"Armature {obj.name!r} is in Edit mode, where its pose does not play: leave Edit mode "
+                             "(Tab, or choose Pose Mode) and generate again.")
 
 
 def check_inherited_rotation(obj, roles):

@@ -74,15 +74,15 @@ def test_a_gesture_far_below_the_supported_length_is_baked_with_a_warning(settin
 
 
 def test_an_armature_in_edit_mode_is_refused_naming_the_fix_and_stays_in_edit_mode(settings):
-    """Generate in Edit mode failed the bake check with bone-map advice (the pose does not play there); Blender's
-    undo in Edit mode keeps only bone edits, so the bake is refused rather than done and returned to Edit mode."""
+    """Generate in Edit mode failed the bake check with bone-map advice (the pose does not play there): it is
+    refused before anything is written, naming the fix."""
     rig = helpers.activate(helpers.load_sample_rig())
     for obj in bpy.context.view_layer.objects:
         obj.select_set(obj is rig)
     settings.behaviour, settings.arm = "WAVE", "LEFT"
     bpy.ops.object.mode_set(mode="EDIT")
-    _assert_refused(rig, r"^Error: Armature 'RLAnimate_Character' is in Edit mode, where its pose does not play and a "
-                         r"bake could not be undone: leave Edit mode \(Tab, or choose Pose Mode\) and generate again.")
+    _assert_refused(rig, r"^Error: Armature 'RLAnimate_Character' is in Edit mode, where its pose does not play: leave "
+                         r"Edit mode \(Tab, or choose Pose Mode\) and generate again.")
     assert rig.mode == "EDIT" and bpy.context.mode == "EDIT_ARMATURE"
     bpy.ops.object.mode_set(mode="POSE")
     assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"} and rig.animation_data.action is not None
