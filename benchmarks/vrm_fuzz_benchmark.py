@@ -30,8 +30,8 @@ sys.path.insert(0, str(ROOT / "tests" / "core"))
 
 import numpy as np  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
-import vrm_fuzz  # noqa: E402  (tests/core/vrm_fuzz.py)
 
+import vrm_fuzz  # noqa: E402  (tests/core/vrm_fuzz.py)
 from rlanimate_addon.core import vrm  # noqa: E402
 
 HEADING = "## VRM file fuzz"

@@ -6,8 +6,8 @@ hand 14.6-16.6 degrees off the target over the hold on the Rigify rig, 9.4-10.3 
 these four targets.)"""
 import numpy as np
 import pytest
-import real_rigs
 
+import real_rigs
 from rlanimate_addon.core import gesture
 
 

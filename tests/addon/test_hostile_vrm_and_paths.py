@@ -10,14 +10,14 @@ import struct
 import sys
 import time
 
-import addon_helpers as helpers
 import bpy
 import pytest
-import real_rigs
-from test_registration import RecordingLayout
 
+import addon_helpers as helpers
+import real_rigs
 from rlanimate_addon.blender import panel
 from rlanimate_addon.core import vrm
+from test_registration import RecordingLayout
 
 
 def _two_roles(gltf):

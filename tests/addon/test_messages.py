@@ -3,11 +3,11 @@ every role it found and marks the others for the user to fill in; a Rigify arm a
 to switch from IK."""
 import json
 
-import addon_helpers as helpers
 import bpy
 import pytest
-import real_rigs
 
+import addon_helpers as helpers
+import real_rigs
 from rlanimate_addon.blender import bone_map, generate
 from rlanimate_addon.core import rig_roles, skeleton
 

@@ -2,10 +2,10 @@
 a bone-map file that is not one is refused before it is read whole, an armature in Edit mode is refused naming
 the fix, and a gesture far below the agent's supported length is baked with a warning. A refusal changes
 nothing."""
-import addon_helpers as helpers
 import bpy
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import generate, preferences
 from rlanimate_addon.core import gesture
 

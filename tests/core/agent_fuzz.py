@@ -34,7 +34,6 @@ import io
 import json
 import struct
 import zipfile
-import zlib
 
 import numpy as np
 

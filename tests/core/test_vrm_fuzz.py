@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 import vrm_fuzz
 
 ROBOT = Path(__file__).resolve().parents[3] / "shared" / "rigs" / "vrm" / "unavi_robot_vrm0.vrm"
