@@ -22,7 +22,6 @@ import statistics
 import sys
 import tempfile
 import time
-import tracemalloc
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -30,6 +29,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "core"))
 
+import measure  # noqa: E402  (benchmarks/measure.py)
 import numpy as np  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
@@ -43,24 +43,6 @@ MAX_LOAD_SECONDS = 1.0
 MAX_LOAD_MB = 300.0
 
 
-def measured_load(path):
-    """(seconds, peak MB) of one `runtime.load_agent` of the file, whatever it raises."""
-    began = time.perf_counter()
-    try:
-        runtime.load_agent(path)
-    except Exception:  # noqa: BLE001  (outcome() names what was raised)
-        pass
-    seconds = time.perf_counter() - began
-    tracemalloc.start()
-    try:
-        runtime.load_agent(path)
-    except Exception:  # noqa: BLE001
-        pass
-    peak = tracemalloc.get_traced_memory()[1] / 2 ** 20
-    tracemalloc.stop()
-    return seconds, peak
-
-
 def fuzz(reference, seed, mutations, folder, counts, measures, failures):
     """Run `mutations` mutations of seed `seed`, adding to counts[kind][outcome] and measures[kind]."""
     generator = agent_fuzz.mutations(reference.data, np.random.default_rng(seed))
@@ -71,8 +53,8 @@ def fuzz(reference, seed, mutations, folder, counts, measures, failures):
         began = time.perf_counter()
         outcome = agent_fuzz.outcome(path, reference)
         elapsed = time.perf_counter() - began
-        load_seconds, load_mb = measured_load(path)
-        measures[kind].append((elapsed, load_seconds, load_mb))
+        load_seconds, load_mb = measure.seconds_and_peak_mb(lambda: runtime.load_agent(path))
+        measures[kind].append((elapsed, load_seconds, load_mb, seed, k))
         counts[kind][outcome if outcome in agent_fuzz.ACCEPTED else "other"] += 1
         if outcome not in agent_fuzz.ACCEPTED:
             failures.append(f"seed {seed} mutation {k} ({kind}): {outcome}")
@@ -88,7 +70,7 @@ def main():
     args = parser.parse_args()
     reference = agent_fuzz.Reference(SHIPPED)
     counts = collections.defaultdict(collections.Counter)  # kind -> outcome -> count
-    measures = collections.defaultdict(list)  # kind -> [(seconds with gesture, load seconds, load MB)]
+    measures = collections.defaultdict(list)  # kind -> [(seconds with gesture, load seconds, load MB, seed, k)]
     failures, per_seed = [], []
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as folder:
@@ -109,6 +91,8 @@ def main():
 
     total = sum(counts.values(), collections.Counter())
     every = [r for kind in measures for r in measures[kind]]
+    slow_kind, slow = max(((kind, r) for kind in measures for r in measures[kind]), key=lambda item: item[1][1])
+    big_kind, big = max(((kind, r) for kind in measures for r in measures[kind]), key=lambda item: item[1][2])
     seeds = " ".join(str(seed) for seed in args.seeds)
     text = "\n".join([
         HEADING, "",
@@ -132,6 +116,8 @@ def main():
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
         *(row(kind, counts[kind], measures[kind]) for kind in agent_fuzz.KINDS),
         row("**all**", total, every), "",
+        f"Slowest load: {1e3 * slow[1]:.1f} ms, seed {slow[3]} mutation {slow[4]} ({slow_kind}). Largest peak: "
+        f"{big[2]:.1f} MB, seed {big[3]} mutation {big[4]} ({big_kind}).", "",
         "Per seed: " + "; ".join(f"seed {seed}: {sum(c.values()):,} mutations, {c['other']:,} other"
                                  for seed, c in per_seed) + ".",
     ]) + "\n"

@@ -20,7 +20,6 @@ import statistics
 import sys
 import tempfile
 import time
-import tracemalloc
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -28,6 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "core"))
 
+import measure  # noqa: E402  (benchmarks/measure.py)
 import numpy as np  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
@@ -41,23 +41,6 @@ MAX_READ_SECONDS = 1.0
 MAX_READ_MB = 100.0
 
 
-def measured_read(path, bone_names):
-    """(seconds, peak MB) of one read of the file as the extension reads it, whatever it raises."""
-    def read():
-        try:
-            vrm.file_roles(str(path), bone_names)
-        except Exception:  # noqa: BLE001  (outcome() names what was raised)
-            pass
-    began = time.perf_counter()
-    read()
-    seconds = time.perf_counter() - began
-    tracemalloc.start()
-    read()
-    peak = tracemalloc.get_traced_memory()[1] / 2 ** 20
-    tracemalloc.stop()
-    return seconds, peak
-
-
 def fuzz(reference, seed, mutations, folder, counts, measures, failures):
     """Run `mutations` mutations of seed `seed`, adding to counts[kind][outcome] and measures[kind]
     (seconds, peak MB, seed, mutation)."""
@@ -67,7 +50,7 @@ def fuzz(reference, seed, mutations, folder, counts, measures, failures):
         kind, data = next(generator)
         path.write_bytes(data)
         outcome = vrm_fuzz.outcome(path, reference)
-        seconds, peak = measured_read(path, reference.bone_names)
+        seconds, peak = measure.seconds_and_peak_mb(lambda: vrm.file_roles(str(path), reference.bone_names))
         measures[kind].append((seconds, peak, seed, k, len(data)))
         counts[kind][outcome if outcome in vrm_fuzz.ACCEPTED else "other"] += 1
         if outcome not in vrm_fuzz.ACCEPTED:

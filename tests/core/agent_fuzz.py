@@ -37,6 +37,7 @@ import zipfile
 
 import numpy as np
 
+import fuzz_json
 from rlanimate_addon.core import agent_file, gesture, runtime
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -280,15 +281,8 @@ def _metadata_entry(text):
 
 
 def _metadata_value(layout, rng):
-    metadata = json.loads(_metadata_text(layout))
-    path = _pick(_METADATA_PATHS, rng)
-    parent = metadata
-    for key in path[:-1]:
-        parent = parent[key]
-    if rng.random() < 0.15:
-        parent.pop(path[-1]) if isinstance(parent, list) else parent.pop(path[-1], None)
-    else:
-        parent[path[-1]] = _pick(_EDGE_VALUES, rng)
+    metadata = fuzz_json.set_or_remove(json.loads(_metadata_text(layout)), _pick(_METADATA_PATHS, rng), rng,
+                                       _EDGE_VALUES)
     text = json.dumps(metadata)  # inf and NaN as JSON's Infinity and NaN, as Python writes them
     return _rezip(layout, {agent_file.METADATA_KEY + ".npy": _metadata_entry(text)}, rng)
 

@@ -27,6 +27,7 @@ import struct
 
 import numpy as np
 
+import fuzz_json
 from rlanimate_addon.core import vrm
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -170,17 +171,7 @@ def _paths(gltf, rng):
 
 def _json_value(original, gltf, rng):
     changed = json.loads(json.dumps(gltf))
-    path = _paths(changed, rng)
-    if not path:
-        changed = _pick(_EDGE_VALUES, rng)
-    else:
-        parent = changed
-        for key in path[:-1]:
-            parent = parent[key]
-        if rng.random() < 0.15:
-            parent.pop(path[-1]) if isinstance(parent, list) else parent.pop(path[-1], None)
-        else:
-            parent[path[-1]] = _pick(_EDGE_VALUES, rng)
+    changed = fuzz_json.set_or_remove(changed, _paths(changed, rng), rng, _EDGE_VALUES)
     return _glb(original, json.dumps(changed).encode())
 
 
