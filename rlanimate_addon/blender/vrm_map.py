@@ -12,54 +12,28 @@ operators read the file (Generate, Save Bone Map, Bone Map from VRM File, the im
 draw() only looks up what they read (`roles_of(obj, read=False)`), never the file itself.
 """
 import contextlib
-import os
 
 import bpy
 from bpy_extras.io_utils import ImportHelper
 
 from ..core import vrm
 from ..core.errors import RLAnimateError
+from . import file_versions
 
-#: {(path, modification time, size): {role: bone name} or the message of the RLAnimateError reading it}.
-_maps = {}
-_MAPS_KEPT = 16
-
-
-def _version(path):
-    """(path, modification time, size) of a file, or None when it cannot be stat'ed."""
-    try:
-        stat = os.stat(path)
-    except (OSError, ValueError):  # ValueError: a NUL in the path
-        return None
-    return path, stat.st_mtime_ns, stat.st_size
+#: The bone maps of the VRM files read, per file version.
+_maps = file_versions.PerVersion(kept=16)
 
 
 def file_map(path, read=True):
     """{role: bone name} of the VRM file at `path` (core.vrm.file_map), read once per version of the file;
     RLAnimateError when it cannot be read (the same message each time). With read=False (in draw()) the
     file is never read: None when no operator read this version of it yet."""
-    key = _version(path)
-    if key is None:
-        if not read:
-            return None
-        return vrm.file_map(path)  # raises, naming why the file cannot be read
-    if key not in _maps:
-        if not read:
-            return None
-        if len(_maps) >= _MAPS_KEPT:
-            _maps.clear()
-        try:
-            _maps[key] = vrm.file_map(path)
-        except RLAnimateError as error:
-            _maps[key] = str(error)
-    if isinstance(_maps[key], str):
-        raise RLAnimateError(_maps[key])
-    return _maps[key]
+    return _maps.read(path, vrm.file_map, read)
 
 
 def known(path):
     """Whether an operator has read this version of the file at `path` (its map or why it cannot be)."""
-    return bool(path) and _version(path) in _maps
+    return _maps.known(path)
 
 
 def roles_of(obj, read=True):
