@@ -15,12 +15,11 @@ Run: `python benchmarks/agent_fuzz_benchmark.py [--mutations 3000] [--seeds 0 1 
 """
 import argparse
 import collections
+import functools
 import os
 import platform
-import resource
 import statistics
 import sys
-import tempfile
 import time
 from datetime import UTC, datetime
 from pathlib import Path
@@ -29,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "core"))
 
-import measure  # noqa: E402  (benchmarks/measure.py)
+import fuzz_runs  # noqa: E402  (benchmarks/fuzz_runs.py)
 import numpy as np  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
@@ -53,7 +52,7 @@ def fuzz(reference, seed, mutations, folder, counts, measures, failures):
         began = time.perf_counter()
         outcome = agent_fuzz.outcome(path, reference)
         elapsed = time.perf_counter() - began
-        load_seconds, load_mb = measure.seconds_and_peak_mb(lambda: runtime.load_agent(path))
+        load_seconds, load_mb = fuzz_runs.seconds_and_peak_mb(lambda: runtime.load_agent(path))
         measures[kind].append((elapsed, load_seconds, load_mb, seed, k))
         counts[kind][outcome if outcome in agent_fuzz.ACCEPTED else "other"] += 1
         if outcome not in agent_fuzz.ACCEPTED:
@@ -69,19 +68,9 @@ def main():
     parser.add_argument("--no-write", action="store_true", help="print the section only")
     args = parser.parse_args()
     reference = agent_fuzz.Reference(SHIPPED)
-    counts = collections.defaultdict(collections.Counter)  # kind -> outcome -> count
-    measures = collections.defaultdict(list)  # kind -> [(seconds with gesture, load seconds, load MB, seed, k)]
-    failures, per_seed = [], []
-    start = time.perf_counter()
-    with tempfile.TemporaryDirectory() as folder:
-        for seed in args.seeds:
-            seed_counts = collections.defaultdict(collections.Counter)
-            fuzz(reference, seed, args.mutations, folder, seed_counts, measures, failures)
-            per_seed.append((seed, sum(seed_counts.values(), collections.Counter())))
-            for kind, counter in seed_counts.items():
-                counts[kind].update(counter)
-    elapsed = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # MB (Linux reports kB)
+    runs = fuzz_runs.run_seeds(functools.partial(fuzz, reference), args.seeds, args.mutations)
+    counts, measures, failures, per_seed = runs.counts, runs.measures, runs.failures, runs.per_seed
+    elapsed, peak = runs.seconds, runs.peak_mb
 
     def row(label, counter, rows):
         return (f"| {label} | {sum(counter.values()):,} | {counter['refused']:,} | {counter['identical']:,} | "

@@ -13,13 +13,11 @@ Run: `python benchmarks/vrm_fuzz_benchmark.py [--mutations 1000] [--seeds 0 1 2]
 """
 import argparse
 import collections
+import functools
 import os
 import platform
-import resource
 import statistics
 import sys
-import tempfile
-import time
 from datetime import UTC, datetime
 from pathlib import Path
 
@@ -27,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "core"))
 
-import measure  # noqa: E402  (benchmarks/measure.py)
+import fuzz_runs  # noqa: E402  (benchmarks/fuzz_runs.py)
 import numpy as np  # noqa: E402
 import report  # noqa: E402  (benchmarks/report.py)
 
@@ -50,7 +48,7 @@ def fuzz(reference, seed, mutations, folder, counts, measures, failures):
         kind, data = next(generator)
         path.write_bytes(data)
         outcome = vrm_fuzz.outcome(path, reference)
-        seconds, peak = measure.seconds_and_peak_mb(lambda: vrm.file_roles(str(path), reference.bone_names))
+        seconds, peak = fuzz_runs.seconds_and_peak_mb(lambda: vrm.file_roles(str(path), reference.bone_names))
         measures[kind].append((seconds, peak, seed, k, len(data)))
         counts[kind][outcome if outcome in vrm_fuzz.ACCEPTED else "other"] += 1
         if outcome not in vrm_fuzz.ACCEPTED:
@@ -112,19 +110,9 @@ def main():
     if not ROBOT.is_file():
         raise SystemExit(f"{ROBOT} is absent: the VRM fuzz reads ../shared/rigs (see its README.md)")
     reference = vrm_fuzz.Reference(ROBOT)
-    counts = collections.defaultdict(collections.Counter)  # kind -> outcome -> count
-    measures = collections.defaultdict(list)  # kind -> [(seconds, peak MB, seed, mutation, bytes)]
-    failures, per_seed = [], []
-    start = time.perf_counter()
-    with tempfile.TemporaryDirectory() as folder:
-        for seed in args.seeds:
-            seed_counts = collections.defaultdict(collections.Counter)
-            fuzz(reference, seed, args.mutations, folder, seed_counts, measures, failures)
-            per_seed.append((seed, sum(seed_counts.values(), collections.Counter())))
-            for kind, counter in seed_counts.items():
-                counts[kind].update(counter)
-    elapsed = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # MB (Linux reports kB)
+    runs = fuzz_runs.run_seeds(functools.partial(fuzz, reference), args.seeds, args.mutations)
+    counts, measures, failures, per_seed = runs.counts, runs.measures, runs.failures, runs.per_seed
+    elapsed, peak = runs.seconds, runs.peak_mb
     text = section(args, counts, measures, per_seed, elapsed, peak)
     print(text)
     for failure in failures:
