@@ -414,15 +414,15 @@ def _check_metadata_values(path, metadata):
                              f"{MAX_AVERAGE_FRAMES:,} frames for each behaviour it was trained for, among "
                              f"{', '.join(space.names)}): re-export it.")
     if metadata["wave_rhythm"] is not None:
-        problem = rhythm.invalid_field(metadata["wave_rhythm"])
-        if problem:
-            raise RLAnimateError(f"The agent file {path} has an invalid wave_rhythm ({problem}): re-export it with "
-                                 f"trainer/agent/agent_export.py.")
         largest = _largest_number(metadata["wave_rhythm"])
         if not largest <= MAX_RHYTHM_VALUE:
             raise RLAnimateError(f"The agent file {path} has a wave_rhythm value of {_describe(largest)}, beyond "
                                  f"+-{MAX_RHYTHM_VALUE:g} (exaggerations, wave frequencies and fractions of a "
                                  f"gesture are small numbers): re-export it with trainer/agent/agent_export.py.")
+        problem = rhythm.invalid_field(metadata["wave_rhythm"])
+        if problem:
+            raise RLAnimateError(f"The agent file {path} has an invalid wave_rhythm ({problem}): re-export it with "
+                                 f"trainer/agent/agent_export.py.")
     return {name: tuple(shape) for name, shape in expected.items()}
 
 

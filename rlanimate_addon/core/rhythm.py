@@ -25,6 +25,7 @@ rate, start and stop near the exaggeration alone at the circular mean phase of a
 request weighs only the training waves of its own arm (`by_arm`, as retrieval fetches only that arm's), are
 chosen on real-capture validation takes (docs/results/realmocap_length.md) and kept in the file.
 """
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
@@ -239,7 +240,7 @@ def invalid_field(values) -> str | None:
         return "wave_rhythm.phase must be a finite number"
     for key in ("ramp", "bandwidth", "tempo_bandwidth"):
         if key in values and not (_finite(values[key]) and values[key] > 0):
-            return f"wave_rhythm.{key} must be a positive number, not {_json_type(values[key])} {values[key]!r:.40}"
+            return f"wave_rhythm.{key} must be a positive number, not {json.dumps(values[key])[:40]}"
     phases, arms = values.get("phases"), values.get("arms")
     if phases is not None and not (isinstance(phases, list) and len(phases) == count and all(map(_finite, phases))):
         return f"wave_rhythm.phases must be null or a list of {count} finite numbers, one per training wave"
