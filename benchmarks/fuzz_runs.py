@@ -46,7 +46,7 @@ def run_seeds(fuzz: Callable, seeds, mutations: int) -> Runs:
     runs, start = Runs(), time.perf_counter()
     with tempfile.TemporaryDirectory() as folder:
         for seed in seeds:
-            seed_counts = collections.defaultdict(collections.Counter)
+            seed_counts: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
             fuzz(seed, mutations, folder, seed_counts, runs.measures, runs.failures)
             runs.per_seed.append((seed, sum(seed_counts.values(), collections.Counter())))
             for kind, counter in seed_counts.items():

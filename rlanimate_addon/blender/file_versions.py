@@ -25,7 +25,8 @@ class PerVersion:
     at most `kept` versions (then forgotten all at once)."""
 
     def __init__(self, kept: int):
-        self._kept, self._read = kept, {}
+        self._kept = kept
+        self._read: dict[tuple, object] = {}
 
     def known(self, path) -> bool:
         """Whether this version of the file at `path` was read (its value or why it could not be)."""

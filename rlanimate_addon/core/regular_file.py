@@ -17,7 +17,7 @@ class NotRegularFile(OSError):
     """The path names something other than a regular file; `strerror` says what it is."""
 
 
-def open_regular(path: str | os.PathLike) -> BinaryIO:
+def open_regular(path: str | os.PathLike[str]) -> BinaryIO:
     """The regular file at `path`, open for binary reading; NotRegularFile (an OSError) for anything else,
     other OSErrors as `open` raises them."""
     descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
