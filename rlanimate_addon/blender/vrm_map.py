@@ -43,6 +43,8 @@ def roles_of(obj, read=True):
     names = obj.data.bones.keys()
     roles = addon_roles(obj.data, set(names))
     path = obj.rlanimate.vrm_file
+    if roles:
+        vrm.check_one_role_per_bone(roles, f"The VRM add-on's humanoid map of {obj.name!r}", "generate again")
     if roles or not path:
         return roles
     try:

@@ -223,13 +223,19 @@ def file_map(path):
     major, nodes = humanoid_nodes(gltf, path)
     names = imported_bone_names(gltf)
     roles = roles_from_map(major, {vrm: names[node] for vrm, node in nodes.items()})
+    check_one_role_per_bone(roles, f"The VRM file {path}", "export the VRM again")
+    return roles
+
+
+def check_one_role_per_bone(roles, source, then):
+    """RLAnimateError when a VRM humanoid map (`source`, for the message) gives one bone two roles, as a
+    bone-map file's is; `then`: what to do after correcting the map."""
     shared = sorted(bone for bone, uses in Counter(roles.values()).items() if uses > 1)
     if shared:
         given = [role for role, bone in roles.items() if bone == shared[0]]
-        raise RLAnimateError(f"The VRM file {path} gives the bone {shared[0]!r} to the roles {', '.join(given)}: "
-                             "each role needs a bone of its own. Correct the humanoid map (VRM add-on: Humanoid "
-                             "panel) and export the VRM again, or map the bones with a bone-map file.")
-    return roles
+        raise RLAnimateError(f"{source} gives the bone {shared[0]!r} to the roles {', '.join(given)}: each role "
+                             f"needs a bone of its own. Correct the humanoid map (VRM add-on: Humanoid panel) and "
+                             f"{then}, or map the bones with a bone-map file.")
 
 
 def check_bones(roles, bone_names, path, rig_name="the armature"):

@@ -190,3 +190,17 @@ def test_the_vrm_addons_map_on_the_armature_is_used(settings, tmp_path, vrm_addo
     target = real_rigs.world_target(rig, settings, "RIGHT", np.random.default_rng(3))
     result, miss, _ = real_rigs.point(rig, settings, "RIGHT", target, 1)
     assert result == {"FINISHED"} and miss <= EXACT_WORST
+
+
+def test_the_vrm_addons_map_giving_one_bone_two_roles_is_refused_as_a_bone_map_file_is(settings, tmp_path,
+                                                                                      vrm_addon_layout):
+    rig = real_rigs.load_shared("vrm0_robot", tmp_path)
+    human_bones = rig.data.vrm_addon_extension.vrm0.humanoid.human_bones
+    for vrm_bone, bone in (("hips", "hips"), ("spine", "spine"), ("neck", "neck"), ("head", "head"),
+                           ("rightUpperArm", "upper_arm.R"), ("rightLowerArm", "upper_arm.R"), ("rightHand", "hand.R")):
+        entry = human_bones.add()
+        entry.bone, entry.node.bone_name = vrm_bone, bone
+    with pytest.raises(RuntimeError, match=r"The VRM add-on's humanoid map of 'Armature' gives the bone 'upper_arm\.R' "
+                                           r"to the roles RightArm, RightForeArm: each role needs a bone of its own"):
+        helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT")
+    assert rig.animation_data is None or rig.animation_data.action is None
