@@ -7,7 +7,8 @@
 With no arguments it trains the RLAnimate agent of every behaviour of the sample clip library (point and
 wave) into runs/default/. `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
 report to docs/results/. Outputs: see trainer/experiments/run.py. `--resume` continues the run in --output
-from its checkpoint with the run's own settings; the continuation equals the uninterrupted run.
+from its checkpoint with the run's own settings; the continuation equals the uninterrupted run. A new run
+into the folder of another is refused unless `--overwrite`.
 """
 import argparse
 from pathlib import Path
@@ -39,6 +40,11 @@ def build_parser():
     parser.add_argument("--variant", choices=VARIANTS, help="ablation variant (Table 4; default rlanimate)")
     parser.add_argument("--resume", action="store_true",
                         help="continue the run in --output from its checkpoint, with the run's own settings")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace the run in --output (without it, a new run into a run's folder is refused)")
+    parser.add_argument("--allow-new-behaviour", action="store_true",
+                        help="with --behaviour all, also learn a behaviour other than point and wave that fewer "
+                             "than 3 clips name (without it, such a behaviour is refused as a likely typo)")
     parser.add_argument("--install", action="store_true",
                         help="install the agent as the add-on's default and its report into docs/results/")
     parser.add_argument("--eval-every", type=int,
@@ -56,7 +62,8 @@ def run_settings(args):
     """RunSettings from parsed arguments."""
     return RunSettings(output=args.output, behaviour=args.behaviour, clips=args.clips, epochs=args.epochs,
                        seed=args.seed, preset=args.preset, variant=args.variant, eval_every=args.eval_every,
-                       resume=args.resume, checkpoint_every=args.checkpoint_every, progress=not args.quiet)
+                       resume=args.resume, overwrite=args.overwrite, allow_new_behaviour=args.allow_new_behaviour,
+                       checkpoint_every=args.checkpoint_every, progress=not args.quiet)
 
 
 def install(output):
