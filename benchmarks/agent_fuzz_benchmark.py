@@ -23,7 +23,7 @@ import sys
 import tempfile
 import time
 import tracemalloc
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -31,9 +31,9 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "core"))
 
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 import agent_fuzz  # noqa: E402  (tests/core/agent_fuzz.py)
-import report  # noqa: E402  (benchmarks/report.py)
 from rlanimate_addon.core import runtime  # noqa: E402
 
 HEADING = "## Agent file fuzz"
@@ -125,7 +125,7 @@ def main():
         f"Regenerate: `{COMMAND} --mutations {args.mutations} --seeds {seeds}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python "
         f"{platform.python_version()}, numpy {np.__version__}. {elapsed:.1f} s in all, peak memory of the run "
-        f"{peak:.0f} MB (the bombs are built in memory). Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.",
+        f"{peak:.0f} MB (the bombs are built in memory). Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.",
         "",
         "| mutation | count | refused | identical | valid other file | other | median ms | worst ms | "
         "worst load ms | worst load MB |",

@@ -41,7 +41,6 @@ def core(root, out):
 def blender(root, out):
     sys.path.insert(0, str(root / "tests" / "addon"))
     import addon_helpers
-
     from rlanimate_addon.blender import action_adapter, gestures
     settings = addon_helpers.enable_addon()
     rig = addon_helpers.load_sample_rig()

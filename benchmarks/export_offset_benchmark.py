@@ -21,9 +21,9 @@ sys.path.insert(0, str(ROOT / "tests" / "addon"))
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 import addon_helpers as helpers  # noqa: E402  (tests/addon/addon_helpers.py)
-import report  # noqa: E402  (benchmarks/report.py)
 from rlanimate_addon.blender import export  # noqa: E402
 
 HEADING = "## Export FBX frame offset"

@@ -11,7 +11,7 @@ import platform
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -21,8 +21,8 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import ray  # noqa: E402
-
 import report  # noqa: E402  (benchmarks/report.py)
+
 from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip_directory, import_into_cache  # noqa: E402
 from trainer.cluster import connect  # noqa: E402
 from trainer.experiments.paper import COLUMNS, PaperSettings, run_folder, train_all  # noqa: E402
@@ -111,7 +111,8 @@ def main():
 
     runs = len(TABLE4["seeds"]) * len(TABLE4["variants"]) * len(TABLE4["columns"])
     real_header = " real capture import (s) |" if realmocap else ""
-    text = f"""{HEADING}
+    text = (
+        f"""{HEADING}
 
 Wall seconds against the number of local Ray workers (`trainer/cluster.py`): importing the sample library's
 100 FBX clips into a fresh cache (one Blender in this process for 1 worker; N Ray tasks, each its own
@@ -125,11 +126,14 @@ machine whose load already exceeds its cores two workers share what one had.
 
 Regenerate: `{COMMAND}`
 
-Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at start), Python {platform.python_version()}, bpy {bpy.app.version_string}, Ray {ray.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
+Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at start), Python {platform.python_version()}, bpy {bpy.app.version_string}, Ray {ray.__version__}. Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.
 
 | workers | Ray start (s) | sample library import (s) |{real_header} small Table 4 training (s) |
 |---:|---:|---:|{"---:|" if realmocap else ""}---:|
-""" + "\n".join(rows) + "\n"
+"""
+        + "\n".join(rows)
+        + "\n"
+    )
     print(text)
     if not args.no_write:
         report.write_section(HEADING, text)

@@ -27,10 +27,10 @@ ROOT = Path(__file__).resolve().parents[1]
 for path in (ROOT, ROOT / "tests", ROOT / "tests" / "addon"):
     sys.path.insert(0, str(path))
 
-import addon_helpers as helpers  # noqa: E402
 import bpy  # noqa: E402
-import real_rigs  # noqa: E402
 
+import addon_helpers as helpers  # noqa: E402
+import real_rigs  # noqa: E402
 from benchmarks.report import BENCHMARKS_MD, write_section  # noqa: E402
 
 #: (row, family, source) of every rig: a ../shared/rigs file (real_rigs.FILES) or a Rigify build, still; a
@@ -146,7 +146,9 @@ def _rerun(rows, seconds, date):
     which rows were rerun, when and how long they took."""
     old = re.search(r"^## Real rigs\n.*?(?=^## |\Z)", BENCHMARKS_MD.read_text(), re.S | re.M).group(0)
     lines = old.rstrip("\n").split("\n")
-    table = {line.split("|")[1].strip(): line for line in lines if line.startswith("| ") and not line.startswith("| rig |")}
+    table = {
+        line.split("|")[1].strip(): line for line in lines if line.startswith("| ") and not line.startswith("| rig |")
+    }
     table.update(rows)
     head = [line for line in lines if not line.startswith(("|---", "Rows rerun"))
             and (not line.startswith("| ") or line.startswith("| rig |"))]

@@ -12,6 +12,9 @@ import bpy
 import numpy as np
 
 LAYERED = "slots" in bpy.types.Action.bl_rna.properties
+#: Blender 5.0's `ChannelbagFCurves.new` takes the channel group's name; 4.4 and 4.5 group the F-curve after.
+_NEW_FCURVE_TAKES_GROUP = LAYERED and (
+    "group_name" in bpy.types.ActionChannelbagFCurves.bl_rna.functions["new"].parameters)
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZIER"].value
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
@@ -34,9 +37,14 @@ class ActionTarget:
     def new_fcurve(self, data_path, index, group):
         """A new F-curve of this target, in the named channel group."""
         fcurves = self._fcurves(create=True)
-        if LAYERED:
+        if not LAYERED:
+            return fcurves.new(data_path, index=index, action_group=group)
+        if _NEW_FCURVE_TAKES_GROUP:
             return fcurves.new(data_path, index=index, group_name=group)
-        return fcurves.new(data_path, index=index, action_group=group)
+        fcurve = fcurves.new(data_path, index=index)
+        groups = self._channelbag.groups
+        fcurve.group = groups.get(group) or groups.new(group)
+        return fcurve
 
     def fcurves(self):
         """The F-curves of this target (a list, empty when there are none)."""

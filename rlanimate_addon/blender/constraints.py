@@ -266,7 +266,7 @@ def mute(obj, found, start, end, hold=False):
         else:
             kept, evaluate = _keys(curve), curve.evaluate
         prior = {int(f): float(evaluate(float(f))) for f in frames}
-        keys = {**kept, **{f: v * k for (f, v), k in zip(prior.items(), keep)}}
+        keys = {**kept, **{f: v * k for (f, v), k in zip(prior.items(), keep, strict=True)}}
         if hold:
             prior = {**kept, **prior}
             keys = dict.fromkeys(keys, 0.0)

@@ -182,7 +182,9 @@ def _compute(context, plan, settings, agent, frames):
         plan.hold = bool(plan.overriding) and not rig.animated and constraints.follow_rest(obj, plan.overriding)
         if plan.ik_share is not None:
             plan.properties = rigify.switch_keys(obj, settings.arm, switch, plan.blend_type, rig.animated)
-        plan.under = {bone: below_values[bone][0] for bone in plan.bones if not np.ptp(below_values[bone], axis=0).any()}
+        plan.under = {
+            bone: below_values[bone][0] for bone in plan.bones if not np.ptp(below_values[bone], axis=0).any()
+        }
         plan.keys = {}
         for column, bone in enumerate(plan.bones):
             mode = obj.pose.bones[bone].rotation_mode

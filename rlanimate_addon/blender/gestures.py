@@ -170,8 +170,12 @@ def influence_before(gesture):
     """{influence path: {frame: value}} the gesture's mute overwrote (`record`; none in a record made before
     Generate kept them; a record made before it kept their frames holds values from the gesture's start)."""
     start = gesture.record["start"]
-    return {item["path"]: dict(zip(item.get("frames", range(start, start + len(item["values"]))), item["values"]))
-            for item in gesture.record.get("influence_before", [])}
+    return {
+        item["path"]: dict(
+            zip(item.get("frames", range(start, start + len(item["values"]))), item["values"], strict=True)
+        )
+        for item in gesture.record.get("influence_before", [])
+    }
 
 
 def edited_by_hand(gesture):

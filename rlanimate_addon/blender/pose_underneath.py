@@ -223,7 +223,7 @@ def sample(obj, names, frames):
             continue
         times, played = mapping(frames)
         values = evaluate_fcurves([f for f, _ in curves], times)  # (F, N)
-        for (fcurve, key), row in zip(curves, values):
+        for (fcurve, key), row in zip(curves, values, strict=True):
             channels[key][played, fcurve.array_index] = row[played]
             covered[key] |= played
     # A channel the NLA plays on some frames only, or a connected bone's location: Blender's call.

@@ -29,8 +29,14 @@ import numpy as np
 from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, each_frame, inverse
-from .rotations import (matrix_to_quat, matrix_to_rotvec, quat_to_matrix, quat_to_rotvec, rotvec_to_matrix,
-                        rotvec_to_quat)
+from .rotations import (
+    matrix_to_quat,
+    matrix_to_rotvec,
+    quat_to_matrix,
+    quat_to_rotvec,
+    rotvec_to_matrix,
+    rotvec_to_quat,
+)
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
 SUPPORTED_LENGTH = (0.4, 1.5)
@@ -147,7 +153,9 @@ def arm_reach(arm, rest_heads):
     if prefix + "HandIndex1" in rest_heads:
         return float(np.linalg.norm(np.subtract(rest_heads[prefix + "HandIndex1"], shoulder)))
     canonical = {name: np.asarray(skeleton.BONE_BY_NAME[prefix + name].head) for name in ("Arm", "Hand", "HandIndex1")}
-    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(canonical["Hand"] - canonical["Arm"])
+    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(
+        canonical["Hand"] - canonical["Arm"]
+    )
     return float(ratio * np.linalg.norm(np.subtract(rest_heads[prefix + "Hand"], shoulder)))
 
 
@@ -290,8 +298,16 @@ def rest_swings(roles, rest_heads, rest_tails, to_character):
     directed = [n for n in names if directions[n] is not None]
     rig = np.array([directions[n] for n in directed]).reshape(-1, 3) @ np.asarray(to_character).T
     canonical = np.array([_CANONICAL_DIRECTIONS[n] for n in directed]).reshape(-1, 3)
-    turns = dict(zip(directed, aim.rotation_between(rig / np.linalg.norm(rig, axis=1, keepdims=True),
-                                                     canonical / np.linalg.norm(canonical, axis=1, keepdims=True))))
+    turns = dict(
+        zip(
+            directed,
+            aim.rotation_between(
+                rig / np.linalg.norm(rig, axis=1, keepdims=True),
+                canonical / np.linalg.norm(canonical, axis=1, keepdims=True),
+            ),
+            strict=True,
+        )
+    )
     swings = {}
     for name in names:
         parent = _parent_role(name, roles)
@@ -591,7 +607,7 @@ def gesture_rotations(agent, request, rig):
                 lambda frames: matrix_to_quat(frames[:, eye_columns, :3, :3]), under_basis)], axis=1)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
-    broken = [bone for bone, ok in zip(bones, finite) if not ok]
+    broken = [bone for bone, ok in zip(bones, finite, strict=True) if not ok]
     if broken:
         raise RLAnimateError(f"The gesture's rotations of {', '.join(broken)} are not numbers (NaN): check those "
                              "bones' pose and animation at the gesture's frames and the rig's rest pose for NaN "

@@ -22,7 +22,7 @@ def hermite(values: np.ndarray, tangents: np.ndarray, keys: np.ndarray) -> np.nd
     third of the way to the neighbouring keys along the slopes `tangents` (N, C)."""
     values = np.asarray(values, dtype=np.float64)
     out = values.copy()
-    for a, b in zip(keys[:-1], keys[1:]):
+    for a, b in zip(keys[:-1], keys[1:], strict=True):
         t = (np.arange(a, b + 1) - a)[:, None] / float(b - a)
         span = float(b - a)
         h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t

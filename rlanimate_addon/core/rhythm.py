@@ -110,7 +110,9 @@ class RhythmModel:
         if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
                                  "side: add such wave clips.")
-        examples = [[float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms)]
+        examples = [
+            [float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms, strict=True)
+        ]
         phases = np.array([r.phase for r in rhythms])
         phase = float(np.angle(np.mean(np.exp(1j * phases))))
         return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases, arms=arms)

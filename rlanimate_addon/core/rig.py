@@ -96,7 +96,10 @@ class RigSkeleton:
         changed = set(changed)
         bones = self._evaluation_order(only)
         slot = {i: k for k, i in enumerate(bones)}
-        pose_inverse, basis_inverse = _frames_inverse(pose, bones), _frames_inverse(basis, bones)  # (N, len(bones), 4, 4)
+        pose_inverse, basis_inverse = (
+            _frames_inverse(pose, bones),
+            _frames_inverse(basis, bones),
+        )  # (N, len(bones), 4, 4)
         still = pose.strides[0] == 0 and basis.strides[0] == 0  # one frame broadcast: a rig standing still
         out = np.array(pose, dtype=np.float64)
         moved = np.zeros(len(self.names), dtype=bool)

@@ -22,7 +22,9 @@ def check_nonzero_scale(rig_name: str, object_matrix: ArrayLike, bone_scales: di
                              "(Object Mode, N panel > Item > Scale, or Alt+S for 1) to non-zero values, and that of "
                              "any object it is parented to, then generate.")
     scales = np.array(list(bone_scales.values()), dtype=np.float64).reshape(len(bone_scales), 3)
-    zero = [name for name, kept in zip(bone_scales, np.all(np.abs(scales) >= MIN_SCALE, axis=1)) if not kept]
+    zero = [
+        name for name, kept in zip(bone_scales, np.all(np.abs(scales) >= MIN_SCALE, axis=1), strict=True) if not kept
+    ]
     if zero:
         shown = ", ".join(f"{name!r} {tuple(round(float(v), 3) for v in bone_scales[name])}" for name in zero[:3])
         raise RLAnimateError(f"Bones of {rig_name!r} are scaled to zero ({shown}), which collapses the bones they "

@@ -72,7 +72,7 @@ def quat_to_matrix(quat: ArrayLike) -> np.ndarray:
 def _picked(picks, options):
     """Per element, options[0], or options[k + 1] where picks[k] (masks that never overlap)."""
     out = options[0].copy()
-    for pick, option in zip(picks, options[1:]):
+    for pick, option in zip(picks, options[1:], strict=True):
         np.copyto(out, option, where=pick)
     return out
 

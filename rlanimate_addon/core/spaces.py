@@ -25,9 +25,8 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import skeleton
-from . import behaviours
-from .behaviours import INTENSITY, TARGET, WAVE, Behaviour
+from . import behaviours, skeleton
+from .behaviours import TARGET, WAVE, Behaviour
 from .errors import RLAnimateError
 
 DESCRIPTION_SIZE = 42

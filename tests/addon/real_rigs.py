@@ -9,16 +9,16 @@ import shutil
 import struct
 from pathlib import Path
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
+
+import addon_helpers as helpers
 import rig_variants
 import test_generate
-from test_rig_variants import _strokes
-
 from rlanimate_addon.blender import armature_io, bake_check
 from rlanimate_addon.core import behaviour_metrics, gesture, skeleton
+from test_rig_variants import _strokes
 
 SHARED_RIGS = helpers.ROOT.parent / "shared" / "rigs"
 
@@ -75,7 +75,9 @@ def require(name):
     """Path of a ../shared/rigs file; skips the test, with a message, when it is absent."""
     path = shared_file(name)
     if path is None:
-        pytest.skip(f"{SHARED_RIGS / FILES[name]} is absent: the real-rig tests read ../shared/rigs (see its README.md)")
+        pytest.skip(
+            f"{SHARED_RIGS / FILES[name]} is absent: the real-rig tests read ../shared/rigs (see its README.md)"
+        )
     return path
 
 
@@ -273,7 +275,7 @@ def deformed_joints(rig, settings, arm):
     carriers = [bake_check.stand_in(rig, bone, deformed) for bone in joints]
     rests = [np.array(rig.data.bones[c].matrix_local) for c in carriers]
     points = [np.append(np.array(rig.data.bones[b].head_local), 1.0) for b in joints]
-    local = [np.linalg.inv(r) @ p for r, p in zip(rests, points)]
+    local = [np.linalg.inv(r) @ p for r, p in zip(rests, points, strict=True)]
     world = np.array(rig.matrix_world)
     heads = {r: world @ np.append(np.array(rig.data.bones[found[prefix + r]].head_local), 1.0)
              for r in ("Arm", "ForeArm", "Hand")}
@@ -284,7 +286,7 @@ def deformed_joints(rig, settings, arm):
         bpy.context.scene.frame_set(int(frame))
         evaluated = rig.evaluated_get(bpy.context.evaluated_depsgraph_get())
         poses = [np.array(evaluated.pose.bones[c].matrix) for c in carriers]
-        return np.array([(world @ pose @ p)[:3] for pose, p in zip(poses, local)])
+        return np.array([(world @ pose @ p)[:3] for pose, p in zip(poses, local, strict=True)])
     return at, arm_length
 
 
@@ -366,7 +368,7 @@ def point_misses(rig, settings, count, exact, seed):
                                      exact=exact)
         assert result == {"FINISHED"}, result
         measured.append((miss, travel))
-    return tuple(np.array(m) for m in zip(*measured))
+    return tuple(np.array(m) for m in zip(*measured, strict=True))
 
 
 def _shoulder_width(rig, settings):

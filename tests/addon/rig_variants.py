@@ -7,10 +7,10 @@ to save; `tmp` is a folder for the files an export and re-import go through.
 """
 import math
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 
+import addon_helpers as helpers
 from rlanimate_addon.core import gesture, rig_roles, skeleton
 
 

@@ -2,14 +2,14 @@
 ids), a stored choice survives a change of agent, the panel shows Target or Exaggeration by the behaviour's
 kind, and Generate bakes a behaviour the agent declares beyond the shipped agent's (tests/addon/declared_agents.py
 widens the shipped agent by two behaviours with numpy alone, so this runs on Blender 4.2 and 5.0)."""
-import addon_helpers
 import bpy
-import declared_agents
 import numpy as np
 import pytest
-from test_registration import RecordingLayout, _draw
 
+import addon_helpers
+import declared_agents
 from rlanimate_addon.blender import gestures, preferences, properties
+from test_registration import RecordingLayout, _draw
 
 ADDED = [("BECKON", "target"), ("SHRUG", "intensity")]
 

@@ -6,13 +6,13 @@ import struct
 import time
 import zipfile
 
-import addon_helpers
 import bpy
 import numpy as np
 import pytest
-from test_registration import RecordingLayout
 
+import addon_helpers
 from rlanimate_addon.blender import panel, preferences
+from test_registration import RecordingLayout
 
 
 def _lzma(data):

@@ -1,9 +1,9 @@
 """Constraints that would override the gesture: refused by name, or muted over the gesture's frames only."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.core import gesture
 from test_generate import _assert_refused, _fcurves, _key_existing_animation, _state
 
@@ -22,8 +22,11 @@ def _ik_rig():
 def test_a_constraint_overriding_the_arm_is_refused_by_name_and_changes_nothing(settings):
     rig, forearm, _ = _ik_rig()
     settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
-    _assert_refused(rig, rf"Constraint 'IK' \(Inverse Kinematics, target IK Target\) on {forearm.name} overrides the rotations the "
-                         rf"gesture keys, so the bake would not play\. Click 'Generate, Muting Constraints'")
+    _assert_refused(
+        rig,
+        rf"Constraint 'IK' \(Inverse Kinematics, target IK Target\) on {forearm.name} overrides the rotations the "
+        rf"gesture keys, so the bake would not play\. Click 'Generate, Muting Constraints'",
+    )
 
 
 def test_muting_keeps_the_constraint_outside_the_gesture_and_lets_the_gesture_play_inside(settings):

@@ -1,11 +1,11 @@
 """Export FBX: Blender's exporter writes the rig, its mesh and the baked gesture, and they read back."""
 import os
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import export
 from rlanimate_addon.core import skeleton
 

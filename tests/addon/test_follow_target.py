@@ -96,7 +96,9 @@ def test_a_re_bake_records_its_settings_and_follows_again(settings):
     _move(target, NEW)
     record = gestures.last_targeted(rig).record
     assert record["note"] == "" and record["settings"]["target"] == target
-    assert np.allclose(np.reshape(record["aimed_at"], (-1, 3))[0], np.array(rig.matrix_world.inverted() @ target.location))
+    assert np.allclose(
+        np.reshape(record["aimed_at"], (-1, 3))[0], np.array(rig.matrix_world.inverted() @ target.location)
+    )
     _move(target, OLD)
     to_old, to_new = _apex_angles(rig)
     assert to_old <= MAX_APEX_ANGLE_DEG < to_new, "a second move is followed too"

@@ -1,11 +1,11 @@
 """Generate Gesture on real rigs: pointing accuracy, wave size, return to start, other rigs, undo-safe errors."""
 import math
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.core import skeleton
 
 RNG = np.random.default_rng()
@@ -214,7 +214,9 @@ def test_pushed_down_animation_plays_as_before_over_the_scene(settings, kind):
     scene = bpy.context.scene
     outside = np.r_[scene.frame_start:140, 181:scene.frame_end + 1]
     _, before = _pose_snapshot(rig, outside)
-    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=140, frame_count=41) == {"FINISHED"}
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=140, frame_count=41) == {
+        "FINISHED"
+    }
     _, after = _pose_snapshot(rig, outside)
     assert np.abs(after - before).max() < 1e-5, f"{kind}: the pushed-down action plays differently"
 
@@ -366,7 +368,7 @@ def test_a_linked_armature_is_refused_and_a_library_override_keeps_its_gesture(s
     bpy.context.scene.collection.objects.link(rig)
     helpers.activate(rig)
     settings.behaviour = "WAVE"
-    _assert_refused(rig, rf"is linked from .*character\.blend, so a gesture baked onto it would be lost when the "
+    _assert_refused(rig, r"is linked from .*character\.blend, so a gesture baked onto it would be lost when the "
                          r"file is saved\. Make a library override")
     assert rig.animation_data is None
 

@@ -2,16 +2,15 @@
 a bone of another armature as target, and a bone-map file saved, edited and loaded."""
 import json
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-from test_generate import finger_angles, random_target
-from test_rig_variants import _pose_snapshot
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import generate
 from rlanimate_addon.core import key_reduction, rig_roles, skeleton
-from rlanimate_addon.core.rotations import quat_to_matrix
+from test_generate import finger_angles, random_target
+from test_rig_variants import _pose_snapshot
 
 
 def _rotations(rig, bones, frames):

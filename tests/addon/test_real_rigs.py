@@ -3,13 +3,13 @@ by the Rigify add-on shipped with Blender, measured on the bones their meshes de
 them (tests/addon/real_rigs.py). The issue's bars: Exact Aim at most 1 degree median and 3 worst, the
 agent's own aim at most 5 median and 12 worst, every wave at least 4 strokes, the hand travelling at least
 half an arm length."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
+
+import addon_helpers as helpers
 import real_rigs
 import test_generate
-
 from rlanimate_addon.blender import armature_io
 from rlanimate_addon.core import rig_roles
 

@@ -1,14 +1,14 @@
 """Generate Gesture on rig variants built from the sample character (tests/addon/rig_variants.py): accepted,
 pointing on target with exact aim, waves with their strokes, and nothing it does not own changed."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import rig_variants
-from test_generate import random_target
 
+import addon_helpers as helpers
+import rig_variants
 from rlanimate_addon.blender import action_adapter
 from rlanimate_addon.core import behaviour_metrics, gesture, rig_roles
+from test_generate import random_target
 
 RNG = np.random.default_rng(11)
 POINT_STARTS = (20, 220, 420)
@@ -154,7 +154,9 @@ def _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=12
         for owner, start in owned:
             if owner == bone:
                 inside |= still | ((frames >= start) & (frames < start + length))
-        assert np.allclose(after[bone][~inside], matrices[~inside], atol=1e-5), f"{bone} changed where the gesture does not drive it"
+        assert np.allclose(after[bone][~inside], matrices[~inside], atol=1e-5), (
+            f"{bone} changed where the gesture does not drive it"
+        )
     keys_after = _all_keys()
     assert {k: v for k, v in keys_after.items() if k in keys_before} == keys_before, "existing keys changed"
 
@@ -165,7 +167,9 @@ def _lateral_wrist(rig, frames):
     roles = _roles(rig)
     heads = {r: np.array(rig.data.bones[b].head_local) for r, b in roles.items()}
     frame = gesture.character_frame(heads)
-    size = np.linalg.norm(heads["RightForeArm"] - heads["RightArm"]) + np.linalg.norm(heads["RightHand"] - heads["RightForeArm"])
+    size = np.linalg.norm(heads["RightForeArm"] - heads["RightArm"]) + np.linalg.norm(
+        heads["RightHand"] - heads["RightForeArm"]
+    )
     out = []
     for f in frames:
         bpy.context.scene.frame_set(int(f))

@@ -1,10 +1,10 @@
 """Rigs and settings Generate cannot serve well: a zero-scale armature or bone is refused naming it and the fix,
 a bone-map file that is not one is refused before it is read whole, and a gesture far below the agent's
 supported length is baked with a warning. A refusal changes nothing."""
-import addon_helpers as helpers
 import bpy
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import generate, preferences
 from rlanimate_addon.core import gesture
 

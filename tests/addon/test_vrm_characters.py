@@ -2,12 +2,12 @@
 Blender's glTF importer, on a VRM 1.0 file made from it by rewriting its JSON chunk, and from the VRM
 add-on's data on the armature: accepted with no bone-map file, pointing and waving as measured on the
 bones the mesh deforms with."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import real_rigs
 
+import addon_helpers as helpers
+import real_rigs
 from rlanimate_addon.blender import armature_io
 from rlanimate_addon.core import vrm
 
@@ -27,7 +27,9 @@ def _check_gestures(rig, settings, family):
     result, strokes, wave_travel = real_rigs.wave(rig, settings, "RIGHT", 1001)
     print(f"{family}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)} arm "
           f"lengths, wave {strokes} strokes / {wave_travel:.2f}, start arm drop {start:.0f} deg")
-    assert real_rigs.measured_bones_deform(rig, settings, "RIGHT") and real_rigs.measured_bones_deform(rig, settings, "LEFT")
+    assert real_rigs.measured_bones_deform(rig, settings, "RIGHT") and real_rigs.measured_bones_deform(
+        rig, settings, "LEFT"
+    )
     assert np.median(exact) <= EXACT_MEDIAN and exact.max() <= EXACT_WORST
     assert np.median(own) <= OWN_MEDIAN and own.max() <= OWN_WORST
     assert result == {"FINISHED"} and strokes >= 4 and min(travel.min(), wave_travel) >= 0.5

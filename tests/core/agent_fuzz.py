@@ -32,7 +32,6 @@ import io
 import json
 import struct
 import zipfile
-import zlib
 
 import numpy as np
 

@@ -3,8 +3,13 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import channels
-from rlanimate_addon.core.rotations import (euler_to_matrix, quat_to_matrix, rotvec_to_matrix, rotvec_to_quat,
-                                            matrix_to_euler)
+from rlanimate_addon.core.rotations import (
+    euler_to_matrix,
+    matrix_to_euler,
+    quat_to_matrix,
+    rotvec_to_matrix,
+    rotvec_to_quat,
+)
 
 RNG = np.random.default_rng(5)
 

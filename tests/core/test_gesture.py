@@ -4,8 +4,7 @@ import pytest
 
 from rlanimate_addon.core import aim, gesture, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
-from rlanimate_addon.core.rotations import (matrix_to_quat, quat_to_matrix, rotvec_to_matrix,
-                                            rotvec_to_quat)
+from rlanimate_addon.core.rotations import matrix_to_quat, quat_to_matrix, rotvec_to_matrix, rotvec_to_quat
 
 RNG = np.random.default_rng(11)
 
@@ -227,7 +226,9 @@ def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underne
     agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(frames, spaces.ACTION_SIZE)))
     rig = _animated(gesture.canonical_rig(), frames, scale=0.1)
     target = np.array([-1.0 if arm == "RIGHT" else 1.0, -2.5, 1.7])
-    names, quats, _ = gesture.gesture_rotations(agent, _request("POINT", arm, frames, targets=np.tile(target, (frames, 1))), rig)
+    names, quats, _ = gesture.gesture_rotations(
+        agent, _request("POINT", arm, frames, targets=np.tile(target, (frames, 1))), rig
+    )
     basis = rig.under.copy()
     columns = [rig.skeleton.index[n] for n in names]
     basis[:, columns, :3, :3] = quat_to_matrix(quats)
@@ -252,7 +253,9 @@ def test_the_eyes_look_at_the_target_while_pointing(animated):
     basis = rig.under_at(frames).copy()
     basis[:, [rig.skeleton.index[n] for n in names], :3, :3] = quat_to_matrix(quats)
     pose = rig.skeleton.pose_matrices(basis, only=("LeftEye", "RightEye"))
-    phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT"))
+    phase = aim.pointing_phase(
+        gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT")
+    )
     for eye in ("LeftEye", "RightEye"):
         i = rig.skeleton.index[eye]
         looking = pose[:, i, :3, :3] @ (skeleton.rest_frame(skeleton.BONE_BY_NAME[eye]).T @ [0.0, -1.0, 0.0])
@@ -274,8 +277,8 @@ def test_a_missing_spine_or_collar_bone_is_folded_and_the_bone_above_turns_the_s
     assert missing not in kept and len(kept) == len(joints) - 1
     from rlanimate_addon.core import kinematics
 
-    full = kinematics.pose_matrices(dict(zip(joints, np.moveaxis(rotvecs, 1, 0))))
-    merged = kinematics.pose_matrices(dict(zip(kept, np.moveaxis(folded, 1, 0))))
+    full = kinematics.pose_matrices(dict(zip(joints, np.moveaxis(rotvecs, 1, 0), strict=True)))
+    merged = kinematics.pose_matrices(dict(zip(kept, np.moveaxis(folded, 1, 0), strict=True)))
     bone = kinematics.bone_index(above)
     assert np.allclose(full[:, bone, :3, :3], merged[:, bone, :3, :3], atol=1e-9)
 
@@ -285,7 +288,7 @@ def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
 
     for arm in skeleton.ARMS:
         names, rotvecs = gesture.pointing_hand_rotations(arm, 1)
-        pose = kinematics.head_positions(kinematics.pose_matrices(dict(zip(names, rotvecs[0]))))
+        pose = kinematics.head_positions(kinematics.pose_matrices(dict(zip(names, rotvecs[0], strict=True))))
         rest = kinematics.head_positions(kinematics.pose_matrices({}))
         prefix = skeleton.ARM_PREFIX[arm]
         for finger in ("Middle", "Ring", "Pinky"):

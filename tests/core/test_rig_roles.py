@@ -40,7 +40,9 @@ def test_each_family_is_detected_from_its_own_names_with_every_gesture_role(fami
 def test_a_rigify_game_export_keys_its_deform_bones_and_a_whole_rigify_rig_its_controls():
     deform = _family_names(rig_roles.RIGIFY_DEFORM) + ["DEF-upper_arm.L.001", "DEF-forearm.R.001", "root"]
     family, roles = rig_roles.detect(deform)
-    assert family is rig_roles.RIGIFY_DEFORM and roles["LeftArm"] == "DEF-upper_arm.L" and roles["Head"] == "DEF-spine.006"
+    assert (
+        family is rig_roles.RIGIFY_DEFORM and roles["LeftArm"] == "DEF-upper_arm.L" and roles["Head"] == "DEF-spine.006"
+    )
     family, roles = rig_roles.detect(deform + _family_names(rig_roles.RIGIFY))
     assert family is rig_roles.RIGIFY and roles["LeftArm"] == "upper_arm_fk.L"
 
@@ -61,7 +63,11 @@ def test_biped_and_spaced_mixamo_names_are_detected(prefix):
 
 def test_rigify_keys_the_fk_controls():
     _, roles = rig_roles.detect(_family_names(rig_roles.RIGIFY))
-    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == ("upper_arm_fk.L", "forearm_fk.R", "spine_fk.002")
+    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == (
+        "upper_arm_fk.L",
+        "forearm_fk.R",
+        "spine_fk.002",
+    )
 
 
 def test_unreal_5_spine_keys_its_top_spine_bone():

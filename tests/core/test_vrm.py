@@ -99,7 +99,9 @@ def test_bad_files_are_refused_with_what_is_wrong(tmp_path, case, message):
     elif case == "no humanoid":
         data = glb({"nodes": NODES, "extensions": {"VRM": {"meta": {}}}})
     elif case == "node out of range":
-        data = glb({"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": [{"bone": "hips", "node": 99}]}}}})
+        data = glb(
+            {"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": [{"bone": "hips", "node": 99}]}}}}
+        )
     elif case == "too many bones":
         data = glb({"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": [VRM0[0]] * 300}}}})
     elif case == "wrong type":

@@ -40,8 +40,10 @@ def _agents_equal(folder_a, folder_b):
             np.array_equal(a[name], b[name]) for name in weights)
 
 
-@pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
-                    reason=f"real motion capture not found at {REALMOCAP_DIR} (../shared/realmocap/ beside the repository)")
+@pytest.mark.skipif(
+    not (REALMOCAP_DIR / "wave").is_dir(),
+    reason=f"real motion capture not found at {REALMOCAP_DIR} (../shared/realmocap/ beside the repository)",
+)
 def test_a_real_capture_run_on_a_ray_worker_equals_the_run_in_this_process(tmp_path, local_ray):
     wave = REALMOCAP_DIR / "wave"
     train_takes = tuple(str(wave / f"dataset-2_wave-left-hand_{name}.bvh") for name in ("feminine_001", "active_021"))
@@ -67,7 +69,7 @@ def test_clips_imported_by_two_blenders_are_the_serial_import_in_the_same_cache(
     serial, serial_problems = import_clip_directory(tiny_library, cache_dir=tmp_path / "serial")
     parallel, parallel_problems = import_clip_directory(tiny_library, cache_dir=tmp_path / "parallel", workers=2)
     assert len(serial) == len(parallel) == 6 and serial_problems == parallel_problems == []
-    for a, b in zip(serial, parallel):
+    for a, b in zip(serial, parallel, strict=True):
         assert (a.name, a.behaviour, a.arm, a.fps) == (b.name, b.behaviour, b.arm, b.fps)
         assert np.array_equal(a.rotvecs, b.rotvecs) and sorted(a.fingers) == sorted(b.fingers)
         assert all(np.array_equal(a.fingers[name], b.fingers[name]) for name in a.fingers)

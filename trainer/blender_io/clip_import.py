@@ -139,7 +139,7 @@ def _alignments(canonical, bones, rest):
     """
     index = {name: k for k, name in enumerate(canonical)}
     result = np.tile(np.eye(3), (len(bones), 1, 1))
-    for k, (name, bone) in enumerate(zip(canonical, bones)):
+    for k, (name, bone) in enumerate(zip(canonical, bones, strict=True)):
         frame = rest[k, :3, :3]
         child = _TAIL_CHILD.get(name)
         if child in index:

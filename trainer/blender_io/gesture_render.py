@@ -7,8 +7,6 @@ through the registered operator, exactly as an animator runs it from the panel.
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from trainer.blender_io.rig_session import blender_output, import_bpy, load_rig, new_empty_scene
 from trainer.paths import SAMPLE_RIG_BLEND
 

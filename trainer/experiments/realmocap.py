@@ -50,11 +50,28 @@ from trainer.evaluation.label_reach import label_reach
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
-from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, TAKE_GROUPS,
-                                            parse_name, relaxed_hand, require_realmocap, style_holdout_split,
-                                            take_group, take_paths, wave_split)
-from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
-                           shown)
+from trainer.motion.realmocap_takes import (
+    GUIDE_TARGET_DISTANCE,
+    HOLDOUT_STYLES,
+    PAPER_LABELS,
+    TAKE_GROUPS,
+    parse_name,
+    relaxed_hand,
+    require_realmocap,
+    style_holdout_split,
+    take_group,
+    take_paths,
+    wave_split,
+)
+from trainer.paths import (
+    DEFAULT_MANIFEST,
+    INSTALLED_AGENT,
+    REALMOCAP_DIR,
+    REALMOCAP_RUNS,
+    RESULTS_DIR,
+    seed_folder,
+    shown,
+)
 from trainer.reporting.realmocap_report import frames_figure, seed_summary
 
 
@@ -102,8 +119,8 @@ def waves_and_env(realmocap=REALMOCAP_DIR, runs=REALMOCAP_RUNS):
 
 
 class RealSession:
-    """What trainer.experiments.run.train needs (env, references, train_clips, test_clips, problems), over real clips (every one
-    imported: a take that does not import stops the experiment)."""
+    """What trainer.experiments.run.train needs (env, references, train_clips, test_clips, problems), over real clips
+    (every one imported: a take that does not import stops the experiment)."""
 
     def __init__(self, env, references, train_clips, test_clips):
         self.env, self.references, self.problems = env, references, []
@@ -130,7 +147,7 @@ def guide_angles(method, clips, env):
     """Per guide clip: the angle (deg) between generated and real forearm directions at their holds."""
     rows = []
     motions = baselines.generate_for(method, clips)
-    for clip, motion in zip(clips, motions):
+    for clip, motion in zip(clips, motions, strict=True):
         real = env.evaluate(clip.rotvecs)
         generated = env.evaluate(motion)
         hold = autolabel.label_point(motion, clip.arm).hold_frame
@@ -211,7 +228,7 @@ def compare(methods, clips, env, references, with_tempo=False):
         result = scoring.score_motions(env, motions, clips, references)
         if all(c.behaviour == behaviours.WAVE for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
-                                                   for m, c in zip(motions, clips)]))
+                                                   for m, c in zip(motions, clips, strict=True)]))
         results[name] = result
     return results
 
@@ -225,10 +242,17 @@ def label_table(clips):
         entry["elevation"].append(clip.label.elevation)
         entry["stroke"].append(clip.label.stroke)
         entry["arm_correct"].append(clip.named_arm is None or clip.named_arm == clip.arm)
-    return {style: {"clips": len(v["exaggeration"]), "exaggeration": float(np.mean(v["exaggeration"])),
-                    "exaggeration_sd": float(np.std(v["exaggeration"])), "elevation_deg": float(np.mean(v["elevation"])),
-                    "stroke_arm_lengths": float(np.mean(v["stroke"])), "arm_correct": int(np.sum(v["arm_correct"]))}
-            for style, v in sorted(table.items(), key=lambda item: np.mean(item[1]["exaggeration"]))}
+    return {
+        style: {
+            "clips": len(v["exaggeration"]),
+            "exaggeration": float(np.mean(v["exaggeration"])),
+            "exaggeration_sd": float(np.std(v["exaggeration"])),
+            "elevation_deg": float(np.mean(v["elevation"])),
+            "stroke_arm_lengths": float(np.mean(v["stroke"])),
+            "arm_correct": int(np.sum(v["arm_correct"])),
+        }
+        for style, v in sorted(table.items(), key=lambda item: np.mean(item[1]["exaggeration"]))
+    }
 
 
 def tempo_table(clips, references):
@@ -367,8 +391,14 @@ def run_experiments(settings: RealMocapSettings) -> dict:
         if name == "wave":
             chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
             generated = baselines.generate_for(methods["rlanimate"], chosen)
-            frames_figure(env, [(f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
-                                for c, g in zip(chosen, generated)], Path(settings.results) / "realmocap_frames.png")
+            frames_figure(
+                env,
+                [
+                    (f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
+                    for c, g in zip(chosen, generated, strict=True)
+                ],
+                Path(settings.results) / "realmocap_frames.png",
+            )
     results["evaluation_cpu_seconds"] = time.process_time() - evaluation_started
 
     try:

@@ -351,6 +351,6 @@ def _output_to(path):
         finally:
             sys.stdout.flush()
             sys.stderr.flush()
-            for descriptor, copy in zip((1, 2), saved):
+            for descriptor, copy in zip((1, 2), saved, strict=True):
                 os.dup2(copy, descriptor)
                 os.close(copy)

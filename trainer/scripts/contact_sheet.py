@@ -43,16 +43,25 @@ def further_requests():
     """The requests of the guide and raise-hand sheet: "this way" to two targets, raised hands small to big."""
     from trainer.blender_io.gesture_render import RenderRequest
     return [
-        RenderRequest("this way, right, to a door", {"behaviour": "GUIDE", "arm": "RIGHT", "seed": 0}, target=TARGET_DOOR),
-        RenderRequest("this way, left, to the floor", {"behaviour": "GUIDE", "arm": "LEFT", "seed": 0},
-                      target=TARGET_FLOOR),
-        RenderRequest("raise hand right, e 0.1", {"behaviour": "RAISE_HAND", "arm": "RIGHT", "exaggeration": 0.1, "seed": 0}),
-        RenderRequest("raise hand left, e 0.9", {"behaviour": "RAISE_HAND", "arm": "LEFT", "exaggeration": 0.9, "seed": 0}),
+        RenderRequest(
+            "this way, right, to a door", {"behaviour": "GUIDE", "arm": "RIGHT", "seed": 0}, target=TARGET_DOOR
+        ),
+        RenderRequest(
+            "this way, left, to the floor", {"behaviour": "GUIDE", "arm": "LEFT", "seed": 0}, target=TARGET_FLOOR
+        ),
+        RenderRequest(
+            "raise hand right, e 0.1", {"behaviour": "RAISE_HAND", "arm": "RIGHT", "exaggeration": 0.1, "seed": 0}
+        ),
+        RenderRequest(
+            "raise hand left, e 0.9", {"behaviour": "RAISE_HAND", "arm": "LEFT", "exaggeration": 0.9, "seed": 0}
+        ),
     ]
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0]
+    )
     parser.add_argument("--out", type=Path)
     parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="library plan seed (library sheet)")
     parser.add_argument("--generated", action="store_true", help="render Generate Gesture's output with Blender")

@@ -94,11 +94,14 @@ def test_resumed_run_equals_the_uninterrupted_run(session, tmp_path):
     a, b = straight.state_dict(), resumed.state_dict()
     assert a["agent"].keys() == b["agent"].keys()
     assert all(torch.equal(a["agent"][k], b["agent"][k]) for k in a["agent"])
-    for state_a, state_b in zip(a["optimizer"]["state"].values(), b["optimizer"]["state"].values()):
+    for state_a, state_b in zip(a["optimizer"]["state"].values(), b["optimizer"]["state"].values(), strict=True):
         assert all(torch.equal(state_a[k], state_b[k]) for k in state_a)
     assert len(straight.buffer) == len(resumed.buffer)
-    assert all(np.array_equal(x[k], y[k]) for x, y in zip(straight.buffer.episodes, resumed.buffer.episodes)
-               for k in x)
+    assert all(
+        np.array_equal(x[k], y[k])
+        for x, y in zip(straight.buffer.episodes, resumed.buffer.episodes, strict=True)
+        for k in x
+    )
     assert [e["loss/total"] for e in a["history"]] == [e["loss/total"] for e in b["history"]]
     lines = (tmp_path / "resumed" / "metrics.jsonl").read_text().splitlines()
     assert len(lines) == 4  # the metrics log is rebuilt from the checkpoint, not duplicated

@@ -292,7 +292,7 @@ def test_imported_clips_are_cached_and_reused_without_reimporting(library, tmp_p
     imported = count_imports(monkeypatch)
     second = clip_import.load_clip_set(manifest)
     assert imported == ["point_right_001.fbx"]  # only the bad file, which has no cache entry
-    for a, b in zip(first.clips, second.clips):
+    for a, b in zip(first.clips, second.clips, strict=True):
         np.testing.assert_array_equal(a.rotvecs, b.rotvecs)
         assert a.fingers.keys() == b.fingers.keys()
         assert (a.behaviour, a.split) == (b.behaviour, b.split)
