@@ -4,6 +4,7 @@ Blenders at once are the serial import's, in the same cache."""
 import numpy as np
 import pytest
 
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.blender_io.clip_import import import_clip_directory
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect
@@ -31,6 +32,20 @@ def test_a_run_on_a_ray_worker_equals_the_run_in_this_process(tiny_library, tmp_
     assert settings.output == str(tmp_path / "ray") and report["epochs"] == 2
     assert "clips:" in (tmp_path / "ray" / "train.log").read_text()  # the worker's output went to the run's log
     assert _agents_equal(tmp_path / "serial", tmp_path / "ray")
+
+
+def test_a_run_refused_on_a_ray_worker_is_one_line_naming_the_run(tiny_library, tmp_path, local_ray):
+    output = tmp_path / "run"
+    output.mkdir()
+    (output / "checkpoint.pt").write_bytes(b"not a checkpoint")
+    settings = RunSettings(output=str(output), clips=str(tiny_library), epochs=2, preset="debug", resume=True,
+                           progress=False)
+    with pytest.raises(RLAnimateError) as refused:
+        list(train_runs([settings]))
+    message = str(refused.value)
+    assert message.startswith(f"The run in {output}: The checkpoint {output / 'checkpoint.pt'} is damaged (")
+    assert "\n" not in message and "weights_only" not in message and "Traceback" not in message
+    assert (output / "checkpoint.pt").read_bytes() == b"not a checkpoint", "the run's files are kept"
 
 
 def _agents_equal(folder_a, folder_b):

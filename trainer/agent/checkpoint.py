@@ -83,8 +83,8 @@ def _written_after_a_resume(path, error):
 
 
 #: What a run whose checkpoint cannot be read can do instead.
-_RESTART = ("put back a copy of the run's folder if you have one, or start the run again with --overwrite "
-            "(which replaces it) or into another --output folder.")
+_RESTART = ("put back a copy of the run's folder if you have one, or train the run again: train.py with --overwrite "
+            "(which replaces it) or another --output folder; an experiment after moving the run's folder away.")
 
 
 def _plain(value):
@@ -99,11 +99,13 @@ def _plain(value):
 
 def _reason(error):
     """What torch says is wrong with a file, without its advice to load with weights_only=False (which
-    would unpickle, and could run, whatever the file holds) or its terminal colour codes."""
+    would unpickle, and could run, whatever the file holds) or its terminal colour codes: its first sentence,
+    on one line."""
     text = re.sub(r"\x1b\[[0-9;]*m", "", str(error))
     if "WeightsUnpickler error:" in text:  # torch's advice comes first, the reason after this marker
         text = text.split("WeightsUnpickler error:", 1)[1]
-    return text.strip().split(". ", 1)[0].strip().rstrip(".") or type(error).__name__
+    first = next((line.strip() for line in text.splitlines() if line.strip()), "")
+    return first.split(". ", 1)[0].rstrip(".") or type(error).__name__
 
 
 class _CheckedDict(dict):

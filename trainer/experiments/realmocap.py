@@ -208,7 +208,7 @@ def train_real_runs(runs, address=None, workers=None):
     pending = [run for run in runs if not is_finished(Path(run.settings.output), run.settings.epochs)]
     if pending:
         connect(address, workers)
-        for run, _ in run_tasks(train_real, pending):
+        for run, _ in run_tasks(train_real, pending, name=lambda run: f"The run in {run.settings.output}"):
             print(f"realmocap: trained {shown(run.settings.output)}", flush=True)
     return {run.settings.output: json.loads((Path(run.settings.output) / "report.json").read_text()) for run in runs}
 

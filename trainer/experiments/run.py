@@ -334,7 +334,7 @@ def train_runs(runs: Iterable[RunSettings], address: str | None = None,
     runs = list(runs)
     if runs:
         connect(address, workers)
-        yield from run_tasks(train_logged, runs)
+        yield from run_tasks(train_logged, runs, name=lambda run: f"The run in {run.output}")
 
 
 @contextmanager

@@ -20,6 +20,9 @@ from trainer.files import atomic_copy
 from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.scripts.cli import run_main, script_args
 
+#: What an interrupted run says: every epoch it finished is in its checkpoint.
+INTERRUPTED = "interrupted: the run's checkpoint holds every epoch it finished; continue it with --resume"
+
 
 def build_parser():
     """The command line. Run settings default to None ("not given"): a new run takes NEW_RUN_DEFAULTS, a
@@ -90,4 +93,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=INTERRUPTED))

@@ -65,8 +65,8 @@ def test_a_checkpoint_holding_code_is_refused_without_torchs_advice_to_unpickle_
         checkpoint.load(path)
     message = str(refused.value)
     assert message.startswith(f"The checkpoint {path} is damaged (Unsupported global: GLOBAL argparse.Namespace")
-    assert message.endswith("start the run again with --overwrite (which replaces it) or into another --output "
-                            "folder."), "the advice keeps the run's files until the user chooses to replace them"
+    assert message.endswith("train.py with --overwrite (which replaces it) or another --output folder; an "
+                            "experiment after moving the run's folder away."), "the advice keeps the run's files"
     assert "weights_only" not in message and "\x1b" not in message
 
 
@@ -161,7 +161,7 @@ def test_a_checkpoint_missing_a_key_is_refused_naming_it_and_the_run_is_kept(ses
     torch.save(payload, path)
     files = {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()}
     with pytest.raises(RLAnimateError, match=rf"^The checkpoint {re.escape(str(path))} lacks {re.escape(missing)}: "
-                                             r"it is incomplete.*start the run again with --overwrite"):
+                                             r"it is incomplete.*train the run again: train.py with --overwrite"):
         _run(session, run, 4, resume=True)
     assert {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()} == files, "the run's files are kept"
 
