@@ -1,4 +1,4 @@
-"""Ray, the engine that runs training runs and clip imports side by side: on this machine by default, or
+"""Ray, the engine that runs training runs side by side: on this machine by default, or
 on a cluster that `ray start` made (docs/TRAINING.md, "Many runs, many machines").
 
 `connect()` starts a local Ray with no set-up (`address` None; never a cluster that happens to run here)

@@ -13,8 +13,10 @@ into the folder of another is refused unless `--overwrite`.
 import argparse
 from pathlib import Path
 
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.models import VARIANTS
 from trainer.blender_io.clip_session import LibrarySession
+from trainer.blender_io.import_worker import ImportLimits
 from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
 from trainer.files import atomic_copy
 from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
@@ -57,8 +59,25 @@ def build_parser():
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--verbose", action="store_true", help="show what Blender prints while loading the clips")
     parser.add_argument("--import-workers", type=int, default=1,
-                        help="import the clips the cache lacks with N Blenders at once (Ray tasks; default 1)")
+                        help="import the clips the cache lacks with N Blenders at once (worker processes; default 1)")
+    parser.add_argument("--import-memory-limit", type=float, default=ImportLimits.memory_gb, metavar="GB",
+                        help="the memory one clip's import may take; a clip that needs more is skipped with a note "
+                             f"(default {ImportLimits.memory_gb:g})")
+    parser.add_argument("--import-time-limit", type=float, default=ImportLimits.seconds, metavar="SECONDS",
+                        help="the time one clip's import may take; a clip that takes longer is skipped with a note "
+                             f"(default {ImportLimits.seconds:g})")
     return parser
+
+
+def import_limits(args):
+    """The ImportLimits of the arguments; RLAnimateError naming each that is not a positive number."""
+    problems = [f"{option} {value:g}: give a number above 0{example}" for option, value, example in (
+        ("--import-workers", args.import_workers, ", such as 2"),
+        ("--import-memory-limit", args.import_memory_limit, " (GB), such as 2"),
+        ("--import-time-limit", args.import_time_limit, " (seconds), such as 60")) if not value > 0]
+    if problems:
+        raise RLAnimateError("; ".join(problems) + ". Nothing was trained.")
+    return ImportLimits(memory_gb=args.import_memory_limit, seconds=args.import_time_limit)
 
 
 def run_settings(args):
@@ -80,7 +99,9 @@ def install(output):
 def main(argv=None):
     args = build_parser().parse_args(script_args(argv))
     settings = resolve(run_settings(args))
-    session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers)
+    limits = import_limits(args)
+    session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers,
+                             import_limits=limits)
     report, _ = train(settings, session)
     scored, split = ((report["held_out"], "held-out") if report["held_out"] is not None
                      else (report["training"], "no held-out clips; training-clip"))

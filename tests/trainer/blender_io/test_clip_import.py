@@ -2,6 +2,7 @@
 import json
 import shutil
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,7 +11,7 @@ bpy = pytest.importorskip("bpy")
 
 from rlanimate_addon.core import kinematics, rotations, skeleton, spaces  # noqa: E402
 from rlanimate_addon.core.errors import RLAnimateError  # noqa: E402
-from trainer.blender_io import clip_import, rig_session  # noqa: E402
+from trainer.blender_io import clip_import, import_worker, rig_session  # noqa: E402
 from trainer.motion import clip_cache  # noqa: E402
 from trainer.paths import SAMPLE_RIG_BLEND, SAMPLE_RIG_FBX  # noqa: E402
 
@@ -270,15 +271,21 @@ def test_load_clip_set_attaches_the_manifest_labels_and_split(library, tmp_path)
 
 
 def count_imports(monkeypatch):
-    """A list that collects the name of every file clip_import really imports (not from its cache)."""
+    """A list that collects the name of every file clip_import really imports (not from its cache): in this
+    process (import_clip) or in its import workers (a library's clips)."""
     imported = []
-    real_import = clip_import._import_uncached
+    real_import, real_workers = clip_import._import_uncached, import_worker.import_into_cache
 
     def counting_import(path, *args):
         imported.append(path.name)
         return real_import(path, *args)
 
+    def counting_workers(files, *args, **kwargs):
+        imported.extend(Path(path).name for path, _ in files)
+        return real_workers(files, *args, **kwargs)
+
     monkeypatch.setattr(clip_import, "_import_uncached", counting_import)
+    monkeypatch.setattr(import_worker, "import_into_cache", counting_workers)
     return imported
 
 
