@@ -20,6 +20,7 @@ import io
 import sys
 import tempfile
 from contextlib import contextmanager, nullcontext, redirect_stderr
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -394,8 +395,8 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
             clip = imported[folder / entry.file, entry.fps]
             if isinstance(clip, RLAnimateError):
                 raise clip
-            if manifest_path is not None:
-                clip = labelled(clip, entry, manifest_path)
+            if manifest_path is not None:  # a copy: two entries may name one file
+                clip = labelled(replace(clip), entry, manifest_path)
             clips.append(clip)
         except FrameRateMismatch as error:
             problems.append(str(error) if manifest_path is None else _manifest_fps_problem(error, entry, manifest,

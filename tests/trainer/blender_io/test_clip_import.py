@@ -393,3 +393,14 @@ def test_a_clip_folder_without_a_manifest_is_named_with_what_training_needs(libr
     with pytest.raises(RLAnimateError, match=rf"{tmp_path / 'elsewhere'} does not exist"):
         clip_import.load_clip_set(tmp_path / "elsewhere")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["point_left_000.fbx"], "nothing was written"
+
+
+def test_two_entries_of_one_file_keep_their_own_labels(library, tmp_path):
+    files, _, _ = library
+    manifest, _ = write_manifest(tmp_path, files)
+    data = json.loads(manifest.read_text())
+    data["clips"].append(dict(data["clips"][0], behaviour="JUMP", split="test"))  # the same file again
+    manifest.write_text(json.dumps(data))
+    clips, _ = clip_import.import_clip_directory(manifest, cache_dir=False)
+    assert [(c.name, c.behaviour, c.split) for c in clips] == [
+        ("point_left_000", "POINT", "train"), ("wave_right_000", "WAVE", "test"), ("point_left_000", "JUMP", "test")]
