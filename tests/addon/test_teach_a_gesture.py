@@ -8,7 +8,7 @@ import shutil
 
 import pytest
 
-pytest.importorskip("torch", reason="trains an agent: needs the trainer's torch (Blender 4.2's environment has none)")
+pytest.importorskip("torch", reason="trains an agent: needs the trainer's torch (the LTS environments have none)")
 
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
