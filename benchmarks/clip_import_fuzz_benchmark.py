@@ -7,8 +7,9 @@ allocates a byte per property); an animation curve's last key moved to a random 
 file cut short. The mutated files are imported as a library's clips are (trainer/blender_io/import_worker.py,
 one worker, the default 2 GB memory cap, a time limit of --seconds), and each outcome is counted per kind:
 imported, refused with the importer's reason (a note naming the file), skipped at the memory cap, skipped at
-the time limit, or a failure (an error in the importer's own code, or a note that does not name the file),
-which fails the run. Writes the section "Clip import fuzz" of docs/BENCHMARKS.md.
+the time limit, skipped when Blender's process ended (a crash), or a failure (an error in the importer's own
+code, or a note that does not name the file), which fails the run. Writes the section "Clip import fuzz" of
+docs/BENCHMARKS.md.
 
 Run: `python benchmarks/clip_import_fuzz_benchmark.py [--mutations 60] [--seeds 0 1 2] [--seconds 10] [--no-write]`
 """
@@ -41,7 +42,7 @@ HEADING = "## Clip import fuzz"
 COMMAND = "python benchmarks/clip_import_fuzz_benchmark.py"
 SOURCES = ("point_left_000.fbx", "wave_right_000.fbx")
 KINDS = ("flipped bytes", "array length", "property count", "key frame", "cut short")
-OUTCOMES = ("imported", "refused", "memory cap", "time limit", "failure")
+OUTCOMES = ("imported", "refused", "memory cap", "time limit", "worker ended", "failure")
 
 
 def mutate(kind, data, rng, source, target):
@@ -89,6 +90,8 @@ def classify(path, problem):
         return "memory cap"
     if "took longer than" in text:
         return "time limit"
+    if "ended Blender's process" in text:
+        return "worker ended"
     return "refused"
 
 
@@ -139,7 +142,8 @@ def main():
 clips ({", ".join(SOURCES)}), each imported as a library's clips are: by an import worker (one; the default
 2 GB memory cap; a time limit of {args.seconds:g} s), `trainer/blender_io/import_worker.py`. Imported: the clip
 read; refused: a note with the importer's reason, naming the file; memory cap and time limit: skipped with a
-note naming the limit. A failure is an error in the importer's own code or a note that does not name the file.
+note naming the limit; worker ended: skipped when Blender's process ended (a crash). A failure is an error in
+the importer's own code or a note that does not name the file.
 
 Regenerate: `{COMMAND} --mutations {args.mutations} --seeds {" ".join(map(str, args.seeds))} --seconds {args.seconds:g}`
 

@@ -133,10 +133,17 @@ class _Worker:
             return RLAnimateError(f"{path}: importing it took longer than {self.limits.seconds:g} s, so it was "
                                   f"stopped and the clip skipped (the file may be corrupt). Re-export it, or raise "
                                   f"--import-time-limit if the clip is sound and this long.")
-        if answer is None or answer.get("memory"):
+        if answer is None:
+            ended = self.process.wait()
+            self.close()
+            return RLAnimateError(f"{path}: importing it ended Blender's process ({_ending(ended)}), so the clip was "
+                                  f"skipped (the file may be corrupt, or need more than the {self.limits.memory_gb:g} "
+                                  f"GB memory limit). Re-export it, or raise --import-memory-limit if the clip is "
+                                  f"sound and this large.")
+        if "memory" in answer:
             self.close()
             return RLAnimateError(f"{path}: importing it ran out of its {self.limits.memory_gb:g} GB of memory "
-                                  f"({_how_it_ended(answer, self.process)}), so the clip was skipped (the file may be "
+                                  f"(MemoryError: {answer['memory']}), so the clip was skipped (the file may be "
                                   f"corrupt). Re-export it, or raise --import-memory-limit if the clip is sound and "
                                   f"this large.")
         if "bug" in answer:
@@ -159,11 +166,9 @@ class _Worker:
             self.process = None
 
 
-def _how_it_ended(answer, process):
-    if answer is not None:
-        return f"MemoryError: {answer['memory']}"
-    code = process.wait()
-    return f"its process ended with {'signal ' + str(-code) if code < 0 else 'exit status ' + str(code)}"
+def _ending(code: int) -> str:
+    """How a process that ended with `code` (Popen.returncode) ended, in words."""
+    return f"signal {-code}" if code < 0 else f"exit status {code}"
 
 
 def _problem(answer):
