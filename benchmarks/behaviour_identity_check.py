@@ -40,6 +40,7 @@ def core(root, out):
 
 def blender(root, out):
     sys.path.insert(0, str(root / "tests" / "addon"))
+    import bpy  # noqa: F401, I001  (before the helpers: a base tree's may import addon_utils first, which needs bpy)
     import addon_helpers
     from rlanimate_addon.blender import action_adapter, gestures
     settings = addon_helpers.enable_addon()

@@ -17,8 +17,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
-import bpy  # noqa: E402
+import bpy  # noqa: E402, I001  (before addon_utils, Blender's module, importable once bpy is)
+import addon_utils  # noqa: E402
 import numpy as np  # noqa: E402
 
 from rlanimate_addon.core import behaviour_metrics as bm  # noqa: E402

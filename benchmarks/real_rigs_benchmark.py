@@ -28,10 +28,10 @@ for path in (ROOT, ROOT / "tests", ROOT / "tests" / "addon"):
     sys.path.insert(0, str(path))
 
 import bpy  # noqa: E402
+from report import BENCHMARKS_MD, write_section  # noqa: E402  (benchmarks/report.py)
 
 import addon_helpers as helpers  # noqa: E402
 import real_rigs  # noqa: E402
-from benchmarks.report import BENCHMARKS_MD, write_section  # noqa: E402
 
 #: (row, family, source) of every rig: a ../shared/rigs file (real_rigs.FILES) or a Rigify build, still; a
 #: row '<file>_own' measures the file over its own animation (real_rigs.ACTIONS, else its active action).

@@ -1,12 +1,14 @@
 #!/usr/bin/env bash
-# The project's test command: the linter, then the whole suite on Blender 5.0 (bpy 5.0.1), then the
-# Blender-facing extension tests again on Blender 4.5 LTS and 4.2 LTS from the environments made by
-# scripts/setup.sh. Test files run in parallel, one per core (pytest-xdist; a file's module fixtures are
-# built once); PYTEST_WORKERS=0 runs them in this one process.
+# The project's test command: the linter and the type checker (ruff and mypy, configured in pyproject.toml),
+# then the whole suite on Blender 5.0 (bpy 5.0.1), then the Blender-facing extension tests again on Blender
+# 4.5 LTS and 4.2 LTS from the environments made by scripts/setup.sh. Test files run in parallel, one per
+# core (pytest-xdist; a file's module fixtures are built once); PYTEST_WORKERS=0 runs them in this one process.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 echo "== ruff =="
 python -m ruff check .
+echo "== mypy =="
+python -m mypy
 PARALLEL=(-n "${PYTEST_WORKERS:-auto}" --dist loadfile)
 python -m pytest -q "${PARALLEL[@]}" "$@"
 # Blender 4.x as a module can crash (a segfault in create_bones) in its glTF importer once other

@@ -3,10 +3,10 @@
 Rigs come from the committed sample character, or are built from the canonical skeleton with other
 units, another armature-space orientation and other bone rolls, as a Mixamo FBX import has them.
 """
-from pathlib import Path
+from pathlib import Path  # noqa: I001  (bpy before addon_utils, Blender's own module, importable once bpy is)
 
-import addon_utils  # noqa: I001  (Blender's own module, importable once bpy is)
 import bpy
+import addon_utils
 import numpy as np
 
 from rlanimate_addon.core import skeleton

@@ -22,7 +22,8 @@ class RenderRequest:
     """One Generate Gesture call: the panel's settings (Scene.rlanimate names) and a row title."""
     title: str
     settings: dict
-    target: tuple = None  # character-frame position of a target sphere for a target behaviour (POINT, GUIDE)
+    #: character-frame position of a target sphere for a target behaviour (POINT, GUIDE)
+    target: tuple[float, ...] | None = None
     frames: list = field(default_factory=list)  # filled by render_requests: (frame, png path)
 
 

@@ -133,7 +133,7 @@ def random_target_aim(settings, runs, session):
 def aggregate(per_seed: list[dict]) -> dict:
     """[summary per seed] -> {behaviour: {metric: {mean, sd, n}}}; sd 0 for one value, NaN values (a ratio
     to a zero reference) left out."""
-    out = {}
+    out: dict[str, dict[str, dict[str, float | int | None]]] = {}
     for key in per_seed[0]:
         out[key] = {}
         for metric in per_seed[0][key]:

@@ -14,18 +14,18 @@ class MotionClip:
     fps: float
     rotvecs: np.ndarray  # (F, 15, 3) local rotation vectors of skeleton.ACTION_JOINTS
     fingers: dict = field(default_factory=dict)  # {canonical finger bone: (F, 3)}; empty without fingers
-    behaviour: str = None  # the behaviour's id: "POINT", "WAVE", or a user's own ("BECKON")
-    kind: str = None  # behaviours.TARGET or INTENSITY; None for POINT and WAVE is their known kind
-    arm: str = None  # "LEFT" or "RIGHT"
+    behaviour: str | None = None  # the behaviour's id: "POINT", "WAVE", or a user's own ("BECKON")
+    kind: str | None = None  # behaviours.TARGET or INTENSITY; None for POINT and WAVE is their known kind
+    arm: str | None = None  # "LEFT" or "RIGHT"
     attributes: object = None  # target kind: unit vector (3,) from the arm's shoulder; intensity: exaggeration
-    target: tuple = None
-    exaggeration: float = None
-    split: str = None  # "train" or "test"
+    target: tuple[float, ...] | None = None
+    exaggeration: float | None = None
+    split: str | None = None  # "train" or "test"
     label: object = None  # autolabel's WaveLabel or PointLabel, when labelled from the motion
-    content: str = None  # real mocap: what the take shows ("wave", "bye", "guide")
-    style: str = None  # real mocap: the actor's style ("normal", "elderly", ...)
-    take: str = None  # real mocap: the take number ("001")
-    named_arm: str = None  # real mocap: the arm the file name gives ("LEFT", "RIGHT" or None)
+    content: str | None = None  # real mocap: what the take shows ("wave", "bye", "guide")
+    style: str | None = None  # real mocap: the actor's style ("normal", "elderly", ...)
+    take: str | None = None  # real mocap: the take number ("001")
+    named_arm: str | None = None  # real mocap: the arm the file name gives ("LEFT", "RIGHT" or None)
 
     @property
     def frames(self):
