@@ -11,6 +11,7 @@ import random
 import re
 from collections import Counter, OrderedDict
 from pathlib import Path
+from typing import Any
 
 import torch
 
@@ -67,7 +68,7 @@ def load(path):
     return _checked(payload, path, "")
 
 
-def _written_after_a_resume(path, error):
+def _written_after_a_resume(path: Path, error: Exception) -> dict:
     """The checkpoint a run resumed by an earlier trainer wrote: it saved the dicts `load` had returned as
     _CheckedDicts (with their PosixPath), which weights_only refuses. Those load here as Counters (a dict
     type torch builds; the path as None) and come back as plain dicts. Any other file raises the
@@ -87,7 +88,7 @@ _RESTART = ("put back a copy of the run's folder if you have one, or train the r
             "(which replaces it) or another --output folder; an experiment after moving the run's folder away.")
 
 
-def _plain(value):
+def _plain(value: Any) -> Any:
     """`value` with every dict in it but torch's OrderedDict state_dicts a plain dict (a _CheckedDict that
     `load` returned and a resumed trainer kept), lists and tuples rebuilt around them."""
     if isinstance(value, dict) and not isinstance(value, OrderedDict):

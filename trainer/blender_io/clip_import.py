@@ -22,6 +22,7 @@ import tempfile
 from contextlib import contextmanager, nullcontext, redirect_stderr
 from dataclasses import replace
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 from tqdm import tqdm
@@ -276,7 +277,7 @@ def _to_canonical(canonical, frames, calibration_frames, calibration_heads, bone
     return canonicalise.action_rotvecs(bases), fingers
 
 
-def _check_file(path):
+def _check_file(path: Path) -> None:
     """RLAnimateError for a clip path that is no file, not FBX or BVH, or empty."""
     if not path.is_file():
         raise RLAnimateError(f"{path}: no such file. Check the path or the manifest entry.")
@@ -341,7 +342,7 @@ def _cache_file(path, expected_fps, bone_map, cache_dir):
     return Path(cache_dir) / f"{clip_cache.file_hash(path)}_{map_tag}_{float(expected_fps):g}.npz"
 
 
-def _read_cache(cache_file, path):
+def _read_cache(cache_file: Path, path: Path) -> MotionClip | None:
     """The clip of `path` cached in `cache_file`, or None when there is none or it is damaged (then said, so
     that it is imported again and overwritten)."""
     if cache_file.is_file():
@@ -406,20 +407,26 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
     return clips, problems
 
 
-def _import_files(files, cache, workers, limits, progress):
+def _import_files(files: list[tuple[Path, float]], cache: Path | None, workers: int, limits: ImportLimits,
+                  progress: IO | None) -> dict[tuple[Path, float], MotionClip | RLAnimateError]:
     """{(path, fps): its MotionClip, or the RLAnimateError of its file}, read from the cache folder `cache`
     (None, or one that cannot be written: a temporary folder), the clips it lacks imported into it by
     import workers first."""
-    with nullcontext(cache) if _writable(cache) else tempfile.TemporaryDirectory() as store:
-        results = {}
+    results: dict[tuple[Path, float], MotionClip | RLAnimateError] = {}
+    with nullcontext(str(cache)) if _writable(cache) else tempfile.TemporaryDirectory() as folder:
+        store, missing = Path(folder), []
         for path, fps in dict.fromkeys((Path(path), float(fps)) for path, fps in files):
             try:
                 _check_file(path)
-                results[path, fps] = _read_cache(_cache_file(path, fps, None, store), path)
+                cached = _read_cache(_cache_file(path, fps, None, store), path)
             except RLAnimateError as error:
                 results[path, fps] = error
-        missing = [file for file, result in results.items() if result is None]
-        failed = import_worker.import_into_cache(missing, Path(store), workers, limits, progress)
+                continue
+            if cached is None:
+                missing.append((path, fps))
+            else:
+                results[path, fps] = cached
+        failed = import_worker.import_into_cache(missing, store, workers, limits, progress)
         for path, fps in missing:
             result = failed.get((path, fps)) or _read_cache(_cache_file(path, fps, None, store), path)
             results[path, fps] = result or RLAnimateError(f"{path}: its import left no readable cache entry in "
@@ -427,7 +434,7 @@ def _import_files(files, cache, workers, limits, progress):
     return results
 
 
-def _writable(folder):
+def _writable(folder: Path | None) -> bool:
     """Whether the folder `folder` (None: no folder) exists or can be made, and a file can be written in it."""
     if folder is None:
         return False

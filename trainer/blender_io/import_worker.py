@@ -49,12 +49,14 @@ def import_into_cache(files: Sequence[tuple[Path, float]], cache_dir: Path, work
     progress bar goes to `progress` (None: none). RLAnimateError when a worker cannot start."""
     limits = limits or ImportLimits()
     pending = list(dict.fromkeys((Path(path), float(fps)) for path, fps in files))
-    failed, errors, lock = {}, [], threading.Lock()
+    failed: dict[tuple[Path, float], RLAnimateError] = {}
+    errors: list[Exception] = []
+    lock = threading.Lock()
     bar = tqdm(total=len(pending), desc="importing clips", unit="clip", file=progress, disable=progress is None,
                leave=False, dynamic_ncols=True)
 
-    def work():
-        worker = None
+    def work() -> None:
+        worker: _Worker | None = None
         try:
             while True:
                 with lock:
@@ -91,44 +93,45 @@ class _Worker:
     def __init__(self, limits: ImportLimits):
         self.limits = limits
         path = os.pathsep.join(filter(None, (str(REPO_ROOT), os.environ.get("PYTHONPATH"))))
-        env = {**os.environ, "PYTHONPATH": path}
         self.process = subprocess.Popen(_command(int(limits.memory_gb * 2 ** 30)), stdin=subprocess.PIPE,
-                                        stdout=subprocess.PIPE, text=True, cwd=REPO_ROOT, env=env)
-        self.answers = queue.Queue()
+                                        stdout=subprocess.PIPE, text=True, cwd=REPO_ROOT,
+                                        env={**os.environ, "PYTHONPATH": path})
+        assert self.process.stdin is not None and self.process.stdout is not None
+        self.requests, self.replies = self.process.stdin, self.process.stdout
+        self.closed = False
+        self.answers: queue.Queue[dict | None] = queue.Queue()  # None: the process ended
         self.reader = threading.Thread(target=self._read, daemon=True)
         self.reader.start()
-        ready = self._answer(START_SECONDS)
-        if not (ready or {}).get("ready"):
+        try:
+            ready = self.answers.get(timeout=START_SECONDS) or {}
+        except queue.Empty:
+            ready = {"error": f"no answer in {START_SECONDS:g} s"}
+        if not ready.get("ready"):
             self.close()
-            raise RLAnimateError(f"The clip importer's worker process did not start: {(ready or {}).get('error')}")
+            raise RLAnimateError(f"The clip importer's worker process did not start: {ready.get('error')}")
 
     @property
     def running(self) -> bool:
-        return self.process is not None and self.process.poll() is None
+        return not self.closed and self.process.poll() is None
 
-    def _read(self):
-        for line in self.process.stdout:
+    def _read(self) -> None:
+        for line in self.replies:
             if line.startswith(ANSWER):
                 self.answers.put(json.loads(line[len(ANSWER):]))
             elif line.strip():
                 os.write(1, line.encode())  # Blender's prints, where they go in this process
-        self.answers.put(None)  # the process ended
-
-    def _answer(self, seconds):
-        try:
-            return self.answers.get(timeout=seconds)
-        except queue.Empty:
-            return "late"
+        self.answers.put(None)
 
     def import_clip(self, path: Path, fps: float, cache_dir: Path) -> RLAnimateError | None:
         """Import one clip into `cache_dir`: None when it is there, else the clip's RLAnimateError."""
         try:
-            self.process.stdin.write(json.dumps({"path": str(path), "fps": fps, "cache": str(cache_dir)}) + "\n")
-            self.process.stdin.flush()
+            self.requests.write(json.dumps({"path": str(path), "fps": fps, "cache": str(cache_dir)}) + "\n")
+            self.requests.flush()
         except OSError:  # the worker has ended: its end is read below
             pass
-        answer = self._answer(self.limits.seconds)
-        if answer == "late":
+        try:
+            answer = self.answers.get(timeout=self.limits.seconds)
+        except queue.Empty:
             self.close()
             return RLAnimateError(f"{path}: importing it took longer than {self.limits.seconds:g} s, so it was "
                                   f"stopped and the clip skipped (the file may be corrupt). Re-export it, or raise "
@@ -151,19 +154,20 @@ class _Worker:
             raise RuntimeError(f"Importing {path} failed in its worker process:\n{answer['bug']}")
         return _problem(answer)
 
-    def close(self):
+    def close(self) -> None:
         """End the process (its reader thread ends with it)."""
-        if self.process is not None:
-            if self.process.poll() is None:
-                self.process.kill()
-            self.process.wait()
-            self.reader.join()
-            for stream in (self.process.stdin, self.process.stdout):
-                try:
-                    stream.close()
-                except OSError:  # a request it never read
-                    pass
-            self.process = None
+        if self.closed:
+            return
+        self.closed = True
+        if self.process.poll() is None:
+            self.process.kill()
+        self.process.wait()
+        self.reader.join()
+        for stream in (self.requests, self.replies):
+            try:
+                stream.close()
+            except OSError:  # a request it never read
+                pass
 
 
 def _ending(code: int) -> str:
@@ -171,7 +175,7 @@ def _ending(code: int) -> str:
     return f"signal {-code}" if code < 0 else f"exit status {code}"
 
 
-def _problem(answer):
+def _problem(answer: dict) -> RLAnimateError | None:
     """The RLAnimateError of a worker's answer, or None for a clip now in the cache."""
     from trainer.blender_io.clip_import import FrameRateMismatch
     if "frame_rate" in answer:

@@ -121,7 +121,7 @@ RUN_OUTPUTS = ("agent.npz", checkpoint.FILENAME, "metrics.jsonl", "report.json",
                "tensorboard")
 
 
-def _existing_run_problems(settings):
+def _existing_run_problems(settings: RunSettings) -> list[str]:
     """[] when a run may start in `settings.output`, else the one problem: --resume with --overwrite, or a
     new run into the folder of another run (finished: its agent.npz; stopped: its checkpoint) without
     --overwrite."""
@@ -235,7 +235,7 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     return report, trainer
 
 
-def _trainer(settings, session, saved):
+def _trainer(settings: RunSettings, session: Any, saved: dict | None) -> tuple[Trainer, int]:
     """(Trainer, planned epochs) of the resolved `settings` on `session`, from the checkpoint `saved` when
     resuming; a new run with "all" first says which of the library's behaviours it leaves out, and refuses
     a new behaviour that fewer than 3 clips name (library_checks)."""
@@ -262,7 +262,7 @@ def _trainer(settings, session, saved):
     return trainer, epochs
 
 
-def _prepare_output(settings):
+def _prepare_output(settings: RunSettings) -> None:
     """Make the run's folder, once every check has passed (so a refused run leaves none); with --overwrite,
     first remove the files of the run it replaces (RUN_OUTPUTS)."""
     output = Path(settings.output)

@@ -1,4 +1,5 @@
 """The motion-clip type: one clip on the canonical rig with its declared labels, and a labelled clip set."""
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,7 +46,8 @@ def library_space(clips):
     return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 
-def trained_behaviours(clips, training_set, order=None):
+def trained_behaviours(clips: Sequence[MotionClip], training_set: str,
+                       order: Sequence[str] | None = None) -> tuple[str, ...]:
     """The ids of the behaviours a run with the training set `training_set` ("all", "both", keys:
     behaviours.training_set) trains on the training clips `clips`, in the objective order `order` (default
     library_space(clips)'s): "all" is the behaviours the clips have, so a library of points alone, or one

@@ -69,7 +69,7 @@ def build_parser():
     return parser
 
 
-def import_limits(args):
+def import_limits(args: argparse.Namespace) -> ImportLimits:
     """The ImportLimits of the arguments; RLAnimateError naming each that is not a positive number."""
     problems = [f"{option} {value:g}: give a number above 0{example}" for option, value, example in (
         ("--import-workers", args.import_workers, ", such as 2"),
