@@ -14,7 +14,7 @@ python -m pytest -q "${PARALLEL[@]}" "$@"
 # Blender 4.x as a module can crash (a segfault in create_bones) in its glTF importer once other
 # extension tests have run in the same process, so each file that imports glTF runs in a process of its own.
 OWN_PROCESS=(tests/addon/test_rig_variants.py tests/addon/test_real_rigs.py tests/addon/test_real_finger.py
-             tests/addon/test_vrm_characters.py)
+             tests/addon/test_vrm_characters.py tests/addon/test_hostile_vrm_and_paths.py)
 for version in 45 42; do
     venv=".venv-bpy$version"
     if [ ! -x "$venv/bin/python" ]; then

@@ -13,6 +13,7 @@ import numpy as np
 from ..core import rig_roles, vrm
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
+from ..core.regular_file import open_regular
 from . import action_adapter, pose_underneath, rigify, vrm_map
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
@@ -23,35 +24,42 @@ def rotation_path(mode):
     return ROTATION_PATHS.get(mode, "rotation_euler")
 
 
-def rig_roles_of(obj, bone_map_path=""):
+def rig_roles_of(obj, bone_map_path="", read_vrm=True):
     """(family name, {role: bone name}) of an armature: from the bone-map file when one is given, else
     from its VRM humanoid map (its VRM file, or the VRM add-on's data; blender/vrm_map.py), else
-    detected from its bone names. RLAnimateError when obj is not an armature."""
+    detected from its bone names. RLAnimateError when obj is not an armature. read_vrm=False (the panel's
+    draw()): a VRM file is not read, only looked up where an operator read it."""
     if obj is None or obj.type != "ARMATURE":
         raise RLAnimateError("The active object is not an armature: select the character's armature.")
     names = obj.data.bones.keys()
     if bone_map_path:
-        path = Path(bpy.path.abspath(bone_map_path))
-        try:
-            with open(path, "rb") as handle:  # bounded: a bone map is a few KB, /dev/zero is endless
-                data = handle.read(rig_roles.MAX_BONE_MAP_BYTES + 1)
-            if len(data) > rig_roles.MAX_BONE_MAP_BYTES:
-                raise RLAnimateError(f"The bone-map file {str(path)!r} is larger than "
-                                     f"{rig_roles.MAX_BONE_MAP_BYTES >> 10} KB, so it is not a bone map: pick a "
-                                     "bone-map JSON file saved from the panel, or clear the Bone Map field.")
-            text = data.decode("utf-8")
-        except OSError as error:
-            raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({error.strerror}): pick an "
-                                 "existing file, or clear the Bone Map field to detect the bones.") from None
-        except UnicodeDecodeError:
-            raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file "
-                                 "saved from the panel, or clear the Bone Map field.") from None
-        return rig_roles.read_bone_map(text, names)
-    roles = vrm_map.roles_of(obj)
+        return rig_roles.read_bone_map(_bone_map_text(Path(bpy.path.abspath(bone_map_path))), names)
+    roles = vrm_map.roles_of(obj, read_vrm)
     if roles:
         return vrm.FAMILY, roles
     family, roles = rig_roles.detect(names, rigify=rigify.is_generated(obj))
     return family.name, roles
+
+
+def _bone_map_text(path):
+    """The text of the bone-map file at `path`: a regular file (a FIFO or /dev/stdin would block every
+    redraw) of at most MAX_BONE_MAP_BYTES (/dev/zero is endless), UTF-8."""
+    try:
+        with open_regular(path) as handle:
+            data = handle.read(rig_roles.MAX_BONE_MAP_BYTES + 1)
+    except (OSError, ValueError) as error:  # ValueError: a NUL in the path
+        reason = getattr(error, "strerror", None) or error
+        raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({reason}): pick a bone-map JSON "
+                             "file saved from the panel, or clear the Bone Map field to detect the bones.") from None
+    if len(data) > rig_roles.MAX_BONE_MAP_BYTES:
+        raise RLAnimateError(f"The bone-map file {str(path)!r} is larger than {rig_roles.MAX_BONE_MAP_BYTES >> 10} KB, "
+                             "so it is not a bone map: pick a bone-map JSON file saved from the panel, or clear the "
+                             "Bone Map field.")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file saved "
+                             "from the panel, or clear the Bone Map field.") from None
 
 
 def check_hips(obj, roles):

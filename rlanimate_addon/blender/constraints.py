@@ -236,12 +236,17 @@ def _targets(constraint):
     return found + [(t.target, t.subtarget) for t in getattr(constraint, "targets", ()) if t.target is not None]
 
 
+#: A basis location (in bone lengths) and scale this close to rest are at rest: float rounding.
+_OFF_REST = 5e-4
+
+
 def _at_rest(pose_bone):
-    """Whether the bone's basis is its rest: no rotation (within gesture.AT_REST), location or scale."""
+    """Whether the bone's basis is its rest: no rotation (within gesture.AT_REST: an importer's rounding),
+    location or scale (within _OFF_REST)."""
     basis = np.array(pose_bone.matrix_basis)
     rotation = np.array(pose_bone.matrix_basis.to_quaternion())
-    return (np.linalg.norm(rotation[1:]) < gesture.AT_REST and np.abs(basis[:3, 3]).max() <= gesture.AT_REST
-            * pose_bone.bone.length and np.abs(np.linalg.norm(basis[:3, :3], axis=0) - 1.0).max() < gesture.AT_REST)
+    return (np.linalg.norm(rotation[1:]) < gesture.AT_REST and np.abs(basis[:3, 3]).max() <= _OFF_REST
+            * pose_bone.bone.length and np.abs(np.linalg.norm(basis[:3, :3], axis=0) - 1.0).max() < _OFF_REST)
 
 
 def mute(obj, found, start, end, hold=False):

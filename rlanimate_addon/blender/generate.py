@@ -83,6 +83,15 @@ def check_keepable(obj):
                              "Editable) and generate again.")
 
 
+def check_not_editing(obj):
+    """RLAnimateError when the armature is in Edit mode, where its pose does not play (the bake check failed
+    there). Refused rather than left and returned to: the undo step Blender pushes in Edit mode is an Edit-mode
+    step, and that it takes back a gesture's action cannot be checked headless (ed.undo needs a window)."""
+    if obj.mode == "EDIT":
+        raise RLAnimateError(f"Armature {obj.name!r} is in Edit mode, where its pose does not play: leave Edit mode "
+                             "(Tab, or choose Pose Mode) and generate again.")
+
+
 def check_inherited_rotation(obj, roles):
     """RLAnimateError when a bone playing a role does not inherit its parent's rotation: the gesture's
     retargeting and aim turn each bone relative to its parent."""
@@ -139,6 +148,7 @@ class _Plan:
     def __init__(self, obj, family, roles, overriding, ik_share=None):
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
         self.ik_share = ik_share  # a Rigify arm in IK: its IK_FK value, switched to FK over the gesture
+        self.from_ik = False  # ... and whether it stands in IK (IK_FK below 1) on any of the gesture's frames
         self.properties = None
         self.settings = self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.action = None
         self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
@@ -166,6 +176,7 @@ class _Plan:
 
 def _check(obj, settings, start, end, mute_constraints, still):
     """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
+    check_not_editing(obj)
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
     ik_share = rigify.ik_share(obj, settings.arm) if family == rig_roles.RIGIFY.name else None
@@ -255,6 +266,7 @@ def _compute(context, plan, agent, frames):
             rig = _as_made(plan, rig, below_values, frames)
             if plan.ik_share is not None:  # the FK controls start where the arm stands in IK
                 played, switch = rigify.played_arm(context, obj, settings.arm, frames, rig.animated)
+                plan.from_ik = bool(np.any(switch < 1.0))
                 rig = rig_rigify.snap_fk(rig, rig_rigify.fk_controls(settings.arm), played)
         finally:
             if scene.frame_current != original_frame:
@@ -448,7 +460,7 @@ def _summary(plan, agent, scene, placed, count):
     start, end = plan.frames
     label = f"{behaviours.title(settings.behaviour)} {settings.arm.title()}"
     note = _length_notes(plan, agent, scene, count) + _composing_notes(plan, placed)
-    if plan.ik_share is not None:
+    if plan.from_ik:  # an animated switch already at FK is keyed at FK, and nothing is said
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
     if plan.overriding:
         held = (", held muted beyond them: they hold the rig at rest, so it stands as a still rig does"

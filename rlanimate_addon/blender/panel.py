@@ -55,14 +55,14 @@ _VRM_FAMILIES = {vrm.FAMILY, rig_roles.VROID.name, rig_roles.VRM_HUMANOID.name, 
 def _rig_roles(obj, bone_map_file):
     """(family, roles) of the armature as Generate finds them (("", {}) when it cannot: Generate names why),
     remembered per bone names, bone-map and VRM file versions and VRM add-on map: detecting them takes about
-    1 ms, too long for every redraw."""
+    1 ms, too long for every redraw. A VRM file is never read here, only looked up where an operator read it."""
     paths = tuple(bpy.path.abspath(p) if p else "" for p in (bone_map_file, obj.rlanimate.vrm_file))
     key = (tuple(bone.name for bone in obj.data.bones), paths, tuple(_version(p) for p in paths),
-           _vrm_addon_map(obj))
+           _vrm_addon_map(obj), vrm_map.known(paths[1]))
     if key not in _roles:
         _roles.clear()
         try:
-            _roles[key] = armature_io.rig_roles_of(obj, bone_map_file)
+            _roles[key] = armature_io.rig_roles_of(obj, bone_map_file, read_vrm=False)
         except RLAnimateError:
             _roles[key] = ("", {})
     return _roles[key]

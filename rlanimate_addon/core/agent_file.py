@@ -389,6 +389,10 @@ def _check_metadata_values(path, metadata):
     if not isinstance(metadata["variant"], str):
         raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
                              f"{', '.join(VARIANTS)}.")
+    if metadata["variant"] not in VARIANTS:
+        raise RLAnimateError(f"The agent file {path} names an unknown agent variant {metadata['variant']!r:.40}: "
+                             f"it must name one of {', '.join(VARIANTS)}; re-export it with "
+                             "trainer/agent/agent_export.py.")
     space = _checked_space(path, metadata)
     expected = expected_weight_shapes(config, metadata["variant"], space.size)
     parameters = sum(math.prod(shape) for shape in expected.values())
@@ -415,7 +419,10 @@ def _check_metadata_values(path, metadata):
             raise RLAnimateError(f"The agent file {path} has a wave_rhythm value of {_describe(largest)}, beyond "
                                  f"+-{MAX_RHYTHM_VALUE:g} (exaggerations, wave frequencies and fractions of a "
                                  f"gesture are small numbers): re-export it with trainer/agent/agent_export.py.")
-        rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
+        problem = rhythm.invalid_field(metadata["wave_rhythm"])
+        if problem:
+            raise RLAnimateError(f"The agent file {path} has an invalid wave_rhythm ({problem}): re-export it with "
+                                 f"trainer/agent/agent_export.py.")
     return {name: tuple(shape) for name, shape in expected.items()}
 
 

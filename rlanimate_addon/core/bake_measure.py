@@ -27,15 +27,18 @@ FINGER_TOLERANCE_DEG = 3.0
 
 def measured_bones(roles: Mapping[str, str], arm: str) -> tuple[str, str, str]:
     """The role bones carrying the wrist (the hand), the finger base and the finger tip: the finger line
-    Exact Aim solves on (gesture.finger_line_bones, from one joint's head through another's)."""
-    start, end = finger_line_bones(roles, arm)
-    return roles[skeleton.ARM_PREFIX[arm] + "Hand"], start, end
+    Exact Aim solves on (gesture.finger_line_bones: from one joint's head through another's, or a hand
+    without an index finger along itself)."""
+    line = finger_line_bones(roles, arm)
+    return roles[skeleton.ARM_PREFIX[arm] + "Hand"], line.start, line.end
 
 
 def rest_points(rig: RigState, arm: str) -> npt.NDArray[np.float64]:
-    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist, the finger base and the
-    finger tip, each its bone's head (joint positions; an imported bone's tail may point anywhere)."""
-    return np.stack([rig.skeleton.rest_head(bone) for bone in measured_bones(rig.roles, arm)])
+    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist (the hand's head), the
+    finger line's base and tip (gesture.FingerLine.points: joint positions, or the hand's tail for a hand
+    without an index finger)."""
+    hand = rig.skeleton.rest_head(rig.roles[skeleton.ARM_PREFIX[arm] + "Hand"])
+    return np.stack([hand, *finger_line_bones(rig.roles, arm).points(rig.skeleton, rig.skeleton.rest)])
 
 
 def planned_pose(rig: RigState, arm: str, bones: Sequence[str],

@@ -24,6 +24,9 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
     and Point's aim is solved on the rig's own bones against that pose (`aim_rig`), so the finger
     line passes through the target whatever the rig's proportions and whatever moves underneath.
 """
+import math
+from typing import NamedTuple
+
 import numpy as np
 
 from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
@@ -436,22 +439,41 @@ def _standing_pose():
 
 #: Canonical local rotation vectors (3,) of the standing pose, by bone (others stay at rest).
 STANDING_POSE = _standing_pose()
-#: A bone whose rotation underneath is within this of its rest (sin of half the angle: 0.06 degrees) is
-#: at rest: a rest pose read back from float32 bind matrices (FBX, glTF) is a few 1e-5 radians off.
-AT_REST = 5e-4
+#: Degrees: a bone whose rotation underneath is within this of its rest is at rest. An importer's rounding
+#: leaves a rest pose off by up to about a degree (a VRM 0.x's arms 0.6-0.9 degrees, after Blender's glTF
+#: importer guessed its bind pose; float32 bind matrices a few 1e-5 radians), while a pose an animator sets
+#: turns a bone by more. (At 0.06 degrees, such a VRM started and ended every gesture in its T-pose.)
+AT_REST_DEGREES = 3.0
+#: ... as the sine of half that angle, the length of a unit quaternion's vector part.
+AT_REST = math.sin(math.radians(AT_REST_DEGREES) / 2)
+
+
+class FingerLine(NamedTuple):
+    """The rig's pointing line: from `start`'s head through `end`'s head, or through `end`'s tail with
+    `to_tail` (a hand without an index finger: the hand's own line)."""
+    start: str
+    end: str
+    to_tail: bool = False
+
+    def points(self, skeleton: RigSkeleton, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(base (..., 3), tip (..., 3)) of the line in (..., B, 4, 4) pose (or rest) matrices of `skeleton`."""
+        base = pose[..., skeleton.index[self.start], :3, 3]
+        tip = skeleton.tails(pose, self.end) if self.to_tail else pose[..., skeleton.index[self.end], :3, 3]
+        return base, tip
 
 
 def finger_line_bones(roles, arm):
-    """(start bone, end bone) of the rig's pointing line, which runs from the start bone's head through
-    the end bone's head: joint positions, as the mesh shows them, never a bone's tail (an imported
-    bone's tail may point anywhere). The index finger from its base (Index1) to the farthest index joint
-    the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index base; without an
-    index finger, the forearm's head through the hand's head."""
+    """The rig's pointing line (a FingerLine): joint positions, as the mesh shows them, not a finger bone's
+    tail (an imported bone's tail may point anywhere). The index finger from its base (Index1) to the
+    farthest index joint the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index
+    base; without an index finger, the hand's own line, from its head (the wrist) to its tail (the hand's
+    end): a hand without fingers points along itself (aimed along the forearm's line, the hand was 9-17
+    degrees off the target: tests/addon/test_fingerless_hands.py)."""
     prefix = skeleton.ARM_PREFIX[arm]
     if f"{prefix}HandIndex1" not in roles:
-        return roles[prefix + "ForeArm"], roles[prefix + "Hand"]
+        return FingerLine(roles[prefix + "Hand"], roles[prefix + "Hand"], to_tail=True)
     index = [roles[f"{prefix}HandIndex{k}"] for k in (1, 2, 3, 4) if f"{prefix}HandIndex{k}" in roles]
-    return (index[0], index[-1]) if len(index) > 1 else (roles[prefix + "Hand"], index[0])
+    return FingerLine(index[0], index[-1]) if len(index) > 1 else FingerLine(roles[prefix + "Hand"], index[0])
 
 
 def aim_rig(rig, basis, changed, arm, targets, weights):
@@ -463,13 +485,12 @@ def aim_rig(rig, basis, changed, arm, targets, weights):
     `changed`, over the pose underneath.
     """
     arm_bone = rig.roles[skeleton.ARM_PREFIX[arm] + "Arm"]
-    start, end = finger_line_bones(rig.roles, arm)
+    line = finger_line_bones(rig.roles, arm)
     pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed,
-                                   only=(end, arm_bone))
+                                   only=(line.end, arm_bone))
     i = rig.skeleton.index[arm_bone]
-    base = pose[:, rig.skeleton.index[start], :3, 3]
-    finger = pose[:, rig.skeleton.index[end], :3, 3] - base
-    finger /= np.linalg.norm(finger, axis=1, keepdims=True)
+    base, tip = line.points(rig.skeleton, pose)
+    finger = (tip - base) / np.linalg.norm(tip - base, axis=1, keepdims=True)
     correction = aim.shoulder_corrections(pose[:, i, :3, 3], base, finger, targets)  # (N, 3)
     turn = rotvec_to_matrix(correction * np.asarray(weights)[:, None])
     world = pose[:, i, :3, :3] / np.linalg.norm(pose[:, i, :3, :3], axis=1, keepdims=True)  # (N, 3, 3)

@@ -190,12 +190,13 @@ _EXPORT_NAMES = {"DEF-spine": "pelvis", "DEF-spine.001": "spine_01", "DEF-spine.
                     for f in ("thumb", "index", "middle", "ring", "pinky") for k in (1, 2, 3)}}
 
 
-def rigify_rig(arm_mode="FK", export=False):
-    """A Rigify rig generated from Blender's human metarig (fingers, no face: the face takes most of the
-    generation and adds no bone a gesture keys), both arms in FK (IK_FK 1.0) or left as generated, in IK
-    (0.0), the IK hand controls moved so the arms stand posed; a mesh skinned to its DEF- bones, or with
-    `export` to a game export skeleton in the same armature copying them (Copy Transforms). Returns it."""
-    metarig, rig = rig_variants.generate_rigify()
+def rigify_rig(arm_mode="FK", export=False, fingers=True):
+    """A Rigify rig generated from Blender's human metarig (fingers, or none without `fingers`; no face: the
+    face takes most of the generation and adds no bone a gesture keys), both arms in FK (IK_FK 1.0) or left
+    as generated, in IK (0.0), the IK hand controls moved so the arms stand posed; a mesh skinned to its DEF-
+    bones, or with `export` to a game export skeleton in the same armature copying them (Copy Transforms).
+    Returns it."""
+    metarig, rig = rig_variants.generate_rigify(fingers)
     bpy.data.objects.remove(metarig)
     for side in ("L", "R"):
         rig.pose.bones["upper_arm_parent." + side]["IK_FK"] = 1.0 if arm_mode == "FK" else 0.0
@@ -254,27 +255,50 @@ def _skin(rig, bones):
     return body
 
 
+#: Godot's humanoid profile (SkeletonProfileHumanoid) names of the canonical roles a gesture keys.
+GODOT_NAMES = {"Hips": "Hips", "Spine": "Spine", "Spine1": "Chest", "Spine2": "UpperChest", "Neck": "Neck",
+               "Head": "Head", **{f"{side}{role}": f"{side}{godot}" for side in ("Left", "Right") for role, godot in
+                                  (("Eye", "Eye"), ("Shoulder", "Shoulder"), ("Arm", "UpperArm"),
+                                   ("ForeArm", "LowerArm"), ("Hand", "Hand"))}}
+
+
+def godot_without_fingers():
+    """The sample character with Godot's humanoid bone names (GODOT_NAMES), its fingers removed; returns it."""
+    rig = helpers.activate(helpers.load_sample_rig())
+    bpy.ops.object.mode_set(mode="EDIT")
+    for bone in [b for b in rig.data.edit_bones if skeleton.strip_prefix(b.name).partition("Hand")[2]]:
+        rig.data.edit_bones.remove(bone)  # LeftHandIndex1, RightHandThumb2, ...: not LeftHand
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for bone in rig.data.bones:
+        name = skeleton.strip_prefix(bone.name)
+        bone.name = GODOT_NAMES.get(name, name)
+    return rig
+
+
 # Measurements on the deformed bones.
 
 def deformed_joints(rig, settings, arm):
     """A function frame -> (4, 3) world positions of the wrist, the index finger's base and tip joints
     and the shoulder, as the mesh's bones play them; and the arm's rest length (shoulder to elbow to
     wrist, world units). The index tip is the head of the bone after the last index bone (its end
-    bone), else that bone's own head: joint positions, not imported bone tails."""
+    bone), else that bone's own head: joint positions, not imported bone tails. Without an index finger,
+    the hand's own line: the wrist and the hand's tail."""
     found = roles(rig, settings)
     prefix = skeleton.ARM_PREFIX[arm]
     index = [found[prefix + f"HandIndex{k}"] for k in (1, 2, 3) if prefix + f"HandIndex{k}" in found]
     hand = found[prefix + "Hand"]
+    tip_at = "head_local"
     if index:
         last = rig.data.bones[index[-1]]
         base_bone, tip_bone = index[0], last.children[0].name if last.children else index[-1]
-    else:  # no index finger: the forearm's head through the hand's head (gesture.finger_line_bones)
-        base_bone, tip_bone = found[prefix + "ForeArm"], hand
-    joints = [hand, base_bone, tip_bone, found[prefix + "Arm"]]  # their heads
+    else:  # no index finger: the hand's own line, its head to its tail (gesture.finger_line_bones)
+        base_bone, tip_bone, tip_at = hand, hand, "tail_local"
+    joints = [hand, base_bone, tip_bone, found[prefix + "Arm"]]  # their heads (the tip: a hand's tail)
     deformed = bake_check.deformed_bones(rig)
     carriers = [bake_check.stand_in(rig, bone, deformed) for bone in joints]
     rests = [np.array(rig.data.bones[c].matrix_local) for c in carriers]
-    points = [np.append(np.array(rig.data.bones[b].head_local), 1.0) for b in joints]
+    points = [np.append(np.array(getattr(rig.data.bones[b], tip_at if k == 2 else "head_local")), 1.0)
+              for k, b in enumerate(joints)]
     local = [np.linalg.inv(r) @ p for r, p in zip(rests, points, strict=True)]
     world = np.array(rig.matrix_world)
     heads = {r: world @ np.append(np.array(rig.data.bones[found[prefix + r]].head_local), 1.0)
@@ -305,7 +329,7 @@ def measured_bones_deform(rig, settings, arm):
     """The wrist and the finger base the measures read are bones the mesh deforms with (no stand-in)."""
     found = roles(rig, settings)
     prefix = skeleton.ARM_PREFIX[arm]
-    base = found.get(prefix + "HandIndex1", found[prefix + "ForeArm"])
+    base = found.get(prefix + "HandIndex1", found[prefix + "Hand"])
     return {found[prefix + "Hand"], base} <= bake_check.deformed_bones(rig)
 
 

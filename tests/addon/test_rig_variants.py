@@ -30,14 +30,14 @@ def _world(rig, point):
 
 
 def finger_angle(rig, arm, target, frames):
-    """(F,) degrees between the rig's finger line (gesture.finger_line_bones: joint heads) and its base-to-target line,
-    and (F, 3) world positions of the finger base."""
-    start, end = gesture.finger_line_bones(_roles(rig), arm)
+    """(F,) degrees between the rig's finger line (gesture.finger_line_bones: joint heads, or a hand's tail) and
+    its base-to-target line, and (F, 3) world positions of the finger base."""
+    line = gesture.finger_line_bones(_roles(rig), arm)
     angles, bases = [], []
     for frame in frames:
         bpy.context.scene.frame_set(int(frame))
-        base = _world(rig, rig.pose.bones[start].head)[:3]
-        tip = _world(rig, rig.pose.bones[end].head)[:3]
+        base = _world(rig, rig.pose.bones[line.start].head)[:3]
+        tip = _world(rig, getattr(rig.pose.bones[line.end], "tail" if line.to_tail else "head"))[:3]
         finger, to_target = tip - base, np.asarray(target) - base
         cos = finger @ to_target / np.linalg.norm(finger) / np.linalg.norm(to_target)
         angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))

@@ -239,10 +239,9 @@ def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underne
     basis = rig.under.copy()
     columns = [rig.skeleton.index[n] for n in names]
     basis[:, columns, :3, :3] = quat_to_matrix(quats)
-    start, end = gesture.finger_line_bones(rig.roles, arm)
-    pose = rig.skeleton.pose_matrices(basis, only=(end,))
-    base = pose[:, rig.skeleton.index[start], :3, 3]
-    finger, to_target = pose[:, rig.skeleton.index[end], :3, 3] - base, target - base
+    line = gesture.finger_line_bones(rig.roles, arm)
+    base, tip = line.points(rig.skeleton, rig.skeleton.pose_matrices(basis, only=(line.end,)))
+    finger, to_target = tip - base, target - base
     cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(finger, axis=1) / np.linalg.norm(to_target, axis=1)
     angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
     phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm))
@@ -406,10 +405,12 @@ def test_a_nan_start_pose_is_refused_before_anything_is_returned():
 
 def test_the_finger_line_runs_through_joints_index_base_to_its_farthest_joint():
     roles = {f"RightHandIndex{k}": f"i{k}" for k in (1, 2, 3)} | {"RightHand": "hand", "RightForeArm": "forearm"}
-    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3")
-    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip")
-    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1")
-    assert gesture.finger_line_bones({"RightHand": "hand", "RightForeArm": "forearm"}, "RIGHT") == ("forearm", "hand")
+    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3", False)
+    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip", False)
+    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1", False)
+    # Without an index finger, the hand's own line: its head (the wrist) to its tail (the hand's end).
+    fingerless = {"RightHand": "hand", "RightForeArm": "forearm"}
+    assert gesture.finger_line_bones(fingerless, "RIGHT") == ("hand", "hand", True)
 
 
 def test_over_animation_a_gesture_keys_only_its_arm_and_adds_its_spine_and_head_turn_to_what_plays_underneath():

@@ -27,14 +27,15 @@ from rlanimate_addon.core import behaviours, rhythm, spaces
 from trainer.agent import checkpoint, pointing
 from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
+from trainer.motion.clip import trained_behaviours
 from trainer.motion.fk import ClipReferences
 
 
 def clips_for_behaviour(clips, behaviour, space):
     """Clips grouped as Algorithm 1 draws them: one group per behaviour of the training set `behaviour`
-    (behaviours.training_set, among the ObjectiveSpace `space`'s), in objective order ([[point clips],
-    [wave clips]] for 'both')."""
-    wanted = behaviours.training_set(behaviour, space.names)
+    that `clips` have (trained_behaviours, among the ObjectiveSpace `space`'s), in objective order ([[point
+    clips], [wave clips]] for 'both')."""
+    wanted = trained_behaviours(clips, behaviour, space.names)
     return [[clip for clip in clips if clip.behaviour == name] for name in wanted]
 
 

@@ -18,6 +18,7 @@ import numpy as np
 import torch
 
 from rlanimate_addon.core import behaviours, kinematics, spaces
+from trainer.agent import checkpoint
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
@@ -144,9 +145,11 @@ def run_ablation(settings: AblationSettings) -> str:
     agent_ablation.json and .md into `settings.results`; returns the markdown."""
     torch.set_num_threads(1)
     names = settings.only or tuple(ABLATIONS)
-    untrained = [RunSettings(str(Path(settings.runs) / name), behaviour=ABLATIONS[name][0], preset=ABLATIONS[name][1],
-                             variant=ABLATIONS[name][2], eval_every=0, progress=False)
-                 for name in names if not (Path(settings.runs) / name / "report.json").is_file()]
+    folders = {name: Path(settings.runs) / name for name in names}
+    untrained = [RunSettings(str(folders[name]), behaviour=ABLATIONS[name][0], preset=ABLATIONS[name][1],
+                             variant=ABLATIONS[name][2], eval_every=0, progress=False,
+                             resume=(folders[name] / checkpoint.FILENAME).is_file())  # a stopped run continues
+                 for name in names if not (folders[name] / "report.json").is_file()]
     for run, _ in train_runs(untrained, settings.address, settings.workers):
         print(f"trained {Path(run.output).name}", flush=True)
     session = LibrarySession(DEFAULT_MANIFEST)

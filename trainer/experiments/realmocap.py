@@ -39,9 +39,10 @@ import torch
 from rlanimate_addon.core import behaviour_metrics, behaviours, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
-from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip, import_into_cache
+from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.import_worker import import_into_cache
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.cluster import connect, run_tasks
@@ -99,7 +100,7 @@ def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_c
                 labels=PAPER_LABELS):
     """Every clip of root/folder ('wave', 'bye' or 'guide') but the withheld takes, sorted by name, labelled
     as `labels` says (import_real_clip); import_workers > 1: the takes the cache lacks are imported by that
-    many Ray tasks first (clip_import.import_into_cache)."""
+    many import workers first (import_worker.import_into_cache)."""
     paths = take_paths(require_realmocap(root) / folder)
     if import_workers > 1:
         import_into_cache([(p, EXPECTED_FPS) for p in paths], Path(cache_dir), import_workers)
@@ -208,7 +209,7 @@ def train_real_runs(runs, address=None, workers=None):
     pending = [run for run in runs if not is_finished(Path(run.settings.output), run.settings.epochs)]
     if pending:
         connect(address, workers)
-        for run, _ in run_tasks(train_real, pending):
+        for run, _ in run_tasks(train_real, pending, name=lambda run: f"The run in {run.settings.output}"):
             print(f"realmocap: trained {shown(run.settings.output)}", flush=True)
     return {run.settings.output: json.loads((Path(run.settings.output) / "report.json").read_text()) for run in runs}
 

@@ -1,4 +1,5 @@
 """The motion-clip type: one clip on the canonical rig with its declared labels, and a labelled clip set."""
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -45,11 +46,21 @@ def library_space(clips):
     return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 
+def trained_behaviours(clips: Sequence[MotionClip], training_set: str,
+                       order: Sequence[str] | None = None) -> tuple[str, ...]:
+    """The ids of the behaviours a run with the training set `training_set` ("all", "both", keys:
+    behaviours.training_set) trains on the training clips `clips`, in the objective order `order` (default
+    library_space(clips)'s): "all" is the behaviours the clips have, so a library of points alone, or one
+    whose waves are all held out, trains point although the paper's space it declares has wave too."""
+    names = library_space(clips).names if order is None else order
+    return behaviours.training_set(training_set, [name for name in names if any(c.behaviour == name for c in clips)])
+
+
 def training_space(clips, training_set):
-    """The ObjectiveSpace an agent trained on `clips` with the training set `training_set` ("all", "both", keys:
-    behaviours.training_set) declares: its own behaviours only, so point and wave taken from a library with
-    more behaviours keep the paper's objective, as the shipped agent has it."""
-    trained = behaviours.training_set(training_set, library_space(clips).names)
+    """The ObjectiveSpace an agent trained on `clips` with the training set `training_set` declares: its own
+    behaviours only, so point and wave taken from a library with more behaviours keep the paper's
+    objective, as the shipped agent has it."""
+    trained = trained_behaviours(clips, training_set)
     return library_space([clip for clip in clips if clip.behaviour in trained])
 
 
