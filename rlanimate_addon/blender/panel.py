@@ -68,10 +68,18 @@ def _rig_roles(obj, bone_map_file):
     return _roles[key]
 
 
-def _from_vrm(obj, bone_map_file):
-    """Whether the armature came from a VRM file: its VRM File is kept (the glTF import keeps it), the VRM
-    add-on's map is on it, or its bones have VRoid's or VRM's humanoid names."""
-    return bool(obj.rlanimate.vrm_file) or _rig_roles(obj, bone_map_file)[0] in _VRM_FAMILIES
+def _offers_vrm_map(obj, settings):
+    """Whether the panel offers Bone Map from VRM File for the armature: it came from a VRM file (its VRM File
+    is kept, as the glTF import keeps it, the VRM add-on's map is on it, or its bones have VRoid's or VRM's
+    humanoid names), or Generate cannot map its bones (its refusal offers the VRM file's map first)."""
+    family, roles = _rig_roles(obj, settings.bone_map_file)
+    if obj.rlanimate.vrm_file or family in _VRM_FAMILIES:
+        return True
+    try:
+        rig_roles.check_roles(obj.name, roles, settings.arm, family)
+    except RLAnimateError:
+        return True
+    return False
 
 def _version(path):
     """A file's modification time (None when absent or unreadable), to notice an edited map."""
@@ -164,7 +172,7 @@ def _draw_options(layout, context, settings, obj):
     row = layout.row(align=True)
     row.prop(settings, "bone_map_file")
     row.operator("rlanimate.save_bone_map", text="", icon="FILE_TICK")
-    if obj is not None and _from_vrm(obj, settings.bone_map_file):
+    if obj is not None and _offers_vrm_map(obj, settings):
         row = layout.row(align=True)
         row.operator("rlanimate.bone_map_from_vrm", icon="ARMATURE_DATA")
         if obj.rlanimate.vrm_file:
