@@ -151,6 +151,16 @@ def read_keys(fcurve):
     return co, interpolation, handles
 
 
+def holds_still(fcurve):
+    """Whether the F-curve plays one value on every frame: no modifiers, every key and Bezier handle at one value
+    (any extrapolation is then flat too)."""
+    if len(fcurve.modifiers) or not len(fcurve.keyframe_points):
+        return not len(fcurve.modifiers)
+    co, _, handles = read_keys(fcurve)
+    values = co[:, 1] if handles is None else np.concatenate([co[:, 1], handles[:, 1], handles[:, 3]])
+    return bool((values == values[0]).all())
+
+
 def changed_frames(written, now):
     """Frames (sorted ints) at which keys differ: written and now are `read_keys` triples (now None for a
     curve that is gone: every written frame)."""

@@ -14,7 +14,7 @@ from ..core import rig_roles, vrm
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
 from ..core.regular_file import open_regular
-from . import action_adapter, pose_underneath, rigify, vrm_map
+from . import action_adapter, playback, pose_underneath, rigify, vrm_map
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
 ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
@@ -91,49 +91,46 @@ def rotation_basis(pose_bone, values):
     return basis
 
 
-def _rotation_values(pose_bone):
-    return tuple(getattr(pose_bone, rotation_path(pose_bone.rotation_mode)))
-
-
-def sample_rig(context, obj, roles, family, frames, target=None, target_bone=""):
-    """(RigState, {bone: (N, C) rotation channel values underneath}, targets (N, 3)).
+def sample_rig(context, obj, roles, family, frames, target=None, target_bone="", extra=(), properties=()):
+    """(RigState, {bone: (N, C) rotation channel values underneath}, targets (N, 3), playback.Played of the `extra`
+    bones (their pose) and custom `properties` ((bone, name)), or None when none are asked for).
 
     The bones playing roles are read (their basis and their evaluated pose, constraints included) at
     every frame of an animated rig, as its action, NLA and drivers play it: from their keys in numpy
-    where only keys move them and the rig and target stand still (blender/pose_underneath.py), else
-    by scene.frame_set; a still rig once. The target (an object, a bone of an armature when
-    target_bone names one, or the 3D cursor when target is None) is read in the rig's armature space
-    at each frame where anything can move it. The caller restores the scene's frame.
+    where the pose underneath allows it and the rig and target stand still (blender/pose_underneath.py), else
+    through Blender, each frame once (blender/playback.py); a still rig once. The target (an object, a bone of
+    an armature when target_bone names one, or the 3D cursor when target is None) is read in the rig's armature
+    space at each frame where anything can move it. The caller restores the scene's frame.
     """
     scene = context.scene
     animated = action_adapter.plays(obj)
     target_moves = target is not None and (may_move(target) or (target_bone and action_adapter.is_animated(target)))
-    moving = animated or may_move(obj) or target_moves
     skeleton = read_skeleton(obj, roles)
     count = len(frames)
     evaluated = None
-    if animated and not may_move(obj) and not target_moves:
-        evaluated = pose_underneath.sample(obj, skeleton.names, frames)
+    if animated and not may_move(obj) and not target_moves and not properties:
+        evaluated = pose_underneath.sample(obj, list(skeleton.names) + list(extra), frames)
     if evaluated is not None:
-        under, poses, values = _one_frame_if_still(*evaluated)
+        basis, poses, values = evaluated
+        names = len(skeleton.names)
+        under, poses, values = _one_frame_if_still(basis[:, :names], poses[:, :names],
+                                                   {b: values[b] for b in skeleton.names})
         rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
-        return rig, values, np.broadcast_to(target_point(obj, target, target_bone, scene), (count, 3))
-    pose_bones = [obj.pose.bones[name] for name in skeleton.names]
-    under, poses, values, targets = [], [], {b: [] for b in skeleton.names}, []
-    for frame in (frames if moving else frames[:1]):
-        if moving:
-            scene.frame_set(int(frame))
-        # Copied now: mathutils wraps the pose's own memory, which the next frame overwrites.
-        under.append(np.array([pb.matrix_basis for pb in pose_bones], dtype=np.float64))
-        poses.append(np.array([pb.matrix for pb in pose_bones], dtype=np.float64))
-        for pb in pose_bones:
-            values[pb.name].append(_rotation_values(pb))
-        targets.append(target_point(obj, target, target_bone, scene))
-    under, poses = (np.broadcast_to(np.array(m), (count,) + np.shape(m)[1:]) for m in (under, poses))
-    values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
-    under, poses, values = _one_frame_if_still(under, poses, values)
+        targets = np.broadcast_to(target_point(obj, target, target_bone, scene), (count, 3))
+        extras = playback.Played(basis[:, names:], evaluated[1][:, names:], {}, targets, {}) if extra else None
+        return rig, values, targets, extras
+    moving = animated or may_move(obj) or target_moves
+    played = playback.play(scene, obj, list(skeleton.names) + list(extra), frames, moving,
+                           lambda: target_point(obj, target, target_bone, scene), properties)
+    names = len(skeleton.names)
+    under, poses, values = _one_frame_if_still(played.basis[:, :names], played.pose[:, :names],
+                                               {b: played.values[b] for b in skeleton.names})
     rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
-    return rig, values, np.broadcast_to(np.array(targets), (count, 3))
+    extras = None
+    if extra or properties:
+        extras = playback.Played(played.basis[:, names:], played.pose[:, names:], {}, played.targets,
+                                 played.properties)
+    return rig, values, played.targets, extras
 
 
 def _one_frame_if_still(under, poses, values):
@@ -163,7 +160,9 @@ def may_move(obj):
     targets = action_adapter.strip_targets(obj)
     active = action_adapter.active_target(obj)
     targets += [active] if active is not None else []
-    return any(not fcurve.data_path.startswith("pose.") for t in targets for fcurve in t.fcurves())
+    # An importer keys the object's transform too (FBX clips): keys that all hold one value do not move it.
+    return any(not fcurve.data_path.startswith("pose.") and not action_adapter.holds_still(fcurve)
+               for t in targets for fcurve in t.fcurves())
 
 
 def target_point(obj, target, target_bone, scene):

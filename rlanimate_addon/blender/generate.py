@@ -32,6 +32,7 @@ from . import (
     constraints,
     gestures,
     key_layers,
+    playback,
     pose_underneath,
     preferences,
     properties,
@@ -259,15 +260,7 @@ def _compute(context, plan, agent, frames):
         target = settings.target if targeted else None
         bone = target_bone(settings) if target else ""
         try:
-            # Read with the constraints it mutes off: the pose the gesture plays over, which Exact Aim solves on.
-            with constraints.muted(context.view_layer, plan.overriding):
-                rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames,
-                                                                    target, bone)
-            rig = _as_made(plan, rig, below_values, frames)
-            if plan.ik_share is not None:  # the FK controls start where the arm stands in IK
-                played, switch = rigify.played_arm(context, obj, settings.arm, frames, rig.animated)
-                plan.from_ik = bool(np.any(switch < 1.0))
-                rig = rig_rigify.snap_fk(rig, rig_rigify.fk_controls(settings.arm), played)
+            rig, below_values, targets, switch = _read_rig(context, plan, frames, target, bone)
         finally:
             if scene.frame_current != original_frame:
                 scene.frame_set(original_frame)
@@ -290,6 +283,27 @@ def _compute(context, plan, agent, frames):
             plan.under.update({bone: values for bone, values in plan.previous.record["under"].items()
                                if bone in rig.resting and bone in plan.bones})
         plan.keys = _keys(plan, below, below_values)
+
+
+def _read_rig(context, plan, frames, target, bone):
+    """(the RigState as the gesture is made over it, {bone: (N, C) rotation values underneath}, (N, 3) targets, a
+    Rigify arm's (N,) IK_FK underneath or None): each frame played once, with the constraints the gesture mutes
+    off (the pose it plays over, which Exact Aim solves on). A Rigify arm's ORG- bones are read in the same pass,
+    unless constraints are muted: then as the rig plays with them, in a pass of their own."""
+    obj, arm = plan.obj, plan.settings.arm
+    rigify_arm = rigify.arm_reads(arm) if plan.ik_share is not None else ((), ())
+    alongside = rigify_arm if not plan.overriding else ((), ())
+    with constraints.muted(context.view_layer, plan.overriding):
+        rig, values, targets, played = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
+                                                              bone, *alongside)
+    rig = _as_made(plan, rig, values, frames)
+    if plan.ik_share is None:
+        return rig, values, targets, None
+    if plan.overriding:
+        played = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, None, "", *rigify_arm)[3]
+    controls, switch = rigify.played_arm(arm, played)
+    plan.from_ik = bool(np.any(switch < 1.0))
+    return rig_rigify.snap_fk(rig, rig_rigify.fk_controls(arm), controls), values, targets, switch
 
 
 def _as_made(plan, rig, values, frames):
@@ -360,7 +374,9 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
 
 def bake(context, requests, progress=lambda step: None, mute_constraints=False, cascade=True):
     """`generate` for [(armature, its settings, the name of the gesture to bake again or "")]; returns the
-    summary. With cascade, the gestures that depend on those it changed are baked again after."""
+    summary. With cascade, the gestures that depend on those it changed are baked again after. Frames it plays
+    through Blender evaluate the armatures, not the meshes they deform (playback.armature_only); the scene is
+    evaluated whole once at the end."""
     plans = [_plan(obj, own, selected, mute_constraints) for obj, own, selected in requests]
     agent = preferences.selected_agent(context)
     for plan in plans:
@@ -368,6 +384,24 @@ def bake(context, requests, progress=lambda step: None, mute_constraints=False, 
         check_frames(int(plan.settings.start_frame), int(plan.settings.frame_count))
         _check_request(plan.settings, agent)
     progress(1)
+    with playback.armature_only(context.view_layer, _evaluated(plans)) as switched:
+        lines = _bake_plans(context, plans, agent, progress, cascade)
+    if switched:
+        context.view_layer.update()
+    return "\n".join(lines)
+
+
+def _evaluated(plans):
+    """The objects a bake of the plans reads as Blender evaluates them: the armatures, the targets of the plans
+    and of the armatures' gestures (baked again after)."""
+    found = {plan.obj for plan in plans} | {plan.settings.target for plan in plans}
+    for plan in plans:
+        found |= {g.record["settings"].get("target") for g in gestures.placed_gestures(plan.obj)}
+    return [obj for obj in found if isinstance(obj, bpy.types.Object)]
+
+
+def _bake_plans(context, plans, agent, progress, cascade):
+    """Compute, write and verify the checked plans, then bake their dependants again; returns the summary lines."""
     # Backups of the gestures it changes (rewritten in place, trimmed), made before BakeUndo records the file.
     trimmed = [key_layers.Backup(plan.taken) for plan in plans if plan.taken is not None]
     rewritten = [key_layers.Backup(plan.previous) for plan in plans if plan.previous is not None]
@@ -389,7 +423,7 @@ def bake(context, requests, progress=lambda step: None, mute_constraints=False, 
     progress(4)
     if cascade:
         lines = [line + _cascade(context, plan) for line, plan in zip(lines, plans, strict=True)]
-    return "\n".join(lines)
+    return lines
 
 
 def _write_and_verify(context, plans, agent, backups):

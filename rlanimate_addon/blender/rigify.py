@@ -1,7 +1,5 @@
 """Rigify at the Blender edge: telling a generated rig, reading an arm's IK-FK switch and the pose its
 arm plays, and the switch's keys (core/rigify.py says how an arm in IK is switched to FK)."""
-import numpy as np
-
 from ..core import rigify
 from ..core.errors import RLAnimateError
 from . import action_adapter
@@ -38,22 +36,18 @@ def ik_share(obj, arm):
     return float(switch[rigify.SWITCH]) if animated or switch[rigify.SWITCH] < 1.0 else None
 
 
-def played_arm(context, obj, arm, frames, moving):
+def arm_reads(arm):
+    """(the ORG- bones the arm's FK controls stand for, [(switch bone, IK_FK)]): what `played_arm` reads, for
+    armature_io.sample_rig to read in its own pass over the frames."""
+    return [rigify.org_bone(c) for c in rigify.fk_controls(arm)], [(rigify.switch_bone(arm), rigify.SWITCH)]
+
+
+def played_arm(arm, played):
     """({FK control: (N, 4, 4)} the armature-space pose of the ORG- bone each FK control of the arm stands
-    for, (N,) the arm's IK_FK), as the rig plays at each frame (once for a still rig). The caller
-    restores the scene's frame."""
+    for, (N,) the arm's IK_FK), as the rig plays: played is the playback.Played of `arm_reads`."""
     controls = rigify.fk_controls(arm)
-    switch = obj.pose.bones[rigify.switch_bone(arm)]
-    out, values = {c: [] for c in controls}, []
-    for frame in (frames if moving else frames[:1]):
-        if moving:
-            context.scene.frame_set(int(frame))
-        for control in controls:
-            out[control].append(np.array(obj.pose.bones[rigify.org_bone(control)].matrix, dtype=np.float64))
-        values.append(float(switch[rigify.SWITCH]))
-    count = len(frames)
-    return ({c: np.broadcast_to(np.array(m), (count, 4, 4)) for c, m in out.items()},
-            np.broadcast_to(np.array(values), (count,)))
+    switch = played.properties[rigify.switch_bone(arm), rigify.SWITCH]
+    return {control: played.pose[:, k] for k, control in enumerate(controls)}, switch
 
 
 def switch_keys(obj, arm, under, blend_type, animated):
