@@ -209,6 +209,16 @@ def write_keys(fcurve, frames, values, memory=None):
         memory.add(fcurve, co, interpolation)
 
 
+def overwrite_values(fcurve, frames, values, memory=None):
+    """Overwrite the values of an F-curve's linear keys, one on each of `frames` (N,) already, with values (N,)
+    (the write `write_keys` makes), remembered by the KeyMemory given. The caller tags the action for update."""
+    co = np.empty((len(frames), 2), dtype=np.float32)
+    co[:, 0], co[:, 1] = frames, values
+    fcurve.keyframe_points.foreach_set("co", co.ravel())
+    if memory is not None:
+        memory.add(fcurve, co, np.full(len(frames), _LINEAR, dtype=np.int32))
+
+
 def write_bezier_keys(fcurve, frames, values, tangents, memory=None):
     """Bulk-write Bezier keys (frames (K,), values (K,), slopes per frame (K,)) into an empty F-curve,
     remembered by the KeyMemory given.

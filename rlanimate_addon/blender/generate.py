@@ -7,6 +7,7 @@ gesture's pose, which is trimmed there; before a later one it is trimmed where t
 gestures that depend on the one it changed (their aim, their start pose) are baked again from their records,
 unless edited by hand. blender/gestures.py describes how a gesture's keys are laid out.
 """
+import contextlib
 import types
 
 import bpy
@@ -160,6 +161,7 @@ class _Plan:
         self.under = {}  # {bone: channel values} of keyed bones that stand still underneath
         self.worst = 0.0
         self.hold = False  # the constraints it mutes stay muted beyond its frames (constraints.follow_rest)
+        self.preview = ""  # baked while Follow Target drags its target: GESTURE or AIM (`bake`)
 
     @property
     def frames(self):
@@ -230,8 +232,10 @@ def _plan(obj, settings, selected, mute_constraints):
 def _check_unedited(placed, settings, doing, skip=()):
     """RLAnimateError naming the bones and frames of the gesture's keys edited by hand (but those of `skip`),
     unless Replace Edited Keys is on."""
+    if getattr(settings, "replace_edited_keys", False):
+        return
     found = {channel: frames for channel, frames in gestures.edited(placed).items() if channel not in skip}
-    if found and not getattr(settings, "replace_edited_keys", False):
+    if found:
         raise RLAnimateError(
             f"The keys of {placed.name!r} were edited by hand on {gestures.describe_edits(found)}, and Generate "
             f"would {doing.format(start=int(settings.start_frame))}, overwriting them: tick 'Replace Edited Keys' "
@@ -260,7 +264,7 @@ def _compute(context, plan, agent, frames):
         target = settings.target if targeted else None
         bone = target_bone(settings) if target else ""
         try:
-            rig, below_values, targets, switch = _read_rig(context, plan, frames, target, bone)
+            rig, below_values, targets, switch = _read_once(context, plan, frames, target, bone)
         finally:
             if scene.frame_current != original_frame:
                 scene.frame_set(original_frame)
@@ -269,7 +273,7 @@ def _compute(context, plan, agent, frames):
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
                                          tempo=settings.tempo or None, exact_aim=settings.exact_aim,
                                          fps=properties.scene_fps(scene))
-        plan.bones, plan.keyed, below = gesture.gesture_rotations(agent, request, rig)
+        plan.bones, plan.keyed, below = _rotations(agent, request, rig, plan, frames)
         if target is not None:
             plan.target, plan.target_bone, plan.targets = target, bone, targets
         plan.rig, plan.blend_type = rig, "REPLACE" if plan.still else settings.blend_type
@@ -283,6 +287,53 @@ def _compute(context, plan, agent, frames):
             plan.under.update({bone: values for bone, values in plan.previous.record["under"].items()
                                if bone in rig.resting and bone in plan.bones})
         plan.keys = _keys(plan, below, below_values)
+
+
+#: The rig as a Follow Target drag's first re-bake read it, for the drag's other re-bakes (`bake`'s preview):
+#: {_read_key: (RigState, rotation values, IK_FK or None, from_ik)}; and the gesture it last baked before its aim
+#: ({_read_key: gesture.Blended}), which a preview of the aim alone aims again.
+_reads: dict = {}
+_blends: dict = {}
+
+
+def forget_reads():
+    """Forget the reads and gestures Follow Target's previews reuse (`_reads`, `_blends`)."""
+    _reads.clear()
+    _blends.clear()
+
+
+def _rotations(agent, request, rig, plan, frames):
+    """gesture.gesture_rotations' result; in a preview of the aim alone, the gesture the drag baked last, aimed
+    at the request's targets (the agent not run again)."""
+    key = _read_key(plan, frames)
+    blended = _blends.get(key) if plan.preview == AIM else None
+    if blended is None:
+        blended = gesture.blended_gesture(agent, request, rig)
+    if plan.preview:
+        _blends[key] = blended
+    return gesture.aimed(request, rig, blended)
+
+
+def _read_key(plan, frames):
+    previous = plan.previous.name if plan.previous is not None else ""
+    return (plan.obj.as_pointer(), previous, int(frames[0]), len(frames), plan.settings.arm, plan.settings.behaviour,
+            tuple(sorted(plan.roles.items())), tuple(bone for bone, _ in plan.overriding))
+
+
+def _read_once(context, plan, frames, target, bone):
+    """`_read_rig`'s result (the caller sets the gesture baked again aside). In a preview, the rig as the drag's
+    first re-bake read it, the target where it is now, where neither the rig nor the target can move."""
+    obj, key = plan.obj, _read_key(plan, frames)
+    if plan.preview and key in _reads:  # kept only where neither moves
+        rig, values, switch, plan.from_ik = _reads[key]
+        point = armature_io.target_point(obj, target, bone, context.scene)
+        return rig, values, np.broadcast_to(point, (len(frames), 3)), switch
+    rig, values, targets, switch = _read_rig(context, plan, frames, target, bone)
+    still = not armature_io.may_move(obj) and (target is None or not armature_io.may_move(target)) and not (
+        bone and action_adapter.is_animated(target))
+    if plan.preview and still:
+        _reads[key] = (rig, values, switch, plan.from_ik)
+    return rig, values, targets, switch
 
 
 def _read_rig(context, plan, frames, target, bone):
@@ -372,19 +423,54 @@ def generate(context, settings, progress=lambda step: None, mute_constraints=Fal
     return bake(context, requests, progress, mute_constraints)
 
 
-def bake(context, requests, progress=lambda step: None, mute_constraints=False, cascade=True):
+#: Follow Target's previews (`bake`): the gesture baked again over the rig as read at the drag's start, or its
+#: aim alone.
+GESTURE, AIM = "gesture", "aim"
+
+
+def bake(context, requests, progress=lambda step: None, mute_constraints=False, cascade=True, preview=""):
     """`generate` for [(armature, its settings, the name of the gesture to bake again or "")]; returns the
     summary. With cascade, the gestures that depend on those it changed are baked again after. Frames it plays
     through Blender evaluate the armatures, not the meshes they deform (playback.armature_only); the scene is
-    evaluated whole once at the end."""
+    evaluated whole once at the end.
+
+    preview (Follow Target while a target is dragged): GESTURE bakes each gesture over the rig as the drag's first
+    re-bake read it (`_read_once`), AIM the gesture the drag baked last aimed at the target where it is now (the
+    agent not run again); either checks the bake, neither bakes its dependants again. A bake that is not a
+    preview forgets what previews reuse."""
+    if not preview:
+        forget_reads()
+    _baking.append(True)
+    try:
+        return _bake(context, requests, progress, mute_constraints, cascade, preview)
+    finally:
+        _baking.pop()
+
+
+#: One entry per bake under way (a bake bakes dependants again inside it).
+_baking: list = []
+
+
+def baking():
+    """Whether a bake is under way (the frames it plays fire depsgraph handlers: Follow Target waits)."""
+    return bool(_baking)
+
+
+def _bake(context, requests, progress, mute_constraints, cascade, preview):
     plans = [_plan(obj, own, selected, mute_constraints) for obj, own, selected in requests]
+    for plan in plans:
+        plan.preview = preview
     agent = preferences.selected_agent(context)
     for plan in plans:
         gesture.check_length(int(plan.settings.frame_count))
         check_frames(int(plan.settings.start_frame), int(plan.settings.frame_count))
         _check_request(plan.settings, agent)
     progress(1)
-    with playback.armature_only(context.view_layer, _evaluated(plans)) as switched:
+    # A preview over a rig read before plays only the bake check's frames: the meshes then cost less than
+    # switching their modifiers off and on.
+    read = preview and all(_read_key(plan, plan.frames[0] + np.arange(plan.frames[1] - plan.frames[0] + 1))
+                           in _reads for plan in plans)
+    with playback.armature_only(context.view_layer, [] if read else _evaluated(plans), not read) as switched:
         lines = _bake_plans(context, plans, agent, progress, cascade)
     if switched:
         context.view_layer.update()
@@ -410,7 +496,11 @@ def _bake_plans(context, plans, agent, progress, cascade):
             start, count = plan.frames[0], int(plan.settings.frame_count)
             if plan.taken is not None:  # its pose at the handover is where this one starts
                 key_layers.trim(plan.taken, start, gesture.blend_ramp(count))
-            with gestures.detached([plan.previous] if plan.previous is not None else [], context.view_layer):
+            # The gesture baked again set aside while the rig is read (unless a preview reads it no more), and put
+            # back as it stood should the bake be refused.
+            previous = [plan.previous] if plan.previous is not None else []
+            reread = not (plan.preview and _read_key(plan, start + np.arange(count)) in _reads)
+            with gestures.detached(previous, context.view_layer) if reread else contextlib.nullcontext():
                 _compute(context, plan, agent, start + np.arange(count))
     except BaseException:
         for backup in trimmed:
@@ -421,7 +511,7 @@ def _bake_plans(context, plans, agent, progress, cascade):
     progress(3)
     lines = _write_and_verify(context, plans, agent, trimmed + rewritten)
     progress(4)
-    if cascade:
+    if cascade and not any(plan.preview for plan in plans):
         lines = [line + _cascade(context, plan) for line, plan in zip(lines, plans, strict=True)]
     return lines
 
@@ -467,7 +557,7 @@ def _write(plan, agent, scene):
         constraints.unmute(obj, gestures.influence_before(plan.previous))
         gesture_id = int(plan.previous.record.get("id", gestures.next_id(obj)))
         memories = key_layers.rewrite(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                      plan.properties, gesture_id)
+                                      plan.properties, gesture_id, in_place=bool(plan.preview))
         plan.action = plan.previous.action
     else:
         gesture_id = gestures.next_id(obj)

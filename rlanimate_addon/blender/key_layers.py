@@ -9,7 +9,7 @@ its actions stay as they are and keep playing. Keys are written in bulk (`keyfra
 import bpy
 import numpy as np
 
-from ..core import easing, key_reduction
+from ..core import behaviours, easing, key_reduction
 from . import action_adapter, armature_io
 from .gestures import MAIN, RECORD, TORSO, TORSO_OF, Layer
 
@@ -37,6 +37,30 @@ def key_action(target, start_frame, keys, memory=None, properties=None):
     for path, values in (properties or {}).items():
         fcurve = target.new_fcurve(path, 0, path.split('"')[1])
         action_adapter.write_keys(fcurve, start_frame + np.arange(len(values)), values, memory)
+
+
+def key_values(fcurves, start_frame, keys, memory, properties=None):
+    """Overwrite the values of the F-curves `fcurves` (of one action, unedited) with `key_action`'s keys (one
+    linear key a frame from start_frame, no kept frames), remembered by `memory`; False, writing nothing, unless
+    the curves are exactly those `key_action` would make, keying the same frames."""
+    values = {}
+    for bone, (mode, rotation, kept) in keys.items():
+        if kept is not None:
+            return False
+        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{armature_io.rotation_path(mode)}'
+        values.update({(path, channel): rotation[:, channel] for channel in range(rotation.shape[1])})
+    values.update({(path, 0): np.asarray(series) for path, series in (properties or {}).items()})
+    curves = {(f.data_path, f.array_index): f for f in fcurves}
+    count = len(next(iter(values.values()))) if values else 0
+    frames = start_frame + np.arange(count)
+    ends = [(f.keyframe_points[0].co[0], f.keyframe_points[-1].co[0]) for f in fcurves if len(f.keyframe_points)]
+    if curves.keys() != values.keys() or any(len(f.keyframe_points) != count for f in fcurves) \
+            or set(ends) != {(frames[0], frames[-1])}:
+        return False  # unedited curves keying the frames from the first to the last one each hold one a frame
+    for key, series in values.items():
+        action_adapter.overwrite_values(curves[key], frames, series, memory)
+    fcurves[0].id_data.update_tag()  # the action's evaluated copy takes the new values
+    return True
 
 
 def _frames(start, layers):
@@ -69,12 +93,15 @@ def place(obj, name, start, layers, blend_type, played, properties, still, gestu
     return main.action, memories
 
 
-def rewrite(gesture, name, start, layers, blend_type, properties, gesture_id):
+def rewrite(gesture, name, start, layers, blend_type, properties, gesture_id, in_place=False):
     """Bake new keys (`place`'s layers) into the gesture's own actions where they play, renamed after `name`:
     the F-curves it wrote are replaced, any other F-curve of its actions is kept. A gesture without a torso layer
-    (made before gestures had one, or its torso action deleted) gets one. Returns {layer: KeyMemory}."""
+    (made before gestures had one, or its torso action deleted) gets one. in_place (Follow Target's previews of
+    an unedited gesture): where the gesture's curves already key those channels on those frames, one key a
+    frame, their values are overwritten (`key_values`). Returns {layer: KeyMemory}."""
     frames = _frames(start, layers)
     memories = {}
+    given = generated_name(gesture.record)  # what it was called, unless the animator renamed it since
     if TORSO not in gesture.layers:
         torso = action_adapter.new_action(name + TORSO_SUFFIX, gesture.obj)
         torso.action[TORSO_OF] = gesture_id
@@ -82,19 +109,37 @@ def rewrite(gesture, name, start, layers, blend_type, properties, gesture_id):
         gesture.torso = Layer(torso, gesture.obj.animation_data.nla_tracks[-1])
     for layer_name, keys in layers.items():
         layer = gesture.layers[layer_name]
-        for fcurve in gesture.owned(layer_name):
-            layer.target.remove(fcurve)
         memories[layer_name] = action_adapter.KeyMemory()
-        key_action(layer.target, start, keys, memories[layer_name], properties if layer_name == MAIN else None)
-        layer_label = name if layer_name == MAIN else name + TORSO_SUFFIX
-        layer.action.name = layer_label
+        extra = properties if layer_name == MAIN else None
+        owned = gesture.owned(layer_name)
+        if not (in_place and key_values(owned, start, keys, memories[layer_name], extra)):
+            for fcurve in owned:
+                layer.target.remove(fcurve)
+            key_action(layer.target, start, keys, memories[layer_name], extra)
+        suffix = "" if layer_name == MAIN else TORSO_SUFFIX
+        layer_label = _renamed(layer.action, given + suffix, name + suffix)
         if layer.track is None:  # the active action: a base on a still rig
             gesture.obj.animation_data.action_blend_type = blend_type
             continue
-        layer.track.name = layer_label
+        _renamed(layer.track, given + suffix, layer_label)
         base = gesture.still and layer_name == MAIN
-        _fit_strip(layer, frames, layer_label, "COMBINE" if layer_name == TORSO else blend_type, base)
+        _fit_strip(layer, frames, layer.track.name, "COMBINE" if layer_name == TORSO else blend_type, base)
     return memories
+
+
+def generated_name(record):
+    """The name Generate gives a gesture's main action: 'RLAnimate Point Right'."""
+    return f"RLAnimate {behaviours.title(record['behaviour'])} {str(record['arm']).title()}"
+
+
+def _renamed(named, given, name):
+    """Rename an action or a track from `given` (Generate's name for it, or that name with the number Blender
+    adds to a name taken: 'RLAnimate Point Right.001') to `name`; one the animator renamed keeps its name.
+    Returns its name."""
+    number = named.name[len(given) + 1:]
+    if named.name != name and (named.name == given or (named.name.startswith(given + ".") and number.isdigit())):
+        named.name = name
+    return named.name
 
 
 def _fit_strip(layer, frames, name, blend_type, base):
@@ -110,9 +155,24 @@ def _fit_strip(layer, frames, name, blend_type, base):
             strip.blend_type, strip.extrapolation = settings
         strip.name = name
         return
-    for old in list(layer.track.strips):
+    strips = list(layer.track.strips)
+    if len(strips) == 1 and _plays(strips[0], layer.target, frames, blend_type):
+        if strips[0].name != name:
+            strips[0].name = name
+        return  # as it is: no new strip (on a large rig, Blender's next frame rebuilds its whole evaluation)
+    for old in strips:
         layer.track.strips.remove(old)
     action_adapter.fill_track(layer.track, layer.target, frames, name).blend_type = blend_type
+
+
+def _plays(strip, target, frames, blend_type):
+    """Whether the strip plays exactly what action_adapter.fill_track would have it play, with that blend type."""
+    slot = getattr(strip, "action_slot", None) if action_adapter.LAYERED else None
+    return (strip.action == target.action and slot == target.slot and not strip.mute
+            and (strip.frame_start, strip.frame_end) == tuple(frames)
+            and (strip.action_frame_start, strip.action_frame_end) == tuple(frames)
+            and strip.scale == 1.0 and strip.repeat == 1.0 and strip.blend_in == 0.0 and strip.blend_out == 0.0
+            and strip.extrapolation == "NOTHING" and strip.blend_type == blend_type and not strip.use_reverse)
 
 
 def trim(gesture, at, fade):

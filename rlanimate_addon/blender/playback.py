@@ -53,12 +53,13 @@ def needed(objects: Iterable[bpy.types.Object]) -> set:
 
 
 @contextlib.contextmanager
-def armature_only(view_layer: bpy.types.ViewLayer, objects: Iterable[bpy.types.Object]) -> Iterator[bool]:
+def armature_only(view_layer: bpy.types.ViewLayer, objects: Iterable[bpy.types.Object],
+                  switch: bool = True) -> Iterator[bool]:
     """While inside, the modifiers of the view layer's objects that `objects` do not depend on (`needed`) are
-    off in the viewport; as they were on leaving. Yields whether it switched any off (the caller then has the
-    scene evaluated again once, the meshes deformed)."""
-    keep = needed(objects)
-    switched = [modifier for obj in view_layer.objects if obj not in keep for modifier in obj.modifiers
+    off in the viewport (none without `switch`); as they were on leaving. Yields whether it switched any off
+    (the caller then has the scene evaluated again once, the meshes deformed)."""
+    keep = needed(objects) if switch else set()
+    switched = [modifier for obj in view_layer.objects if switch and obj not in keep for modifier in obj.modifiers
                 if modifier.show_viewport]
     for modifier in switched:
         modifier.show_viewport = False

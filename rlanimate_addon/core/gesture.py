@@ -25,9 +25,11 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
     line passes through the target whatever the rig's proportions and whatever moves underneath.
 """
 import math
-from typing import NamedTuple
+from dataclasses import dataclass
+from typing import Any, NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
@@ -653,6 +655,24 @@ def gesture_rotations(agent, request, rig):
     needs. The bones are those the gesture owns (`owned_joints`, Point's hand shape, a target behaviour's
     eyes). Every RLAnimateError is raised before anything is returned, so callers can write all or nothing.
     """
+    return aimed(request, rig, blended_gesture(agent, request, rig))
+
+
+@dataclass(frozen=True)
+class Blended:
+    """A gesture before its aim (`blended_gesture`): the roles keyed and their columns in the rig's skeleton, the
+    (N, D, 4) rotations keyed and underneath, the agent's (N, 3) finger base the aim's phase follows (None but for
+    a target behaviour) and the rig's character frame. `aimed` finishes it for a target, and for another."""
+    names: tuple[str, ...]
+    columns: tuple[int, ...]
+    keyed: npt.NDArray[np.float64]
+    under: npt.NDArray[np.float64]
+    phase_base: npt.NDArray[np.float64] | None
+    to_character: npt.NDArray[np.float64]
+
+
+def blended_gesture(agent: Any, request: "GestureRequest", rig: "RigState") -> Blended:
+    """The agent's gesture for the request, retargeted to the rig and blended from and into the pose underneath."""
     rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
     check_length(request.frame_count)
     canonical = run_agent(agent, request.behaviour, _objectives(agent, request, rig), seed=request.seed,
@@ -660,11 +680,22 @@ def gesture_rotations(agent, request, rig):
     targeted = agent.kind(request.behaviour) == behaviours.TARGET
     phase_base = played_finger_base(canonical, request.arm) if targeted else None
     names, played, standing, to_character = _played(request, rig, canonical)
-    bones = [rig.roles[n] for n in names]
-    columns = [rig.skeleton.index[b] for b in bones]  # the eyes, keyed for Point, come after these
+    columns = [rig.skeleton.index[rig.roles[n]] for n in names]  # the eyes, keyed for Point, come after these
     keyed, under = _blended(rig, names, columns, played, standing)
-    if targeted:
-        bones, keyed, under = _aimed(rig, request, names, columns, keyed, under, phase_base, to_character)
+    return Blended(tuple(names), tuple(columns), keyed, under, phase_base, to_character)
+
+
+def aimed(request: "GestureRequest", rig: "RigState",
+          blended: Blended) -> tuple[tuple[str, ...], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """`gesture_rotations`' result from a blended gesture: a target behaviour's aim and gaze solved for the
+    request's targets (which may be others than the gesture was made for: Follow Target's cheap path), the
+    rotations made continuous; RLAnimateError for rotations that are not numbers."""
+    names, columns = list(blended.names), list(blended.columns)
+    bones = [rig.roles[n] for n in names]
+    keyed, under = np.array(blended.keyed), np.array(blended.under)
+    if blended.phase_base is not None:
+        bones, keyed, under = _aimed(rig, request, names, columns, keyed, under, blended.phase_base,
+                                     blended.to_character)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
     broken = [bone for bone, ok in zip(bones, finite, strict=True) if not ok]
