@@ -201,7 +201,8 @@ def test_copies_of_keyed_bones_evaluate_as_blender_plays_them(settings):
 
 
 def _add_controls(rig):
-    """Two control bones, CTRL_A at the root and CTRL_B under the hips, off any bone's rest and rolled."""
+    """Two control bones, CTRL_A at the root and CTRL_B under the hips, off any bone's rest and rolled; the neck
+    connected to its parent (Blender 5.0's FBX importer connects it, 4.2's and 4.5's do not)."""
     helpers.activate(rig)
     bpy.ops.object.mode_set(mode="EDIT")
     edit_bones = rig.data.edit_bones
@@ -209,4 +210,5 @@ def _add_controls(rig):
         bone = edit_bones.new(name)
         bone.head, bone.tail, bone.roll = (0.3, 0.1, 1.0), (0.3, 0.4, 1.1), 0.4
         bone.parent = edit_bones[parent] if parent else None
+    edit_bones[helpers.rig_bone(rig, "Neck")].use_connect = True
     bpy.ops.object.mode_set(mode="OBJECT")

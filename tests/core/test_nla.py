@@ -82,3 +82,7 @@ def test_copies_and_their_interpolation_by_influence():
     mirrored = np.array(owner)
     mirrored[:, 0, 0] = -2.0
     assert bone_constraints.unsupported(mirrored) and not bone_constraints.unsupported(owner)
+    sheared, rounded = np.array(owner), np.array(owner)
+    sheared[:, 0, 1] = 0.01
+    rounded[:, :3, :3] += 1e-6 * np.array([[0.5, -1.0, 0.3], [0.8, 0.2, -0.6], [-0.4, 0.9, 0.1]])  # single precision
+    assert bone_constraints.unsupported(sheared) and not bone_constraints.unsupported(rounded)
