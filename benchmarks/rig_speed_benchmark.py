@@ -12,7 +12,8 @@ Follow Target is timed on the sample character and the Rigify rig: a scripted dr
 one every 1/60 s (an animator's drag, as the viewport sends it) or as soon as the previous move's handler returns,
 counting the gesture's re-bakes per second; then the target rests and the gesture is baked in full.
 
-With --stages it prints, instead, the CPU milliseconds per click in Generate's stages (STAGES) for each case.
+Then it times the CPU milliseconds per click in Generate's stages (STAGES) for each case: where a click's time
+goes (with --stages it prints those alone).
 
 Run: `nice -n 10 python benchmarks/rig_speed_benchmark.py [--rounds N] [--cases NAME ...] [--no-write] [--stages]
 [--root DIR]`
@@ -332,16 +333,15 @@ def drag_table(drags: list[dict]) -> str:
 
 #: (stage, module name, function) timed by --stages, inclusive; a stage inside the dependants' bakes counts to them.
 STAGES = (("plan and checks", "generate", "_plan"), ("rig read", "armature_io", "sample_rig"),
-          ("agent and numpy", "gesture", "gesture_rotations"), ("key writes", "generate", "_write"),
+          ("agent and aim", "generate", "_rotations"), ("key writes", "generate", "_write"),
           ("bake check", "bake_check", "verify"), ("dependants", "generate", "_cascade"))
 
 
 def stages(row: dict, rounds: int) -> dict[str, float]:
     """{stage: CPU ms per click} of a case (STAGES, and the click), over `rounds` clicks after the first."""
     from rlanimate_addon.blender import armature_io, bake_check, generate
-    from rlanimate_addon.core import gesture
 
-    modules = {"generate": generate, "armature_io": armature_io, "bake_check": bake_check, "gesture": gesture}
+    modules = {"generate": generate, "armature_io": armature_io, "bake_check": bake_check}
     spent = dict.fromkeys([label for label, _, _ in STAGES] + ["Generate"], 0.0)
     inside: list[str] = []
 
@@ -381,7 +381,8 @@ def stages_table(rows: list[dict], rounds: int) -> str:
     return "\n".join(lines)
 
 
-def section(rows: list[dict], drags: list[dict], args: argparse.Namespace, load: float, seconds: float) -> str:
+def section(rows: list[dict], drags: list[dict], profile: str, args: argparse.Namespace, load: float,
+            seconds: float) -> str:
     from rlanimate_addon.blender import follow_target
 
     follow_target_keep_up = follow_target.KEEP_UP
@@ -424,6 +425,16 @@ read again, its dependants baked again), and its keys are Generate's for that po
 {drag_table(drags)}
 
 Targets (issue 43): at least 20 re-bakes a second on the sample character, 5 on the Rigify rig.
+
+Where a click's time goes: CPU milliseconds per click in Generate's stages, on the same files (the mean of
+{args.rounds} clicks after a warm-up, the instrumented functions' inclusive time; "dependants" is the gestures
+baked again after the click's own, stages inside it counted to it; "other" is the rest of the operator: the
+checks before the plan, undo, the gesture list, the scene evaluated again once, the meshes deformed).
+"rig read" is the pose underneath and the rig's rest (numpy where `blender/pose_underneath.py` can, else
+Blender playing the frames, the armature alone); "agent and aim" runs the agent and Exact Aim in numpy; "bake
+check" plays the gesture's frames through Blender.
+
+{profile}
 """
 
 
@@ -442,7 +453,8 @@ def main() -> None:
             print(stages_table(rows, args.rounds))
             return
         drags = [drag(row) for row in rows if row["case"].name in DRAGGED]
-    text = section(rows, drags, args, load, time.perf_counter() - started)
+        profile = stages_table(rows, args.rounds)
+    text = section(rows, drags, profile, args, load, time.perf_counter() - started)
     print(text)
     if not args.no_write and not args.root:
         write_section(SECTION, text)
