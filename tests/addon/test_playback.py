@@ -20,13 +20,20 @@ def _sway(rig, role):
     bone.rotation_quaternion = (1.0, 0.0, 0.0, 0.0)
 
 
-def _watch(played):
-    """A frame_change_post handler appending (frame, each modifier's show_viewport by object) to `played`."""
+def _generate_watched(rig, settings, **values):
+    """[(frame, {mesh: each modifier's show_viewport})] of every frame Blender plays during a Generate that must
+    finish."""
+    played = []
+
     def handler(scene, *_):
         played.append((scene.frame_current, {o.name: [m.show_viewport for m in o.modifiers]
                                              for o in scene.objects if o.type == "MESH"}))
     bpy.app.handlers.frame_change_post.append(handler)
-    return handler
+    try:
+        assert helpers.generate(rig, settings, start_frame=1, **values) == {"FINISHED"}
+    finally:
+        bpy.app.handlers.frame_change_post.remove(handler)
+    return played
 
 
 def _blender_plays_the_pose(rig):
@@ -43,13 +50,8 @@ def test_frames_played_for_the_pose_underneath_leave_the_meshes_unevaluated_and_
     subdivision.show_viewport = False  # the animator's: stays off
     _sway(rig, "Spine")
     _blender_plays_the_pose(rig)
-    played = []
-    handler = _watch(played)
-    try:
-        assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=helpers.add_empty("T", OLD),
-                                start_frame=1, frame_count=60) == {"FINISHED"}
-    finally:
-        bpy.app.handlers.frame_change_post.remove(handler)
+    played = _generate_watched(rig, settings, behaviour="POINT", arm="RIGHT", target=helpers.add_empty("T", OLD),
+                               frame_count=60)
     frames = [frame for frame, _ in played]
     assert set(range(1, 61)) <= set(frames), "the pose underneath read through Blender, frame by frame"
     assert len(frames) <= 60 + 3 + 2, "each frame once, the bake check's three, and the scene's frame put back"
@@ -79,13 +81,7 @@ def test_a_mesh_the_rig_follows_keeps_its_modifiers(settings):
     child_of.target = prop
     _sway(rig, "Spine")
     _blender_plays_the_pose(rig)
-    played = []
-    handler = _watch(played)
-    try:
-        assert helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT", start_frame=1,
-                                frame_count=40) == {"FINISHED"}
-    finally:
-        bpy.app.handlers.frame_change_post.remove(handler)
+    played = _generate_watched(rig, settings, behaviour="WAVE", arm="RIGHT", frame_count=40)
     assert played and all(shown[prop.name] == [True] and shown[body.name] == [False] for _, shown in played)
 
 
@@ -97,12 +93,6 @@ def test_a_rigify_arm_in_ik_is_read_in_the_same_pass_as_the_pose_underneath(sett
     for frame in range(1, 61, 10):
         torso.rotation_quaternion = (math.cos(0.01 * frame), 0.0, 0.0, math.sin(0.01 * frame))
         torso.keyframe_insert("rotation_quaternion", frame=frame)
-    played = []
-    handler = _watch(played)
-    try:
-        assert helpers.generate(rig, settings, behaviour="WAVE", arm="RIGHT", start_frame=1,
-                                frame_count=40) == {"FINISHED"}
-    finally:
-        bpy.app.handlers.frame_change_post.remove(handler)
+    played = _generate_watched(rig, settings, behaviour="WAVE", arm="RIGHT", frame_count=40)
     frames = [frame for frame, _ in played]
     assert set(range(1, 41)) <= set(frames) and len(frames) <= 40 + 3 + 2
