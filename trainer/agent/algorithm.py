@@ -8,8 +8,9 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
        objectives only (it self-describes with its portrayal model), so the whole rollout can be
        computed before the environment is asked for the real descriptions d'_t. Each episode
        (o, a, d', m, FK of m) is appended to the buffer;
-    3. run T update steps, each on C random chunks of L frames (C grows with the behaviours beyond
-       two: chunks_per_update), with Adam on the description, KL and pose terms (the paper's L1 + L2 + L3).
+    3. run T update steps, each on C random chunks of L frames (beyond two behaviours C grows with them,
+       chunks_per_update, and T is the config's update_steps_many, updates_per_epoch), with Adam on the
+       description, KL and pose terms (the paper's L1 + L2 + L3).
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
 that they explore and stay reproducible; evaluation rolls out deterministically. With
 `average_last_epochs` N, the agent that is evaluated and exported (`played_agent`) is the mean of the
@@ -48,6 +49,15 @@ def chunks_per_update(chunk_count, behaviour_count):
     return int(math.ceil(chunk_count * max(behaviour_count, 2) / 2))
 
 
+def updates_per_epoch(config, behaviour_count):
+    """T, the update steps of an iteration: the config's `update_steps` for one or two behaviours, and its
+    `update_steps_many` (when given) for more. Their steps are dearer (C grows with them: chunks_per_update),
+    and the four behaviours of the sample library learn as well in 80 as in 120 (docs/TRAINING.md)."""
+    if behaviour_count > 2 and config.update_steps_many is not None:
+        return config.update_steps_many
+    return config.update_steps
+
+
 def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm=True):
     """(N, O) objectives of the ObjectiveSpace `space` for `clip`'s label, over its own length or
     `frame_count` frames.
@@ -66,11 +76,17 @@ def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm
 
 
 def rollout_actions(agent, objectives, deterministic=True, generator=None):
-    """(N, O) numpy objectives -> (N, 45) numpy actions in [0, 1] from one agent rollout."""
-    batch = torch.as_tensor(objectives, dtype=torch.float32)[None]  # (1, N, O)
+    """A list of (N_i, O) numpy objectives -> the list of (N_i, 45) numpy actions in [0, 1], from one rollout
+    of the agent over all of them as a batch (one recurrent step a frame for the batch, not one an episode
+    a frame). A rollout is causal, each frame depending on earlier frames only, so a shorter episode is
+    padded at its end with its last objective and its actions cut back to its length."""
+    longest = max(len(objective) for objective in objectives)
+    padded = [np.concatenate([objective, np.repeat(objective[-1:], longest - len(objective), 0)])
+              for objective in objectives]
+    batch = torch.as_tensor(np.stack(padded), dtype=torch.float32)  # (B, longest, O)
     with torch.no_grad():
-        actions = agent.rollout(batch, deterministic=deterministic, generator=generator)  # (1, N, 45)
-    return actions[0].double().numpy()
+        actions = agent.rollout(batch, deterministic=deterministic, generator=generator)  # (B, longest, 45)
+    return [action[:len(objective)].double().numpy() for action, objective in zip(actions, objectives, strict=True)]
 
 
 def gradient_step(agent, optimizer, batch, config, bounds):
@@ -79,7 +95,7 @@ def gradient_step(agent, optimizer, batch, config, bounds):
     optimizer.zero_grad(set_to_none=True)
     losses["total"].backward()
     if getattr(config, "grad_clip", None):
-        torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip)
+        torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip, foreach=True)
     optimizer.step()
     return losses
 
@@ -106,8 +122,10 @@ class Trainer:
         #: C of the update steps: the config's for one or two behaviours, in proportion beyond
         #: (chunks_per_update), so each behaviour keeps the chunks it has beside one other.
         self.chunk_count = chunks_per_update(train_config.chunk_count, len(self.clip_groups))
+        #: T of the update steps: the config's for one or two behaviours, its update_steps_many beyond.
+        self.update_steps = updates_per_epoch(train_config, len(self.clip_groups))
         self.references = references or ClipReferences(env)
-        self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
+        self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate, foreach=True)
         self.buffer = EpisodeBuffer()
         self.rng = np.random.default_rng(seed)
         self.decks = [[] for _ in self.clip_groups]  # per group: clip indices still to draw this pass
@@ -146,8 +164,7 @@ class Trainer:
                         clip.behaviour, clip.arm, self._random_direction(group, clip.arm), len(clip.rotvecs)))
                     imitated.append(False)
         self.agent.eval()
-        actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
-                   for o in objectives]
+        actions = rollout_actions(self.agent, objectives, deterministic=False, generator=self.rollout_generator)
         rotvecs = spaces.decode_action(np.concatenate(actions), self.bounds)  # (sum F, 15, 3)
         descriptions = np.asarray(self.env.evaluate(rotvecs).descriptions)  # (sum F, 42)
         ends = np.cumsum([len(a) for a in actions])[:-1]
@@ -203,13 +220,13 @@ class Trainer:
             group["lr"] = self.learning_rate()
         self.agent.train()
         totals = {}
-        for _ in range(config.update_steps):
+        for _ in range(self.update_steps):
             batch = self.buffer.sample_chunks(self.chunk_count, config.chunk_length, self.rng,
                                               config.random_target_weight, config.last_frame_share)
             losses = gradient_step(self.agent, self.optimizer, batch, config, self.bounds)
             for name, value in losses.items():
                 totals[name] = totals.get(name, 0.0) + float(value.detach())
-        return {name: value / config.update_steps for name, value in totals.items()}
+        return {name: value / self.update_steps for name, value in totals.items()}
 
     def run_epoch(self):
         """One iteration of Algorithm 1; appends and returns its metrics."""

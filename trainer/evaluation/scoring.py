@@ -37,7 +37,7 @@ def select_clips(clips, trained, count=None):
 
 def generate_descriptions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUNDS):
     """Deterministic rollouts for a list of (N_i, O) objectives -> list of (N_i, 42) descriptions."""
-    actions = [rollout_actions(agent, objective, deterministic=True) for objective in objectives]
+    actions = rollout_actions(agent, objectives, deterministic=True)
     rotvecs = spaces.decode_action(np.concatenate(actions), bounds)  # (sum N, 15, 3)
     descriptions = np.asarray(env.evaluate(rotvecs).descriptions)  # (sum N, 42)
     return np.split(descriptions, np.cumsum([len(a) for a in actions])[:-1])
