@@ -121,10 +121,10 @@ def section(figures: dict, load: float) -> str:
             f"{f['collect_s']:.2f} | {f['epoch_s']:.2f} | {f['run_minutes']:.1f} |" for label, f in figures.items()]
     lines = [HEADING, "",
              "CPU time of the default training's epoch, measured on its own buffer: the sample library's four "
-             f"behaviours, seed 2, after {WARM_EPOCHS} epochs of rollouts (Blender FK); each tree in worker processes "
-             f"pinned to one core, taking turns ({TURNS} each), {ROUNDS} rounds of {STEPS} update steps after a warm-up. "
-             "An update step: sample the chunks, the losses, backward, gradient clip, Adam. An epoch: T steps and "
-             "one collection of rollouts.", "",
+             f"behaviours, seed 2, after {WARM_EPOCHS} epochs of rollouts (Blender FK); each tree in worker "
+             f"processes pinned to one core, taking turns ({TURNS} each), {ROUNDS} rounds of {STEPS} update steps "
+             "after a warm-up. An update step: sample the chunks, the losses, backward, gradient clip, Adam. An "
+             "epoch: T steps and one collection of rollouts.", "",
              f"Regenerate: `{COMMAND}`", "",
              f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average "
              f"{load:.1f} at start), Python {platform.python_version()}. "
