@@ -51,8 +51,8 @@ def chunks_per_update(chunk_count, behaviour_count):
 
 def updates_per_epoch(config, behaviour_count):
     """T, the update steps of an iteration: the config's `update_steps` for one or two behaviours, and its
-    `update_steps_many` (when given) for more, whose steps are dearer (C grows with them: chunks_per_update);
-    Trainer.learning_rate lengthens each step in proportion (docs/TRAINING.md, "How long training takes")."""
+    `update_steps_many` (when given) for more, whose steps are dearer (C grows with them: chunks_per_update;
+    docs/TRAINING.md, "How long training takes")."""
     if behaviour_count > 2 and config.update_steps_many is not None:
         return config.update_steps_many
     return config.update_steps
@@ -205,16 +205,13 @@ class Trainer:
 
     def learning_rate(self):
         """This epoch's Adam step size: cosine from learning_rate down to learning_rate_final over the
-        planned epochs, or constant when the config or the trainer gives no final rate or no length. With
-        fewer update steps than the config's `update_steps` (more than two behaviours: updates_per_epoch),
-        every step size grows in proportion, so that a run's steps add up to the same length."""
+        planned epochs, or constant when the config or the trainer gives no final rate or no length."""
         config = self.train_config
-        scale = config.update_steps / self.update_steps
         final = config.learning_rate_final
         if final is None or not self.epochs:
-            return scale * config.learning_rate
+            return config.learning_rate
         progress = min(self.epoch / self.epochs, 1.0)
-        return scale * (final + (config.learning_rate - final) * 0.5 * (1.0 + math.cos(math.pi * progress)))
+        return final + (config.learning_rate - final) * 0.5 * (1.0 + math.cos(math.pi * progress))
 
     def update(self):
         """Step 3: T gradient steps on C chunks of L frames; returns each loss's mean over the steps."""

@@ -50,7 +50,7 @@ class TrainConfig:
     epochs_single: int = 50  # iterations of Algorithm 1 for one behaviour (the paper's 50)
     epochs_both: int = 100  # ... and for two or more behaviours (the paper's 100)
     update_steps: int = 120  # T: model updates per iteration for one or two behaviours
-    update_steps_many: int | None = 76  # T for more than two behaviours (None: update_steps; updates_per_epoch)
+    update_steps_many: int | None = 80  # T for more than two behaviours (None: update_steps; updates_per_epoch)
     chunk_count: int = 32  # C: chunks per update for one or two behaviours (n > 2: C * n / 2, chunks_per_update)
     chunk_length: int = 32  # L: frames per chunk
     learning_rate: float = 3e-3  # Adam
