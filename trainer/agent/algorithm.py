@@ -8,9 +8,9 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
        objectives only (it self-describes with its portrayal model), so the whole rollout can be
        computed before the environment is asked for the real descriptions d'_t. Each episode
        (o, a, d', m, FK of m) is appended to the buffer;
-    3. run T update steps, each on C random chunks of L frames (beyond two behaviours C grows with them,
-       chunks_per_update, and T is the config's update_steps_many, updates_per_epoch), with Adam on the
-       description, KL and pose terms (the paper's L1 + L2 + L3).
+    3. run T update steps, each on C random chunks of L frames (beyond two behaviours the config's
+       update_steps_many and chunk_count_many: epoch_updates), with Adam on the description, KL and pose
+       terms (the paper's L1 + L2 + L3).
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
 that they explore and stay reproducible; evaluation rolls out deterministically. With
 `average_last_epochs` N, the agent that is evaluated and exported (`played_agent`) is the mean of the
@@ -49,13 +49,15 @@ def chunks_per_update(chunk_count, behaviour_count):
     return int(math.ceil(chunk_count * max(behaviour_count, 2) / 2))
 
 
-def updates_per_epoch(config, behaviour_count):
-    """T, the update steps of an iteration: the config's `update_steps` for one or two behaviours, and its
-    `update_steps_many` (when given) for more, whose steps are dearer (C grows with them: chunks_per_update;
-    docs/TRAINING.md, "How long training takes")."""
-    if behaviour_count > 2 and config.update_steps_many is not None:
-        return config.update_steps_many
-    return config.update_steps
+def epoch_updates(config, behaviour_count):
+    """(T, C): an iteration's update steps and each step's chunks. For one or two behaviours the config's
+    `update_steps` and `chunk_count`; for more, its `update_steps_many` and `chunk_count_many` where given,
+    else those and chunks_per_update (docs/TRAINING.md, "The default preset")."""
+    steps, chunks = config.update_steps, chunks_per_update(config.chunk_count, behaviour_count)
+    if behaviour_count > 2:
+        steps = config.update_steps if config.update_steps_many is None else config.update_steps_many
+        chunks = chunks if config.chunk_count_many is None else config.chunk_count_many
+    return steps, chunks
 
 
 def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm=True):
@@ -119,11 +121,9 @@ class Trainer:
         self.rhythm_model = None
         if waves and train_config.wave_rhythm:
             self.rhythm_model = wave_rhythm.fit_rhythm_model(waves)
-        #: C of the update steps: the config's for one or two behaviours, in proportion beyond
-        #: (chunks_per_update), so each behaviour keeps the chunks it has beside one other.
-        self.chunk_count = chunks_per_update(train_config.chunk_count, len(self.clip_groups))
-        #: T of the update steps: the config's for one or two behaviours, its update_steps_many beyond.
-        self.update_steps = updates_per_epoch(train_config, len(self.clip_groups))
+        #: T update steps an iteration of C chunks each: the config's for one or two behaviours, its
+        #: "many" ones beyond (epoch_updates).
+        self.update_steps, self.chunk_count = epoch_updates(train_config, len(self.clip_groups))
         self.references = references or ClipReferences(env)
         self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate, foreach=True)
         self.buffer = EpisodeBuffer()

@@ -50,8 +50,9 @@ class TrainConfig:
     epochs_single: int = 50  # iterations of Algorithm 1 for one behaviour (the paper's 50)
     epochs_both: int = 100  # ... and for two or more behaviours (the paper's 100)
     update_steps: int = 120  # T: model updates per iteration for one or two behaviours
-    update_steps_many: int | None = 80  # T for more than two behaviours (None: update_steps; updates_per_epoch)
-    chunk_count: int = 32  # C: chunks per update for one or two behaviours (n > 2: C * n / 2, chunks_per_update)
+    update_steps_many: int | None = 99  # T for more than two behaviours (None: update_steps; epoch_updates)
+    chunk_count: int = 32  # C: chunks per update for one or two behaviours
+    chunk_count_many: int | None = 48  # C for more than two behaviours (None: C * n / 2, chunks_per_update)
     chunk_length: int = 32  # L: frames per chunk
     learning_rate: float = 3e-3  # Adam
     learning_rate_final: float | None = 1e-4  # cosine decay to this over the run's epochs (None: constant)
@@ -91,7 +92,7 @@ def _known_fields(cls, values):
 
 _DEFAULT_TRAIN = TrainConfig()
 #: What the debug and paper presets keep of the first defaults (issue 10 and 27's choices came after them).
-_FIRST_TRAIN = dict(update_steps_many=None, learning_rate=1e-3, learning_rate_final=None, wrist_scale=0.0,
+_FIRST_TRAIN = dict(update_steps_many=None, chunk_count_many=None, learning_rate=1e-3, learning_rate_final=None, wrist_scale=0.0,
                     random_targets=1, random_target_margin_deg=0.0, random_target_weight=1.0)
 PRESETS = {
     "debug": (

@@ -9,7 +9,7 @@ from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint, pointing
 from trainer.agent.algorithm import (Trainer, chunks_per_update, clip_objective, clips_for_behaviour,
-                                     rollout_actions, updates_per_epoch)
+                                     epoch_updates, rollout_actions)
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
@@ -159,18 +159,19 @@ def test_every_behaviour_keeps_the_chunks_and_random_targets_it_has_beside_one_o
 
 def test_more_than_two_behaviours_make_fewer_update_steps(env, library):
     default = load_preset("default")[1]
-    assert [updates_per_epoch(default, n) for n in (1, 2, 3, 4)] == [120, 120, 80, 80]
-    assert [updates_per_epoch(replace(default, update_steps_many=None), n) for n in (2, 4)] == [120, 120]
+    assert [epoch_updates(default, n) for n in (1, 2, 3, 4)] == [(120, 32), (120, 32), (99, 48), (99, 48)]
+    unset = replace(default, update_steps_many=None, chunk_count_many=None)
+    assert [epoch_updates(unset, n) for n in (2, 4)] == [(120, 32), (120, 64)]
     agent_config, train_config = load_preset("debug")
     clips = _four_behaviours(library)
     agent = RLAnimateAgent(agent_config, "rlanimate", library_space(clips))
-    trainer = Trainer(agent, env, clips, replace(train_config, update_steps_many=2), "all", seed=1)
+    trainer = Trainer(agent, env, clips, replace(train_config, update_steps_many=2, chunk_count_many=5), "all", seed=1)
     steps = []
     trainer.optimizer.step = lambda: steps.append(1)  # count the update steps of an epoch
     trainer.run_epoch()
-    assert trainer.update_steps == 2 and len(steps) == 2
+    assert trainer.update_steps == 2 and len(steps) == 2 and trainer.chunk_count == 5
     pair = Trainer(RLAnimateAgent(agent_config), env, library.train, replace(train_config, update_steps_many=2), "both")
-    assert pair.update_steps == 3
+    assert (pair.update_steps, pair.chunk_count) == (3, train_config.chunk_count)
 
 
 def test_a_batched_rollout_is_each_episodes_own_rollout(library):
