@@ -148,7 +148,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as folder:
         if args.against:
             trees = {f"{args.against} (before)": unpack(args.against, Path(folder)), **trees}
-        results = {label: [] for label in trees}
+        results: dict[str, list[dict]] = {label: [] for label in trees}
         for _ in range(TURNS):
             for label, tree in trees.items():
                 results[label].append(run_worker(tree))

@@ -34,7 +34,6 @@ from torch.distributions import Beta, Independent, Normal
 
 from rlanimate_addon.core import agent_file, spaces
 from rlanimate_addon.core.errors import RLAnimateError
-
 from trainer.agent import losses as loss_terms
 from trainer.agent import unroll
 
@@ -54,7 +53,7 @@ class MLP(nn.Module):
     def __init__(self, inputs, hidden, layers, outputs):
         super().__init__()
         widths = [inputs] + [hidden] * layers + [outputs]
-        self.layers = nn.ModuleList(nn.Linear(n_in, n_out) for n_in, n_out in zip(widths[:-1], widths[1:]))
+        self.layers = nn.ModuleList(nn.Linear(n_in, n_out) for n_in, n_out in zip(widths[:-1], widths[1:], strict=True))
 
     def forward(self, x):
         for layer in self.layers[:-1]:
@@ -73,7 +72,7 @@ class RLAnimateAgent(nn.Module):
         c = self.config = agent_config
         self.variant = variant
         self.space = space
-        O, D, A = space.size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
+        O, D, A = space.size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE  # noqa: E741 (the paper's sizes)
         E, Z, hid, n = c.behaviour_size, c.stochastic_size, c.hidden_size, c.hidden_layers
         self.uses_portrayal = agent_file.uses_portrayal(variant)
         self.uses_task_state = agent_file.uses_task_state(variant)

@@ -87,7 +87,7 @@ class NearestClip:
             if id(clip) not in self._tempos:
                 self._tempos[id(clip)] = clip_tempo(clip)
         tempos = [self._tempos[id(c)] for c in candidates]
-        swinging = [(c, t) for c, t in zip(candidates, tempos) if t is not None]
+        swinging = [(c, t) for c, t in zip(candidates, tempos, strict=True) if t is not None]
         if not swinging:
             return min(candidates, key=lambda c: abs(float(np.ravel(c.attributes)[0]) - exaggeration))
         values = np.array([[float(np.ravel(c.attributes)[0]), np.log(t)] for c, t in swinging])  # (K, 2)

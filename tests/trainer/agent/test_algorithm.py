@@ -8,8 +8,14 @@ import torch
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint, pointing
-from trainer.agent.algorithm import (Trainer, chunks_per_update, clip_objective, clips_for_behaviour,
-                                     epoch_updates, rollout_actions)
+from trainer.agent.algorithm import (
+    Trainer,
+    chunks_per_update,
+    clip_objective,
+    clips_for_behaviour,
+    epoch_updates,
+    rollout_actions,
+)
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
@@ -108,7 +114,7 @@ def test_collect_stores_real_descriptions_and_clip_motion(env, library):
     drawn = trainer.collect()
     assert len(trainer.buffer) == 2 + train_config.random_targets
     assert [c.behaviour for c in drawn] == ["POINT", "WAVE"] + ["POINT"] * train_config.random_targets
-    for k, (clip, episode) in enumerate(zip(drawn, trainer.buffer.episodes)):
+    for k, (clip, episode) in enumerate(zip(drawn, trainer.buffer.episodes, strict=True)):
         imitated = k < 2
         assert np.all(episode["imitate"] == float(imitated))
         if imitated:
@@ -148,7 +154,9 @@ def test_every_behaviour_keeps_the_chunks_and_random_targets_it_has_beside_one_o
     assert trainer.chunk_count == 2 * train_config.chunk_count
     drawn = trainer.collect()
     assert [c.behaviour for c in drawn] == ["POINT", "WAVE", "GUIDE", "RAISE"] + ["POINT"] * 3 + ["GUIDE"] * 3
-    for clip, episode in zip(drawn[4:], trainer.buffer.episodes[4:]):  # each within its own behaviour's range
+    for clip, episode in zip(
+        drawn[4:], trainer.buffer.episodes[4:], strict=True
+    ):  # each within its own behaviour's range
         direction = episode["objective"][0, spaces.OBJECTIVE_ATTRIBUTES]
         side = 1.0 if clip.arm == "LEFT" else -1.0
         if clip.behaviour == "GUIDE":  # the guides' range: straight to the arm's side, widened by the margin

@@ -36,7 +36,10 @@ def test_parameters_match_the_agent_file_layout(variant):
     config, _ = load_preset("debug")
     agent = RLAnimateAgent(config, variant)
     shapes = {name: tuple(t.shape) for name, t in agent.state_dict().items()}
-    expected = {name: tuple(s) for name, s in agent_file.expected_weight_shapes(config.to_dict(), variant, agent.space.size).items()}
+    expected = {
+        name: tuple(s)
+        for name, s in agent_file.expected_weight_shapes(config.to_dict(), variant, agent.space.size).items()
+    }
     assert shapes == expected
 
 
@@ -146,8 +149,8 @@ def test_presets_and_config_round_trip():
 
 def test_train_configs_defaults_are_the_default_preset_and_debug_and_paper_keep_the_first_ones():
     assert load_preset("default")[1] == TrainConfig()
-    first = {"update_steps_many": None, "chunk_count_many": None, "learning_rate": 1e-3, "learning_rate_final": None, "wrist_scale": 0.0,
-             "random_targets": 1, "random_target_margin_deg": 0.0, "random_target_weight": 1.0}
+    first = {"update_steps_many": None, "chunk_count_many": None, "learning_rate": 1e-3, "learning_rate_final": None,
+             "wrist_scale": 0.0, "random_targets": 1, "random_target_margin_deg": 0.0, "random_target_weight": 1.0}
     for name in ("debug", "paper"):
         assert {key: getattr(load_preset(name)[1], key) for key in first} == first
 

@@ -59,7 +59,9 @@ def test_relaxed_hand_curls_the_fingers_towards_the_palm():
     relaxed = realmocap_takes.relaxed_hand(MotionClip("c", "", 30.0, np.zeros((3, len(skeleton.ACTION_JOINTS), 3))))
     for side in ("Left", "Right"):
         index1 = relaxed.rotvecs[:, skeleton.ACTION_JOINTS.index(side + "HandIndex1")]
-        pose = kinematics.pose_matrices({side + "HandIndex1": index1[0], **{k: v[0] for k, v in relaxed.fingers.items()}})
+        pose = kinematics.pose_matrices(
+            {side + "HandIndex1": index1[0], **{k: v[0] for k, v in relaxed.fingers.items()}}
+        )
         heads = kinematics.head_positions(pose)
         for finger in ("Index", "Pinky"):
             base = heads[kinematics.bone_index(f"{side}Hand{finger}1")]
