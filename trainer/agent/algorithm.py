@@ -19,6 +19,7 @@ rollouts keep using the weights being trained.
 """
 import math
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -30,6 +31,10 @@ from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
 from trainer.motion.clip import trained_behaviours
 from trainer.motion.fk import ClipReferences
+
+if TYPE_CHECKING:
+    from trainer.agent.config import TrainConfig
+    from trainer.agent.models import RLAnimateAgent
 
 
 def clips_for_behaviour(clips, behaviour, space):
@@ -49,7 +54,7 @@ def chunks_per_update(chunk_count, behaviour_count):
     return int(math.ceil(chunk_count * max(behaviour_count, 2) / 2))
 
 
-def epoch_updates(config, behaviour_count):
+def epoch_updates(config: "TrainConfig", behaviour_count: int) -> tuple[int, int]:
     """(T, C): an iteration's update steps and each step's chunks. For one or two behaviours the config's
     `update_steps` and `chunk_count`; for more, its `update_steps_many` and `chunk_count_many` where given,
     else those and chunks_per_update (docs/TRAINING.md, "The default preset")."""
@@ -77,7 +82,8 @@ def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm
     return space.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
 
 
-def rollout_actions(agent, objectives, deterministic=True, generator=None):
+def rollout_actions(agent: "RLAnimateAgent", objectives: list[np.ndarray], deterministic: bool = True,
+                    generator: torch.Generator | None = None) -> list[np.ndarray]:
     """A list of (N_i, O) numpy objectives -> the list of (N_i, 45) numpy actions in [0, 1], from one rollout
     of the agent over all of them as a batch (one recurrent step a frame for the batch, not one an episode
     a frame). A rollout is causal, each frame depending on earlier frames only, so a shorter episode is

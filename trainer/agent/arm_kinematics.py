@@ -7,6 +7,7 @@ the number of torch calls, not their arithmetic.
 """
 import numpy as np
 import torch
+from torch import Tensor
 
 from rlanimate_addon.core import kinematics, skeleton, spaces
 
@@ -15,7 +16,7 @@ _REST = skeleton.rest_matrices()
 _FINGER_BONES = 4
 
 
-def _chain(arm):
+def _chain(arm: str) -> list[int]:
     """Bone indices from the root to the arm's index fingertip (HandIndex4), parents first."""
     index = kinematics.bone_index(skeleton.ARM_PREFIX[arm] + "HandIndex4")
     chain = []
@@ -26,7 +27,7 @@ def _chain(arm):
     return chain[::-1]
 
 
-def arm_indices(objectives):
+def arm_indices(objectives: Tensor) -> Tensor:
     """(N,) long: the arm, as its index in skeleton.ARMS, that each objective (N, O) names."""
     return objectives[..., spaces.OBJECTIVE_ARM].argmax(-1)
 
@@ -40,8 +41,9 @@ class ArmKinematics:
     rotations in one batched call (Rodrigues), then composes them down the chain.
     """
 
-    def __init__(self):
-        locals_, columns = [], []
+    def __init__(self) -> None:
+        locals_: list[list[np.ndarray]] = []
+        columns: list[list[int | None]] = []
         for arm in skeleton.ARMS:
             chain = _chain(arm)
             locals_.append([_REST[i] if k == 0 else np.linalg.inv(_REST[chain[k - 1]]) @ _REST[i]
@@ -67,17 +69,19 @@ class ArmKinematics:
             tips.append(tip / np.linalg.norm(tip))
         self._tips = torch.as_tensor(np.array(tips))  # (2, 3) unit
 
-    def finger(self, rotvecs, arms):
+    def finger(self, rotvecs: Tensor, arms: Tensor) -> tuple[Tensor, Tensor]:
         """rotvecs (N, 15, 3), arms (N,) (indices in skeleton.ARMS) -> each frame's index base (N, 3) and unit
         finger direction (N, 3)."""
         rotation, base = self._down_chain(rotvecs, arms, self.base, with_rotation=True)
+        assert rotation is not None  # asked for
         return base, (rotation @ self._tips.to(rotvecs.dtype)[arms, :, None])[..., 0]
 
-    def wrist(self, rotvecs, arms):
+    def wrist(self, rotvecs: Tensor, arms: Tensor) -> Tensor:
         """rotvecs (N, 15, 3), arms (N,) -> each frame's wrist (its arm's Hand bone's head) (N, 3)."""
         return self._down_chain(rotvecs, arms, self.base - 1, with_rotation=False)[1]
 
-    def _down_chain(self, rotvecs, arms, last, with_rotation):
+    def _down_chain(self, rotvecs: Tensor, arms: Tensor, last: int,
+                    with_rotation: bool) -> tuple[Tensor | None, Tensor]:
         """(world rotation (N, 3, 3) or None, head (N, 3)) of chain bone `last` of each frame's arm; the
         rotation includes the bone's own turn."""
         rest = self._rotations.to(rotvecs.dtype)[arms]  # (N, K, 3, 3)
@@ -93,7 +97,7 @@ class ArmKinematics:
         return (rotation if with_rotation else None), position
 
 
-def _rotvec_to_matrix(rotvec):
+def _rotvec_to_matrix(rotvec: Tensor) -> Tensor:
     """(..., 3) rotation vectors -> (..., 3, 3) matrices (Rodrigues), smooth at zero."""
     angle2 = (rotvec * rotvec).sum(-1, keepdim=True)[..., None]  # (..., 1, 1)
     angle = torch.sqrt(angle2 + 1e-12)
@@ -104,7 +108,7 @@ def _rotvec_to_matrix(rotvec):
     return eye + torch.sin(angle) / angle * cross + (1 - torch.cos(angle)) / (angle2 + 1e-12) * (cross @ cross)
 
 
-def action_rotvecs(actions, bounds):
+def action_rotvecs(actions: Tensor, bounds: Tensor) -> Tensor:
     """Actions (..., 45) in [0, 1] -> rotation vectors (..., 15, 3) within the action bounds (45, 2)."""
     low, high = bounds[:, 0], bounds[:, 1]
     return (low + actions * (high - low)).reshape(actions.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))

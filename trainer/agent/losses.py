@@ -134,7 +134,7 @@ def balanced_kl(posterior, prior, balance, free_nats):
     return balance * train_prior + (1.0 - balance) * train_posterior
 
 
-def concentration_nll(alpha, beta, motion):
+def concentration_nll(alpha: torch.Tensor, beta: torch.Tensor, motion: torch.Tensor) -> torch.Tensor:
     """(C, L) -log Beta(M_t) under the Beta (alpha, beta) (C, L, 45) with its mean held fixed: trains only its
     concentration alpha + beta. The Beta density written out: torch.distributions' Beta stacks its parameters
     and the pose into a Dirichlet's, which made this term 1.6x dearer (6 ms of an update step)."""

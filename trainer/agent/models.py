@@ -125,7 +125,7 @@ class RLAnimateAgent(nn.Module):
         """Animation model: features (..., F) -> Beta over the action (..., 45)."""
         return Independent(Beta(*self.policy_concentrations(features), validate_args=False), 1, validate_args=False)
 
-    def policy_concentrations(self, features):
+    def policy_concentrations(self, features: torch.Tensor) -> tuple[torch.Tensor, ...]:
         """The animation model's Beta parameters (alpha, beta), each (..., 45), from features (..., F)."""
         concentrations = self.config.concentration_floor + \
             self.config.concentration_scale * F.softplus(self.animation(features))  # (..., 90)

@@ -21,11 +21,19 @@ The behaviour model's frame t, from e_{t-1} and z_{t-1} (e_0 = z_0 = 0):
     x         = posterior_inputs_t + e_t W_e^T, then x = tanh(x) W_k^T + b_k for each later layer k
     mean, raw = x split in two;  std = softplus(raw) + min_std;  z_t = mean + noise_t * std
 """
+from typing import Any
+
 import torch
 import torch.nn.functional as F
+from torch import Tensor
+
+#: What a GRU step keeps for its backward: r and u (C, 2E), n (C, E) and the new part of q (C, E).
+GruKept = tuple[Tensor, Tensor, Tensor]
 
 
-def posterior_unroll(input_gates, posterior_inputs, noise, weight_z, weight_hh, bias_hh, weight_e, later, min_std):
+def posterior_unroll(input_gates: Tensor, posterior_inputs: Tensor, noise: Tensor, weight_z: Tensor, weight_hh: Tensor,
+                     bias_hh: Tensor, weight_e: Tensor, later: list[tuple[Tensor, Tensor]],
+                     min_std: float) -> tuple[Tensor, Tensor, Tensor, Tensor]:
     """(e (C, L, E), z (C, L, Z), mean (C, L, Z), std (C, L, Z)) of the behaviour model's unroll above.
 
     input_gates (C, L, 3E): the GRU input gates without z_{t-1}'s part; posterior_inputs (C, L, H): the
@@ -38,7 +46,7 @@ def posterior_unroll(input_gates, posterior_inputs, noise, weight_z, weight_hh, 
                                   float(min_std), *flat)
 
 
-def _gru_step(gates_in, hidden, weight_hh, bias_hh):
+def _gru_step(gates_in: Tensor, hidden: Tensor, weight_hh: Tensor, bias_hh: Tensor) -> tuple[Tensor, GruKept]:
     """(h_t, (r and u, n, the new part of q)) of a GRU step: the state and what its backward needs."""
     size = hidden.shape[1]
     gates_hid = torch.addmm(bias_hh, hidden, weight_hh.t())
@@ -48,7 +56,7 @@ def _gru_step(gates_in, hidden, weight_hh, bias_hh):
     return n + rz[:, size:] * (hidden - n), (rz, n, new_hid)
 
 
-def _gru_step_backward(d_hidden, hidden_prev, kept):
+def _gru_step_backward(d_hidden: Tensor, hidden_prev: Tensor, kept: GruKept) -> tuple[Tensor, Tensor, Tensor]:
     """(dL/dg, dL/dq, the part of dL/dh_{t-1} that does not pass through q) of a GRU step, from dL/dh_t
     and the step's h_{t-1} and kept values; dL/dh_{t-1} is that part plus dL/dq W_hh."""
     rz, n, new_hid = kept
@@ -58,18 +66,20 @@ def _gru_step_backward(d_hidden, hidden_prev, kept):
     return torch.cat([d_rz, d_new], -1), torch.cat([d_rz, d_new * rz[:, :size]], -1), d_hidden * rz[:, size:]
 
 
-def _rows(frames):
+def _rows(frames: list[Tensor]) -> Tensor:
     """L per-frame tensors (C, k) -> (L * C, k): every frame's rows, for a gradient summed over frames."""
     return torch.cat(frames, 0)
 
 
 class _PosteriorUnroll(torch.autograd.Function):
     @staticmethod
-    def forward(ctx, input_gates, posterior_inputs, noise, weight_z, weight_hh, bias_hh, weight_e, min_std, *flat):
+    def forward(ctx: Any, input_gates: Tensor, posterior_inputs: Tensor, noise: Tensor, weight_z: Tensor,
+                weight_hh: Tensor, bias_hh: Tensor, weight_e: Tensor, min_std: float,
+                *flat: Tensor) -> tuple[Tensor, ...]:
         later = list(zip(flat[0::2], flat[1::2], strict=True))
         e = input_gates.new_zeros(input_gates.shape[0], weight_hh.shape[1])
         z = input_gates.new_zeros(input_gates.shape[0], weight_z.shape[1])
-        kept = {name: [] for name in ("e", "z", "mean", "std", "gru", "activations", "raw")}
+        kept: dict[str, list[Any]] = {name: [] for name in ("e", "z", "mean", "std", "gru", "activations", "raw")}
         for t in range(input_gates.shape[1]):
             e, gru = _gru_step(torch.addmm(input_gates[:, t], z, weight_z.t()), e, weight_hh, bias_hh)
             x = torch.addmm(posterior_inputs[:, t], e, weight_e.t())
@@ -88,13 +98,17 @@ class _PosteriorUnroll(torch.autograd.Function):
         return tuple(torch.stack(kept[name], 1) for name in ("e", "z", "mean", "std"))
 
     @staticmethod
-    def backward(ctx, grad_e, grad_z, grad_mean, grad_std):
+    def backward(ctx: Any, grad_e: Tensor, grad_z: Tensor, grad_mean: Tensor,
+                 grad_std: Tensor) -> tuple[Tensor | None, ...]:
         """Back through the frames, last first: each frame's gradients of the GRU's input and hidden gates,
         of the posterior's first layer and of each later layer's output, then every weight's gradient."""
         noise, weight_z, weight_hh, weight_e, *weights = ctx.saved_tensors
         kept = ctx.kept
         e_prev = [torch.zeros_like(kept["e"][0])] + kept["e"][:-1]
-        d_in, d_hid, d_first, d_layers = [], [], [], []
+        d_in: list[Tensor] = []  # per frame, last first: dL/d input gates (C, 3E)
+        d_hid: list[Tensor] = []  # dL/d hidden gates (C, 3E)
+        d_first: list[Tensor] = []  # dL/d the posterior's first layer's output (C, H)
+        d_layers: list[list[Tensor]] = []  # dL/d each later layer's output
         de_next, dz_next = torch.zeros_like(kept["e"][0]), torch.zeros_like(kept["z"][0])  # from frame t + 1
         for t in reversed(range(len(kept["e"]))):
             dz = grad_z[:, t] + dz_next
