@@ -34,7 +34,6 @@ ROUNDS = 5
 STEPS = 10
 TURNS = 2
 RUN_EPOCHS = 100
-BUDGET_MINUTES = 15.0
 COMMAND = "nice -n 10 python benchmarks/update_step_benchmark.py --against 58ac990"
 HEADING = "## Update step"
 
