@@ -24,7 +24,7 @@ from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
 from trainer.evaluation.baselines import AgentMethod
-from trainer.experiments.options import one_of
+from trainer.experiments.options import some_of
 from trainer.experiments.run import RunSettings, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, shown
@@ -55,7 +55,7 @@ class AblationSettings:
     results: str = str(RESULTS_DIR)  # where agent_ablation.json and .md go
     targets: int = 100  # random pointing targets per arm
     # train and measure only these (none: every ablation); the other rows stay as agent_ablation.json has them
-    only: Annotated[tuple[str, ...], one_of(ABLATIONS)] = ()
+    only: Annotated[tuple[str, ...], some_of(ABLATIONS)] = ()
     address: str | None = None  # join a Ray cluster: auto or ray://HOST:PORT (None: a local Ray)
     workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
 

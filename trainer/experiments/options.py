@@ -9,8 +9,8 @@ import tyro
 from rlanimate_addon.core.errors import RLAnimateError
 
 
-def one_of(names: Iterable[str]) -> Any:
-    """An `Annotated[tuple[str, ...], one_of(NAMES)]` marker: the field takes any of `names` on the command line,
+def some_of(names: Iterable[str]) -> Any:
+    """An `Annotated[tuple[str, ...], some_of(NAMES)]` marker: the field takes any of `names` on the command line,
     which --help lists and which refuses any other name."""
     literal: Any = Literal  # made at run time: Literal["a", "b"] from the names
     names_tuple: Any = tuple

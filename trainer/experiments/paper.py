@@ -20,7 +20,7 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.evaluation import behaviour, scoring
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.evaluation.harder_split import harder_clips
-from trainer.experiments.options import one_of, require_values
+from trainer.experiments.options import require_values, some_of
 from trainer.experiments.run import RunSettings, is_finished, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, seed_folder
@@ -40,8 +40,8 @@ class PaperSettings:
     """What the Section 4 experiments run: every (seed, variant, column) for the paper's epochs x `epoch_scale`."""
     preset: str = "default"  # config preset of every run: debug, default or paper
     epoch_scale: float = 1.0  # fraction of the paper's 50 / 100 epochs to train (CPU budget)
-    variants: Annotated[tuple[str, ...], one_of(VARIANTS)] = VARIANTS  # the variants (Table 4's rows) to train
-    columns: Annotated[tuple[str, ...], one_of(COLUMNS)] = COLUMNS  # the behaviours (Table 4's columns) to train
+    variants: Annotated[tuple[str, ...], some_of(VARIANTS)] = VARIANTS  # the variants (Table 4's rows) to train
+    columns: Annotated[tuple[str, ...], some_of(COLUMNS)] = COLUMNS  # the behaviours (Table 4's columns) to train
     clips: str = str(DEFAULT_MANIFEST)  # clip library: a manifest.json or the folder that holds one
     runs: str = str(REPO_ROOT / "runs" / "experiments")  # seed 0's runs; seed N's go to the sibling <runs>_seed<N>
     results: str = str(RESULTS_DIR)  # where table4.json and .md and the figures go

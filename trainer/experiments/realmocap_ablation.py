@@ -39,7 +39,7 @@ from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rhythm import EARLIER_TEMPO_BANDWIDTH, RhythmModel
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import swinging_check
-from trainer.experiments.options import one_of
+from trainer.experiments.options import some_of
 from trainer.experiments.realmocap import RealCaptureSettings, compare, real_run, train_real_runs, waves_and_env
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
@@ -104,7 +104,7 @@ class AblationSettings(RealCaptureSettings):
     """What the ablation runs: which experiments (EXPERIMENTS), the training seed and length of their agents. A name
     given twice counts once."""
     # which agents to train and play: wave (tested on takes 009-010), holdout (unseen styles)
-    experiments: Annotated[tuple[str, ...], one_of(EXPERIMENTS)] = ("wave", "holdout")
+    experiments: Annotated[tuple[str, ...], some_of(EXPERIMENTS)] = ("wave", "holdout")
     seed: int = 0  # the agents' training seed
     epochs: int = 50  # iterations of Algorithm 1 per agent
     preset: str = "end_chunks"  # the config preset of the agents whose play-time settings vary

@@ -26,9 +26,10 @@ def parse_settings(settings_type: type[Settings], argv: Sequence[str] | None = N
     comment the help, its default the dataclass's; a tuple takes several values (`--seeds 0 1`), a bool is a flag
     (`--skip-training`). --help shows them with `prog` and the first paragraph of the script's `doc`; a bad value
     exits with status 2 and a message, as argparse does. The dataclass checks the values it is given
-    (__post_init__ raising RLAnimateError)."""
+    (__post_init__ raising RLAnimateError). A field that is itself a settings dataclass gives its fields' options
+    without a prefix (`--epochs`, not `--run.epochs`)."""
     return tyro.cli(settings_type, args=script_args(argv), prog=prog, description=(doc or "").split("\n\n")[0],
-                    config=(tyro.conf.FlagCreatePairsOff,))
+                    config=(tyro.conf.FlagCreatePairsOff, tyro.conf.OmitArgPrefixes))
 
 
 #: What an experiment that trains its runs as Ray tasks says when it is interrupted.

@@ -126,3 +126,17 @@ def test_the_extension_never_imports_the_trainers_command_line_library():
             if any(name.split(".")[0] == "tyro" for name in names):
                 importers.append(str(path.relative_to(ROOT)))
     assert importers == []
+
+
+def test_a_nested_settings_dataclass_gives_its_options_without_a_prefix():
+    @dataclasses.dataclass(frozen=True)
+    class Run:
+        epochs: int = 50  # iterations of Algorithm 1
+
+    @dataclasses.dataclass(frozen=True)
+    class Command:
+        run: Run = Run()
+        install: bool = False  # install the agent
+
+    assert cli.parse_settings(Command, ["x", "--epochs", "3", "--install"], prog="x", doc=None) == \
+        Command(Run(epochs=3), install=True)
