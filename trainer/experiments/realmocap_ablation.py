@@ -108,7 +108,7 @@ class AblationSettings(RealCaptureSettings):
     seed: int = 0  # the agents' training seed
     epochs: int = 50  # iterations of Algorithm 1 per agent
     preset: str = "end_chunks"  # the config preset of the agents whose play-time settings vary
-    # agents trained with these presets too, played as trained and asked the tempo (preset_variants)
+    # agents trained with these presets too, played as trained and asked the tempo
     compare_presets: tuple[str, ...] = ("default",)
 
     def __post_init__(self) -> None:
