@@ -24,7 +24,7 @@ On a batch of C chunks of L frames (batch-major, from trainer/agent/buffer.py):
     policy       negative log-likelihood of the clip's pose under the Beta with its mean held fixed, so
                  only the concentrations learn: the spread of stochastic rollouts tracks the agent's
                  remaining error instead of staying at its initial value;
-    total        the sum of each term times its `*_scale`.
+    total        the sum of each term times its `*_scale` (1.0 for a term without one).
 The previous action a_{t-1} is the buffer's (the agent's own earlier rollout, teacher forced); the
 supervised variant is behaviour cloning instead: a_{t-1} is the clip's pose M_{t-1}, the description
 term's target is the clip's description, and there is no KL term. docs/AGENT.md gives the reasons.
@@ -86,8 +86,14 @@ def agent_losses(agent, batch, config, bounds=None):
     scales = {"description": config.description_scale, "kl": config.kl_scale, "pose": config.pose_scale,
               "velocity": config.velocity_scale, "wrist": config.wrist_scale,
               "portrayal": config.portrayal_scale, "pointing": config.pointing_scale, "policy": config.policy_scale}
-    terms["total"] = sum(scales[name] * value for name, value in terms.items())
+    terms["total"] = weighted_total(terms, scales)
     return terms
+
+
+def weighted_total(terms, scales):
+    """The sum of each of `terms` ({name: scalar tensor}) times its scale in `scales`; a term that has none counts
+    once (scale 1.0)."""
+    return sum(scales.get(name, 1.0) * value for name, value in terms.items())
 
 
 def of_kind(space, objective, kind):

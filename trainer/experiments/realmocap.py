@@ -48,6 +48,7 @@ from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation import baselines, scoring
 from trainer.evaluation.label_reach import label_reach
+from trainer.experiments.options import require_values
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
@@ -321,18 +322,31 @@ def _summary(result):
 
 
 @dataclass(frozen=True)
-class RealMocapSettings:
-    """What the real-capture experiments run."""
+class RealCaptureSettings:
+    """What every real-capture experiment's settings have: the capture, its runs and results, and how many of its
+    training runs at a time."""
     realmocap: str = str(REALMOCAP_DIR)  # the capture's folder (wave/, bye/, guide/)
-    epochs: int = 100  # per agent: chosen on validation takes (docs/results/realmocap_length.md; paper: 50)
-    preset: str = "end_chunks"  # docs/results/realmocap_ablation.md: the arm comes down in time
-    seeds: tuple[int, ...] = (0, 1, 2)  # the first seed's agents give the full tables and the figure
-    point_agent: str | None = None  # exported pointing agent for the guide clips (None: see point_agent_and_library)
-    runs: str = str(REALMOCAP_RUNS)
-    results: str = str(RESULTS_DIR)  # where realmocap_frames.png goes
-    import_workers: int = 1  # import the takes the cache lacks with this many Blenders at once (Ray tasks)
-    address: str | None = None  # a Ray cluster to join ("auto", "ray://HOST:PORT"); None: a local Ray
+    runs: str = str(REALMOCAP_RUNS)  # seed 0's runs and the import cache; seed N's go to <runs>_seed<N>
+    results: str = str(RESULTS_DIR)  # where the results go: JSON, a Markdown page and figures
     workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
+
+
+@dataclass(frozen=True)
+class RealMocapSettings(RealCaptureSettings):
+    """What the real-capture experiments run."""
+    # iterations of Algorithm 1 per agent (chosen on validation takes: docs/results/realmocap_length.md; paper: 50)
+    epochs: int = 100
+    preset: str = "end_chunks"  # config preset (docs/results/realmocap_ablation.md: the arm comes down in time)
+    seeds: tuple[int, ...] = (0, 1, 2)  # training seeds; the first seed's agents give the full tables and the figure
+    # exported pointing agent (.npz) for the guide clips (None: the installed agent when trained, else one trained
+    # here on the sample library)
+    point_agent: str | None = None
+    import_workers: int = 1  # import the takes the cache lacks with N Blenders at once (Ray tasks)
+    # join a Ray cluster: auto (started on this machine by ray start) or ray://HOST:PORT (None: a local Ray, no set-up)
+    address: str | None = None
+
+    def __post_init__(self) -> None:
+        require_values(self, "seeds")
 
 
 def run_experiments(settings: RealMocapSettings) -> dict:
