@@ -28,6 +28,7 @@ from trainer.blender_io import rig_session
 from trainer.cluster import connect, run_tasks
 from trainer.motion import canonicalise, clip_cache
 from trainer.motion.clip import ClipSet, MotionClip
+from trainer.motion.hands import with_hand
 from trainer.motion.manifest import ManifestEntry, checked_entries, labelled, read_manifest
 
 EXPECTED_FPS = 30.0
@@ -363,7 +364,8 @@ def _import_share(share):
 def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, progress=None, workers=1):
     """Import every clip of a directory (its manifest.json when it has one, else every .fbx/.bvh) or
     of a manifest file. Returns (clips, problems): the clips that imported, and one message per file
-    that did not. Clips listed in a manifest carry its labels. cache_dir: where imported clips are
+    that did not. Clips listed in a manifest carry its labels; a clip without finger data gets the relaxed hand
+    (motion/hands.py). cache_dir: where imported clips are
     cached (default: `.import_cache/` beside a manifest; no cache for a folder without one, so that
     shared data folders stay untouched); False imports afresh without caching. progress: a stream to
     show a progress bar on (None: no bar). workers > 1: the files the cache lacks are imported first as
@@ -391,7 +393,7 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
     for entry in tqdm(entries, desc="clips", unit="clip", file=progress, disable=progress is None, leave=False,
                       dynamic_ncols=True):
         try:
-            clip = import_clip(folder / entry.file, entry.fps, cache_dir=cache)
+            clip = with_hand(import_clip(folder / entry.file, entry.fps, cache_dir=cache))
             if manifest_path is not None:
                 clip = labelled(clip, entry, manifest_path)
             clips.append(clip)

@@ -50,8 +50,9 @@ from trainer.evaluation.label_reach import label_reach
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
+from trainer.motion.hands import relaxed_hand
 from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, TAKE_GROUPS,
-                                            parse_name, relaxed_hand, require_realmocap, style_holdout_split,
+                                            parse_name, require_realmocap, style_holdout_split,
                                             take_group, take_paths, wave_split)
 from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
                            shown)

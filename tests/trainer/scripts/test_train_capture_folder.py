@@ -1,0 +1,60 @@
+"""`trainer/train.py --clips FOLDER` on a folder of takes without a manifest: the labels table, the editable
+manifest, the hold-out by take, training, and the comparison with retrieval on the held-out takes, both requests."""
+import json
+import shutil
+
+import pytest
+
+from trainer.experiments import capture
+from trainer.paths import CLIP_DIR, REALMOCAP_DIR
+from trainer.scripts import train
+
+#: Twelve takes of the sample library: three per behaviour and arm, labelled only by their names and motion here.
+TAKES = [f"{behaviour}_{arm}_{k:03d}.fbx" for behaviour in ("point", "wave") for arm in ("left", "right")
+         for k in range(3)]
+
+
+def test_a_folder_of_takes_is_labelled_held_out_trained_and_compared_with_retrieval(tmp_path, capsys):
+    folder, output = tmp_path / "takes", tmp_path / "run"
+    folder.mkdir()
+    for name in TAKES:
+        shutil.copy(CLIP_DIR / name, folder / name)
+    assert train.main(["train.py", "--clips", str(folder), "--output", str(output), "--preset", "debug", "--epochs",
+                       "2", "--eval-every", "0", "--quiet"]) == 0
+    shown = capsys.readouterr()
+    assert "| take | behaviour (kind) | arm | label | tempo | frames | split | notes |" in shown.out
+    assert f"edit it and train on it with --clips {output / 'manifest.json'}" in shown.err
+    written = json.loads((output / "manifest.json").read_text())["clips"]
+    assert [entry["behaviour"] for entry in written] == ["POINT"] * 6 + ["WAVE"] * 6
+    assert all(entry["arm"] == ("LEFT" if "_left_" in entry["file"] else "RIGHT") for entry in written)
+    assert all(0.0 <= entry["exaggeration"] <= 1.0 and entry["tempo_hz"] > 1.0 for entry in written[6:])
+    held = [entry["file"].rsplit("/", 1)[1] for entry in written if entry["split"] == "test"]
+    assert len(held) == 4 and {name.rsplit("_", 1)[0] for name in held} == {
+        "point_left", "point_right", "wave_left", "wave_right"}, "one of each behaviour and arm's three"
+    report = json.loads((output / "capture_report.json").read_text())
+    assert (report["training_takes"], report["held_out_takes"], report["run"]["preset"]) == (8, 4, "debug")
+    assert set(report["behaviours"]) == {"point", "wave"}
+    assert set(report["behaviours"]["point"]) == {"paper"} and set(report["behaviours"]["wave"]) == {"paper", "tempo"}
+    for requests in report["behaviours"].values():
+        for methods in requests.values():
+            assert set(methods) == {"rlanimate", "nearest_clip"}
+            assert sorted(c["name"] for c in methods["rlanimate"]["clips"]) == sorted(
+                c["name"] for c in methods["nearest_clip"]["clips"]) and len(methods["rlanimate"]["clips"]) == 2
+    page = (output / "capture_report.md").read_text()
+    assert "| wave | tempo asked | 2 |" in page and "| point | label only (the paper's) | 2 |" in page
+    assert "## Labels" in page and "wave_right_000.fbx" in page
+
+
+@pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(), reason=f"the real capture is not at {REALMOCAP_DIR}")
+def test_real_takes_are_labelled_as_waves_of_the_arm_their_names_give(tmp_path):
+    folder = tmp_path / "wave"
+    folder.mkdir()
+    for name in ("dataset-2_wave-left-hand_feminine_001.bvh", "dataset-2_wave-right-hand_active_002.bvh",
+                 "dataset-2_wave-right-hand_masculine_003.bvh"):
+        (folder / name).symlink_to(REALMOCAP_DIR / "wave" / name)
+    labelled = capture.label_folder(str(folder), str(tmp_path / "run"), share=0.0)
+    labels = {label.name.split("_")[2]: label for label in labelled.labels}
+    assert [(label.behaviour, label.arm, label.notes) for label in labels.values()] == [
+        ("WAVE", "LEFT", []), ("WAVE", "RIGHT", []), ("WAVE", "RIGHT", [])]
+    assert labels["feminine"].exaggeration < 0.2 < 0.9 < labels["active"].exaggeration
+    assert 0.6 < labels["masculine"].tempo < 1.6 and labels["active"].tempo > 1.5
