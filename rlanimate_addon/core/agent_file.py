@@ -415,6 +415,10 @@ def _check_metadata_values(path, metadata):
                                  f"+-{MAX_RHYTHM_VALUE:g} (exaggerations, wave frequencies and fractions of a "
                                  f"gesture are small numbers): re-export it with trainer/agent/agent_export.py.")
         rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
+    still = metadata.get("still_free_arm", [])
+    if not isinstance(still, list) or any(not isinstance(b, str) or b not in space.names for b in still):
+        raise RLAnimateError(f"The agent file {path} has an invalid still_free_arm (need a list of the behaviours, "
+                             f"among {', '.join(space.names)}, whose free arm the gesture holds still): re-export it.")
     return {name: tuple(shape) for name, shape in expected.items()}
 
 

@@ -516,13 +516,21 @@ def played_finger_base(canonical, arm):
     return aim.finger_lines(played, arm)[1]
 
 
+def free_arm_columns(names, arm):
+    """The columns of `names` (canonical roles) that are the joints of the arm other than `arm`, collar to index
+    base."""
+    side = skeleton.ARM_PREFIX["RIGHT" if arm == "LEFT" else "LEFT"]
+    return [k for k, name in enumerate(names) if name in skeleton.ACTION_JOINTS and name.startswith(side)]
+
+
 def gesture_rotations(agent, request, rig):
     """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
 
     request: a GestureRequest. rig: a RigState (the rig's bones, roles and the pose underneath).
     `underneath` is the rotation each bone would have without the gesture (its animation, else its
-    pose), which a Combine layer needs. Every RLAnimateError is raised before anything is returned,
-    so callers can write all or nothing.
+    pose), which a Combine layer needs. For a behaviour whose free arm has no part in it (the agent's
+    `still_free_arm`), that arm stays where the gesture starts from on every frame. Every RLAnimateError is
+    raised before anything is returned, so callers can write all or nothing.
     """
     rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
     rest_heads = rig.rest_heads
@@ -568,6 +576,9 @@ def gesture_rotations(agent, request, rig):
     if len(names) > joints:  # the hand shape retargeted once
         held = retarget(hand, conversions[joints:], parent_conversions[joints:])  # (1, H, 4)
         played = np.concatenate([played, np.broadcast_to(held, (len(played),) + held.shape[1:])], axis=1)
+    if request.behaviour in agent.still_free_arm:  # the other arm has no part in it: it stays where it was
+        free = free_arm_columns(names, request.arm)
+        played[:, free] = start[:, free]
     keyed = blend_from_pose(start, played, blend_weights(request.frame_count))
     if targeted:  # the eyes look at the target; Point's finger is aimed exactly on the rig
         phase = aim.pointing_phase(phase_base)

@@ -130,6 +130,9 @@ class GestureAgent:
         #: agent was not trained for gets the mean of the others, so the UI always has a default.
         self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values()))))
                                for b in self.space.names}
+        #: The behaviours whose free arm has no part in them (their training clips leave it still): a gesture of
+        #: one holds that arm where it was (core/gesture.py). Files exported before it was kept hold none.
+        self.still_free_arm = frozenset(metadata.get("still_free_arm", ()))
         rhythm_values = metadata.get("wave_rhythm")
         #: The training waves' rhythms (core/rhythm.py), or None for an agent trained on the paper's objective.
         self.rhythm_model = None if rhythm_values is None else rhythm.RhythmModel.from_dict(rhythm_values)

@@ -20,6 +20,7 @@ class ReplayAgent:
     action_bounds = spaces.DEFAULT_ACTION_BOUNDS
     average_frames = {"POINT": 50, "WAVE": 80}
     space = spaces.PAPER_SPACE
+    still_free_arm = frozenset()
 
     def kind(self, behaviour):
         return self.space.kind(behaviour)
@@ -416,3 +417,28 @@ def test_a_rig_whose_pose_underneath_stands_still_reads_as_still_and_one_that_mo
     assert moving.standing_still(values) is None
     turning = dict(values, RightArm=values["RightArm"] + np.array([[0.0, 0.0, 1e-4, 0.0]]) * np.arange(count)[:, None])
     assert animated.standing_still(turning) is None
+
+
+@pytest.mark.parametrize("animated", [False, True])
+def test_a_behaviour_whose_free_arm_has_no_part_keeps_that_arm_where_it_was(animated):
+    """An agent whose training clips left the free arm still (`still_free_arm`) plays the gesture with that arm's
+    joints held at the pose the gesture starts from (the pose underneath, or the standing pose on a still rig at
+    rest) on every frame, whatever its own output for them; the gesturing arm still moves; other behaviours and
+    agents are played as before."""
+    frames = 40
+    agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(frames, spaces.ACTION_SIZE)))
+    rig = _animated(gesture.canonical_rig(), frames) if animated else gesture.canonical_rig()
+    _, played, _ = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    agent.still_free_arm = frozenset({"WAVE"})
+    names, held, under = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    free = gesture.free_arm_columns(names, "RIGHT")
+    assert [names[k] for k in free] == ["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1"]
+    start = under if animated else np.broadcast_to(
+        [rotvec_to_quat(gesture.STANDING_POSE.get(names[k], np.zeros(3))) for k in free], (frames, len(free), 4))
+    start = start[:, free] if animated else start
+    assert np.allclose(np.abs(np.sum(held[:, free] * start, axis=-1)), 1.0)
+    assert not np.allclose(np.abs(np.sum(played[:, free] * start, axis=-1)), 1.0), "the agent's own output moves it"
+    moving = [k for k in range(len(names)) if k not in free]
+    np.testing.assert_allclose(held[:, moving], played[:, moving])
+    _, pointed, _ = gesture.gesture_rotations(agent, _request("POINT", frames=frames, targets=[-1.0, -2.0, 1.6]), rig)
+    assert not np.allclose(np.abs(np.sum(pointed[:, free] * start, axis=-1)), 1.0), "point is not held"

@@ -32,6 +32,7 @@ from trainer.agent.models import RLAnimateAgent
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
+from trainer.motion.autolabel import still_free_arm
 from trainer.motion.clip import training_space
 from trainer.motion.manifest import manifest_path
 from trainer.paths import DEFAULT_MANIFEST
@@ -253,6 +254,7 @@ def _agent_metadata(report, trainer):
             "action_bounds": trainer.bounds,
             "average_frames": {name: float(np.mean(values)) for name, values in lengths.items()},
             "wave_rhythm": None if trainer.rhythm_model is None else trainer.rhythm_model.to_dict(),
+            "still_free_arm": still_free_arm([clip for group in trainer.clip_groups for clip in group]),
             "evaluation": {} if report["held_out"] is None else {  # {}: no held-out clips
                 "held_out_score": report["held_out"]["score"], "held_out_smoothness": report["held_out"]["smoothness"]}}
 
