@@ -215,7 +215,7 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     if final is None:  # resumed a run that had already finished
         final = evaluate_seen_unseen(trainer, session)
     log.close()
-    report = _report(settings, trainer, final, epochs, session.problems)
+    report = _report(settings, trainer, final, epochs, session.problems, session.test_clips)
     export_agent(trainer.played_agent, output / "agent.npz", _agent_metadata(report, trainer))
     write_run_report(report, output)
     plots.training_curves(trainer.history, output / "training_curves.png",
@@ -228,7 +228,15 @@ def _flatten(evaluation):
             for name in ("score", "smoothness")}
 
 
-def _report(settings, trainer, final, epochs, skipped):
+def _not_scored(trainer, held_out_clips):
+    """[{name, behaviour, why}] of the held-out clips the run does not score: those of behaviours it did not train."""
+    trained = ", ".join(behaviours.key(b) for b in trainer.trained)
+    return [{"name": getattr(clip, "name", ""), "behaviour": behaviours.key(clip.behaviour),
+             "why": f"the agent was not trained on {behaviours.key(clip.behaviour)} (--behaviour {trained})"}
+            for clip in held_out_clips if clip.behaviour not in trainer.trained]
+
+
+def _report(settings, trainer, final, epochs, skipped, held_out_clips=()):
     seconds = sum(e["collect_seconds"] + e["update_seconds"] for e in trainer.history)
     cpu_seconds = sum(e["cpu_seconds"] for e in trainer.history)
     return {
@@ -240,6 +248,8 @@ def _report(settings, trainer, final, epochs, skipped):
         "held_out": final.get("unseen"), "training": final["seen"],  # held_out None: no held-out clips
         "final_losses": {k[5:]: v for k, v in trainer.history[-1].items() if k.startswith("loss/")},
         "skipped_clips": list(skipped),
+        "training_clips": {behaviours.key(group[0].behaviour): len(group) for group in trainer.clip_groups},
+        "not_scored": _not_scored(trainer, held_out_clips),
     }
 
 
