@@ -15,7 +15,11 @@
     end_chunks, end_chunks_wide
              the default with a fifth of the chunks ending at the gesture's last frame, where the arm
              comes down (trainer/agent/buffer.py), and that with every state and hidden layer twice as
-             wide (real capture: docs/results/realmocap.md, realmocap_ablation.md).
+             wide (real capture: docs/results/realmocap.md, realmocap_ablation.md);
+    end_chunks_long, end_chunks_smooth
+             end_chunks with chunks of 64 frames (half as many, the same frames an update), so that a
+             slow real wave's whole cycle lies in one chunk, or with the pose-velocity term (real capture's
+             model search: docs/results/realmocap_model.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -108,6 +112,9 @@ PRESETS = {
     "end_chunks": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
     "end_chunks_wide": (AgentConfig(task_size=128, behaviour_size=128, hidden_size=128, portrayal_hidden_size=128),
                         replace(_DEFAULT_TRAIN, last_frame_share=0.2)),  # ... and twice the width (capacity)
+    # Issue 45's model search on real capture (options: no other preset changes).
+    "end_chunks_long": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, chunk_length=64, chunk_count=16)),
+    "end_chunks_smooth": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),
