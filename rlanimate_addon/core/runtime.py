@@ -146,7 +146,8 @@ class GestureAgent:
         self._concentration_scale = float(config["concentration_scale"])
         self._uses_portrayal = agent_file.uses_portrayal(self.variant)
         self._uses_task_state = agent_file.uses_task_state(self.variant)
-        task_size = int(config["task_size"]) if self._uses_task_state else self.space.size
+        self._phase_input = bool(config.get("phase_input", False))
+        task_size = agent_file.task_width(config, self.variant, self.space.size)
         if self._uses_portrayal:
             self._portrayal = _mlp_arrays(w, "portrayal", layers)
         if self._uses_task_state:
@@ -217,6 +218,8 @@ class GestureAgent:
         A = spaces.ACTION_SIZE
         count = len(objectives)
         task = _gru_sequence(objectives, self._task_rnn) if self._uses_task_state else objectives  # (N, K)
+        if self._phase_input:  # the wave's phase beside the task state (rhythm.phase_features)
+            task = np.hstack([task, self.space.phase_features(objectives)])
         cell_inputs = task @ self._cell_task + self._cell_bias  # (N, 3E)
         hidden = len(self._belief[0][1])
         belief_inputs = np.broadcast_to(self._belief[0][1], (count, hidden))  # (N, hidden)

@@ -25,8 +25,7 @@ from collections.abc import Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from . import skeleton
-from . import behaviours
+from . import behaviours, rhythm, skeleton
 from .behaviours import INTENSITY, TARGET, WAVE, Behaviour
 from .errors import RLAnimateError
 
@@ -126,6 +125,13 @@ class ObjectiveSpace:
         """(...,) bool: which objectives (..., L + 6) belong to a behaviour of `kind`."""
         masks = [self.label_mask(objectives, name) for name in self.of_kind(kind)]
         return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
+
+    def phase_features(self, objectives: ArrayLike) -> np.ndarray:
+        """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): a wave's rhythm signals and their second
+        harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
+        objectives = np.asarray(objectives, dtype=np.float64)
+        wave = self.label_mask(objectives, WAVE) if WAVE in self.names else np.zeros(objectives.shape[:-1], bool)
+        return rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:]) * wave[..., None]
 
     def behaviours_in(self, objectives: ArrayLike) -> set[str]:
         """The ids whose labels the objectives (..., L + 6) carry; RLAnimateError for a label of none."""
