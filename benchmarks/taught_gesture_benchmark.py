@@ -8,7 +8,7 @@ as the add-on plays it (its exported agent.npz, the numpy runtime):
     held-out error     the held-out hello clip's hand height error (arm lengths; the kind's measure)
     rises              whether the hand's peak height rises with the exaggeration (Spearman over 0, 0.25 ... 1, both
                        arms; above 0.8) and by how much (arm lengths from 0 to 1, the smaller arm's; the clips'
-                       own span is about 0.3)
+                       own rise is about 0.45)
     free arm           the agent's own free-arm rise on those requests (arm lengths), and whether the file declares
                        HELLO's free arm still, so that Generate holds it where it was
 A taught gesture is usable when the held-out error is at most 0.1 arm lengths (the raise measure's bound), its
@@ -90,8 +90,8 @@ def measure(run: Path) -> dict:
             "usable": bool(usable)}
 
 
-def section(rows: list[dict]) -> str:
-    """The docs/BENCHMARKS.md section."""
+def section(rows: list[dict], epochs: list[int], load: str) -> str:
+    """The docs/BENCHMARKS.md section of `rows` (measure's, for `epochs`), the machine's `load` said."""
     now = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     lines = [HEADING, "",
              "How long a user's own gesture takes to train until it is usable: six raise-hand clips of the sample "
@@ -99,10 +99,10 @@ def section(rows: list[dict]) -> str:
              "length trained from the start (docs/TRAINING.md, \"Teach it a new gesture\"). Usable: the held-out "
              f"clip's hand height error at most {USABLE_HEIGHT_ERROR} arm lengths, the height rising with the "
              f"exaggeration on both arms (Spearman above 0.8) by at least {USABLE_SPAN} arm lengths from 0 to 1 (the "
-             "clips' own rise about 0.3), and the free arm held by the add-on.", "",
-             f"Regenerate: `{COMMAND}`", "",
+             "clips' own rise about 0.45), and the free arm held by the add-on.", "",
+             f"Regenerate: `{COMMAND} --epochs {' '.join(map(str, epochs))}`", "",
              f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average "
-             f"{LOAD_AT_START:.1f} at start), Python {platform.python_version()}. Date: {now}.", "",
+             f"{load}), Python {platform.python_version()}. Date: {now}.", "",
              "| epochs | training CPU min | held-out hand height error (arm lengths) | held-out score | "
              "height rises, Spearman left / right | rise from 0 to 1 (arm lengths) | agent's own free-arm rise (max) | "
              "free arm held | usable |",
@@ -128,7 +128,7 @@ def main(argv=None) -> int:
                         "--eval-every", "0", "--quiet"])
             rows.append(measure(run))
             print(json.dumps(rows[-1]), flush=True)
-    text = section(rows)
+    text = section(rows, args.epochs, f"{LOAD_AT_START:.1f} at start, {os.getloadavg()[0]:.1f} at the end")
     report.write_section(HEADING, text)
     print(text)
     return 0
