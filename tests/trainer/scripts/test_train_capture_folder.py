@@ -5,6 +5,7 @@ import shutil
 
 import pytest
 
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.experiments import capture
 from trainer.paths import CLIP_DIR, REALMOCAP_DIR
 from trainer.scripts import train
@@ -58,3 +59,20 @@ def test_real_takes_are_labelled_as_waves_of_the_arm_their_names_give(tmp_path):
         ("WAVE", "LEFT", []), ("WAVE", "RIGHT", []), ("WAVE", "RIGHT", [])]
     assert labels["feminine"].exaggeration < 0.2 < 0.9 < labels["active"].exaggeration
     assert 0.6 < labels["masculine"].tempo < 1.6 and labels["active"].tempo > 1.5
+
+
+def test_only_a_folder_without_a_manifest_is_labelled_and_it_trains_the_real_capture_recipe(tmp_path):
+    assert capture.is_capture_folder(str(tmp_path)) and not capture.is_capture_folder(None)
+    (tmp_path / "manifest.json").write_text("{}")
+    assert not capture.is_capture_folder(str(tmp_path)) and not capture.is_capture_folder(str(tmp_path / "x.json"))
+    given = train.run_settings(train.build_parser().parse_args(["--output", "run", "--epochs", "7"]))
+    chosen = capture.capture_settings(given, tmp_path / "run" / "manifest.json")
+    assert (chosen.clips, chosen.preset, chosen.epochs) == (str(tmp_path / "run" / "manifest.json"), "end_chunks", 7)
+
+
+def test_a_folder_without_takes_or_a_bad_share_is_refused_before_anything_is_imported(tmp_path):
+    with pytest.raises(RLAnimateError, match="holds no .bvh or .fbx takes"):
+        capture.label_folder(str(tmp_path), str(tmp_path / "run"))
+    (tmp_path / "wave_left_001.bvh").write_text("not read")
+    with pytest.raises(RLAnimateError, match="--hold-out 1"):
+        capture.label_folder(str(tmp_path), str(tmp_path / "run"), share=1.0)
