@@ -84,10 +84,13 @@ def label_folder(folder: str, output: str, share: float = capture_folder.HOLD_OU
     return labelled
 
 
-def capture_settings(settings: RunSettings, manifest: Path) -> RunSettings:
-    """The run of a labelled capture folder: its manifest, and CAPTURE_DEFAULTS where `settings` has no value."""
-    return replace(settings, clips=str(manifest), **{name: value for name, value in CAPTURE_DEFAULTS.items()
-                                                     if getattr(settings, name) is None})
+def capture_settings(settings: RunSettings, labelled: Labelled) -> RunSettings:
+    """The run of a labelled capture folder: its manifest, CAPTURE_DEFAULTS where `settings` has no value, and, when
+    no --behaviour is given, the behaviours its training takes have (a folder of waves alone trains a wave agent)."""
+    trained = ",".join(dict.fromkeys(behaviours.key(label.behaviour) for label in labelled.labels
+                                     if label.split == "train"))
+    return replace(settings, clips=str(labelled.manifest), behaviour=settings.behaviour or trained,
+                   **{name: value for name, value in CAPTURE_DEFAULTS.items() if getattr(settings, name) is None})
 
 
 def compare_held_out(agent_path: Path, session: Any) -> dict:

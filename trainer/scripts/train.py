@@ -82,7 +82,7 @@ def main(argv=None):
     if not args.resume and capture.is_capture_folder(args.clips):  # a studio's folder of takes, no manifest
         check_settings(settings)
         labelled = capture.label_folder(args.clips, args.output, args.hold_out, args.verbose)
-        settings = capture.capture_settings(settings, labelled.manifest)
+        settings = capture.capture_settings(settings, labelled)
     settings = resolve(settings)
     session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers)
     report, _ = train(settings, session)

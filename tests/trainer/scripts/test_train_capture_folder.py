@@ -7,6 +7,7 @@ import pytest
 
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.experiments import capture
+from trainer.motion import capture_folder
 from trainer.paths import CLIP_DIR, REALMOCAP_DIR
 from trainer.scripts import train
 
@@ -46,6 +47,17 @@ def test_a_folder_of_takes_is_labelled_held_out_trained_and_compared_with_retrie
     assert "## Labels" in page and "wave_right_000.fbx" in page
 
 
+def test_a_folder_of_waves_alone_trains_a_wave_agent(tmp_path):
+    folder = tmp_path / "wave"
+    folder.mkdir()
+    for name in TAKES[6:]:
+        shutil.copy(CLIP_DIR / name, folder / name)
+    assert train.main(["train.py", "--clips", str(folder), "--output", str(tmp_path / "run"), "--preset", "debug",
+                       "--epochs", "1", "--eval-every", "0", "--quiet"]) == 0
+    report = json.loads((tmp_path / "run" / "capture_report.json").read_text())
+    assert list(report["behaviours"]) == ["wave"] and report["held_out_takes"] == 2
+
+
 @pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(), reason=f"the real capture is not at {REALMOCAP_DIR}")
 def test_real_takes_are_labelled_as_waves_of_the_arm_their_names_give(tmp_path):
     folder = tmp_path / "wave"
@@ -66,8 +78,12 @@ def test_only_a_folder_without_a_manifest_is_labelled_and_it_trains_the_real_cap
     (tmp_path / "manifest.json").write_text("{}")
     assert not capture.is_capture_folder(str(tmp_path)) and not capture.is_capture_folder(str(tmp_path / "x.json"))
     given = train.run_settings(train.build_parser().parse_args(["--output", "run", "--epochs", "7"]))
-    chosen = capture.capture_settings(given, tmp_path / "run" / "manifest.json")
+    labels = [capture_folder.TakeLabel(f"/t/{name}.bvh", behaviour, "intensity", "LEFT", 90, 30.0, 0.5, split=split)
+              for name, behaviour, split in (("a", "WAVE", "train"), ("b", "HELLO", "test"), ("c", "WAVE", "test"))]
+    labelled = capture.Labelled("takes", tmp_path / "run" / "manifest.json", labels)
+    chosen = capture.capture_settings(given, labelled)
     assert (chosen.clips, chosen.preset, chosen.epochs) == (str(tmp_path / "run" / "manifest.json"), "end_chunks", 7)
+    assert chosen.behaviour == "wave", "the behaviours its training takes have: a folder of waves trains waves"
 
 
 def test_a_folder_without_takes_or_a_bad_share_is_refused_before_anything_is_imported(tmp_path):
