@@ -15,25 +15,29 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from tqdm import tqdm
 
-from rlanimate_addon.core import behaviours
+from rlanimate_addon.core import behaviours, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.blender_io.clip_import import import_clip
 from trainer.blender_io.rig_session import blender_output
 from trainer.evaluation import baselines
+from trainer.evaluation.behaviour import clip_target
 from trainer.experiments.realmocap import REQUESTS, compare
 from trainer.experiments.run import RunSettings
 from trainer.files import atomic_write_text
 from trainer.motion import capture_folder, clip_cache
 from trainer.motion.hands import with_hand
 from trainer.reporting.capture_report import capture_markdown, labels_markdown
+from trainer.reporting.plots import gesture_hand_paths, wave_hand_paths
 
 #: What a capture-folder run trains by default where the command line says nothing: the recipe chosen on real
 #: capture's validation takes (docs/REALMOCAP.md).
 CAPTURE_DEFAULTS = {"preset": "end_chunks", "epochs": 100}
 MANIFEST = "manifest.json"
 REPORT = "capture_report"
+PATHS_FIGURE = "capture_hand_paths.png"
 
 
 def is_capture_folder(clips: str | None) -> bool:
@@ -111,14 +115,45 @@ def compare_held_out(agent_path: Path, session: Any) -> dict:
     return results
 
 
+#: The hand-path figure beside the page: up to this many held-out takes of each behaviour, over its labels.
+PATH_TAKES = 3
+
+
+def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
+    """Plot the hand paths of up to PATH_TAKES held-out takes of each behaviour the agent performs, lowest to highest
+    label: the take, the agent and retrieval (a wave asked its tempo) into `path`, the waves' side to side where there
+    are waves, else the other gestures' held reach; the takes drawn."""
+    agent = baselines.AgentMethod(agent_path)
+    methods = {"RLAnimate": agent, "retrieval": baselines.NearestClip(session.train_clips)}
+    waves, held = [], []
+    for behaviour in agent.agent.behaviours:
+        takes = sorted((c for c in session.test_clips if c.behaviour == behaviour),
+                       key=lambda c: float(np.ravel(c.attributes)[0]))
+        for clip in [takes[k] for k in sorted({round(x) for x in np.linspace(0, len(takes) - 1, PATH_TAKES)})] \
+                if takes else []:
+            tempo = baselines.request_tempo(clip, behaviour == behaviours.WAVE)
+            played = {"the take": clip.rotvecs, **{name: method.generate(clip.behaviour, clip.arm, clip.attributes,
+                                                                          clip.frames, tempo=tempo)
+                                                   for name, method in methods.items()}}
+            positions = {name: spaces.description_joint_positions(session.describe(r)) for name, r in played.items()}
+            title = f"{clip.name} ({'tempo asked' if tempo else 'label only'})"
+            (waves if behaviour == behaviours.WAVE else held).append((title, clip.arm, positions, clip_target(clip)))
+    if waves:
+        wave_hand_paths([panel[:3] for panel in waves], path)
+    elif held:
+        gesture_hand_paths(held, path)
+    return [panel[0] for panel in waves or held]
+
+
 def write_report(labelled: Labelled, report: dict, session: Any, output: str, command: str) -> Path:
-    """<output>/capture_report.json and .md: the comparison on the held-out takes, with the labels table;
-    returns the page's path."""
+    """<output>/capture_report.json and .md: the comparison on the held-out takes, with the labels table, and
+    capture_hand_paths.png; returns the page's path."""
     results = {"folder": labelled.folder, "command": command, "manifest": str(labelled.manifest),
                "labels": capture_folder.table_rows(labelled.labels), "notes": labelled.notes,
                "training_takes": len(session.train_clips), "held_out_takes": len(session.test_clips),
                "run": {key: report[key] for key in ("preset", "epochs", "seed", "train_cpu_seconds")},
-               "behaviours": compare_held_out(Path(output) / "agent.npz", session)}
+               "behaviours": compare_held_out(Path(output) / "agent.npz", session),
+               "hand_paths": hand_paths(Path(output) / "agent.npz", session, Path(output) / PATHS_FIGURE)}
     atomic_write_text(Path(output) / f"{REPORT}.json", json.dumps(results, indent=1) + "\n")
     page = Path(output) / f"{REPORT}.md"
     atomic_write_text(page, capture_markdown(results))

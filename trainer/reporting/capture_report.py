@@ -75,6 +75,8 @@ def capture_markdown(results: dict) -> str:
                               "retrieval score / DTW / smoothness", "paired score gap (95%)",
                               "paired DTW gap (95%)", "RLAnimate behaviour", "retrieval behaviour"], summary),
              *(["", *fallbacks] if fallbacks else []),
+             "", f"Hand paths of held-out takes ({', '.join(results['hand_paths'])}): the take (black), the agent and "
+             "retrieval.", "", "![hand paths](capture_hand_paths.png)",
              "", "## Per held-out take (score / DTW score)", "",
              *markdown_table(["take", "behaviour", "request", "RLAnimate", "retrieval"], takes),
              "", "## Labels", "",
