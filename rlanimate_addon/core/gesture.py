@@ -576,9 +576,8 @@ def gesture_rotations(agent, request, rig):
     if len(names) > joints:  # the hand shape retargeted once
         held = retarget(hand, conversions[joints:], parent_conversions[joints:])  # (1, H, 4)
         played = np.concatenate([played, np.broadcast_to(held, (len(played),) + held.shape[1:])], axis=1)
-    if request.behaviour in agent.still_free_arm:  # the other arm has no part in it: it stays where it was
-        free = free_arm_columns(names, request.arm)
-        played[:, free] = start[:, free]
+    held = free_arm_columns(names, request.arm) if request.behaviour in agent.still_free_arm else []
+    played[:, held] = start[:, held]  # an arm that has no part in the gesture stays where it was
     keyed = blend_from_pose(start, played, blend_weights(request.frame_count))
     if targeted:  # the eyes look at the target; Point's finger is aimed exactly on the rig
         phase = aim.pointing_phase(phase_base)

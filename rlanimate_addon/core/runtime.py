@@ -213,13 +213,19 @@ class GestureAgent:
             noise = None if seed is None else np.random.default_rng(seed).standard_normal(self._sizes[1])  # (Z,)
             return self._rollout(objectives, noise)
 
+    def _task(self, objectives):
+        """(N, K) what f2 and the heads see of the task: the task state (with the wave's phase features beside it,
+        rhythm.phase_features, for a phase-input agent), or the objectives without a task state."""
+        if not self._uses_task_state:
+            return objectives
+        task = _gru_sequence(objectives, self._task_rnn)
+        return np.hstack([task, self.space.phase_features(objectives)]) if self._phase_input else task
+
     def _rollout(self, objectives, noise):
         E, Z = self._sizes
         A = spaces.ACTION_SIZE
         count = len(objectives)
-        task = _gru_sequence(objectives, self._task_rnn) if self._uses_task_state else objectives  # (N, K)
-        if self._phase_input:  # the wave's phase beside the task state (rhythm.phase_features)
-            task = np.hstack([task, self.space.phase_features(objectives)])
+        task = self._task(objectives)  # (N, K)
         cell_inputs = task @ self._cell_task + self._cell_bias  # (N, 3E)
         hidden = len(self._belief[0][1])
         belief_inputs = np.broadcast_to(self._belief[0][1], (count, hidden))  # (N, hidden)

@@ -215,6 +215,21 @@ def fallback_notes(results):
     return notes
 
 
+def both_requests_section(results):
+    """Lines of the page's first section: each test set asked both ways, side by side (both_request_rows)."""
+    notes = fallback_notes(results)
+    return ["## Both requests, side by side", "",
+            "Each test take asked the paper's way (its auto-label and length) and again naming its tempo (the Hz at "
+            "which its hand swings, as a user types it in the panel's Tempo). Score / DTW score: RLAnimate's mean ± "
+            "sd over the seeds' agents, and nearest-clip retrieval's from the same training takes. Gap: RLAnimate's "
+            "per-take score (mean over the seeds) minus retrieval's on the same take, mean and 95% interval over the "
+            "takes.", "",
+            *markdown_table(["test set", "request", "RLAnimate score / DTW", "retrieval score / DTW",
+                             "paired score gap (95%)", "paired DTW gap (95%)", "seeds paired"],
+                            both_request_rows(results)),
+            *(["", *notes] if notes else []), ""]
+
+
 def cpu_list(entry):
     """An experiment's training CPU seconds per seed, as 'N s (seed S), ...'."""
     return ", ".join(f"{seconds:.0f} s (seed {seed})" for seed, seconds in entry["train_cpu_seconds"].items())
@@ -300,16 +315,7 @@ def realmocap_markdown(results):
              f"Regenerate: `{results['command']}`.", "",
              *([f"**One seed only (seed {results['seeds'][0]}): no spread over seeds is given, and one seed's "
                 "agent can sit a few points either side of the mean.**", ""] if len(results["seeds"]) == 1 else []),
-             "## Both requests, side by side", "",
-             "Each test take asked the paper's way (its auto-label and length) and again naming its tempo (the Hz "
-             "at which its hand swings, as a user types it in the panel's Tempo). Score / DTW score: RLAnimate's "
-             "mean ± sd over the seeds' agents, and nearest-clip retrieval's from the same training takes. Gap: "
-             "RLAnimate's per-take score (mean over the seeds) minus retrieval's on the same take, mean and 95% "
-             "interval over the takes.", "",
-             *markdown_table(["test set", "request", "RLAnimate score / DTW", "retrieval score / DTW",
-                              "paired score gap (95%)", "paired DTW gap (95%)", "seeds paired"],
-                             both_request_rows(results)),
-             *(["", *fallback_notes(results)] if fallback_notes(results) else []), "",
+             *both_requests_section(results),
              "## Auto-labels per style (one-arm waves: takes 001-010 and 021-036)", "",
              *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
                               "arm detected", "tempo, spectrum (Hz)", "tempo, strokes (Hz)", "stroke (cm)"],
