@@ -222,8 +222,9 @@ def both_requests_section(results):
             "Each test take asked the paper's way (its auto-label and length) and again naming its tempo (the Hz at "
             "which its hand swings, as a user types it in the panel's Tempo). Score / DTW score: RLAnimate's mean ± "
             "sd over the seeds' agents, and nearest-clip retrieval's from the same training takes. Gap: RLAnimate's "
-            "per-take score (mean over the seeds) minus retrieval's on the same take, mean and 95% interval over the "
-            "takes.", "",
+            "per-take score (mean over the seeds paired: those whose per-take scores the results keep, the first "
+            "seed's alone in pages scored before they were kept) minus retrieval's on the same take, mean and 95% "
+            "interval over the takes.", "",
             *markdown_table(["test set", "request", "RLAnimate score / DTW", "retrieval score / DTW",
                              "paired score gap (95%)", "paired DTW gap (95%)", "seeds paired"],
                             both_request_rows(results)),
