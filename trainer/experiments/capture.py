@@ -115,8 +115,10 @@ def compare_held_out(agent_path: Path, session: Any) -> dict:
     return results
 
 
-#: The hand-path figure beside the page: up to this many held-out takes of each behaviour, over its labels.
+#: The hand-path figure beside the page: up to this many held-out takes of each behaviour, over its labels, each
+#: titled by the end of its name.
 PATH_TAKES = 3
+TITLE_CHARACTERS = 24
 
 
 def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
@@ -136,7 +138,7 @@ def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
                                                                           clip.frames, tempo=tempo)
                                                    for name, method in methods.items()}}
             positions = {name: spaces.description_joint_positions(session.describe(r)) for name, r in played.items()}
-            title = f"{clip.name} ({'tempo asked' if tempo else 'label only'})"
+            title = f"{clip.name[-TITLE_CHARACTERS:]} ({'tempo asked' if tempo else 'label only'})"
             (waves if behaviour == behaviours.WAVE else held).append((title, clip.arm, positions, clip_target(clip)))
     if waves:
         wave_hand_paths([panel[:3] for panel in waves], path)
