@@ -27,6 +27,9 @@ from trainer.motion.clip import MotionClip
 SUFFIXES = (".bvh", ".fbx")
 #: The share of a behaviour and arm's takes held out for the comparison report, by default.
 HOLD_OUT_SHARE = 0.2
+#: Metres: how far along a target behaviour's held direction the manifest puts its target (the sample library's
+#: are 1.5-4 m away), so that the report can measure the aim.
+TARGET_DISTANCE = 3.0
 
 
 @dataclass
@@ -120,14 +123,17 @@ def hold_out(labels: list[TakeLabel], share: float = HOLD_OUT_SHARE) -> None:
 
 
 def manifest(labels: list[TakeLabel], folder) -> dict:
-    """The clip manifest of the labels (trainer/motion/manifest.py), files by absolute path; `tempo_hz` and
-    `notes` are for the reader and ignored by the importer."""
+    """The clip manifest of the labels (trainer/motion/manifest.py), files by absolute path, a target behaviour's
+    direction and a target TARGET_DISTANCE along it; `tempo_hz` and `notes` are for the reader and ignored by the
+    importer."""
     entries = []
     for label in labels:
         entry = {"file": label.path, "behaviour": label.behaviour, "kind": label.kind, "arm": label.arm,
                  "frames": label.frames, "fps": round(label.fps, 3), "split": label.split}
-        if label.direction is not None:
+        if label.direction is not None:  # and a target along it, which the behaviour measures aim at
             entry["direction"] = [round(v, 5) for v in label.direction]
+            target = skeleton.shoulder_rest_position(label.arm) + TARGET_DISTANCE * np.asarray(label.direction)
+            entry["target"] = [round(float(v), 4) for v in target]
         else:
             entry["exaggeration"] = round(label.exaggeration, 4)
         if label.tempo is not None:

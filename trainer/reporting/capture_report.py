@@ -2,6 +2,7 @@
 (<output>/capture_report.md; trainer/experiments/capture.py)."""
 from trainer.evaluation.paired import gap_cell, paired_gap
 from trainer.motion import capture_folder
+from trainer.reporting.behaviour_report import behaviour_words
 from trainer.reporting.tables import markdown_table
 
 LABEL_COLUMNS = ("take", "behaviour (kind)", "arm", "label", "tempo", "frames", "split", "notes")
@@ -25,25 +26,15 @@ def _gaps(methods: dict) -> list[str]:
             for key in ("score", "aligned_score")]
 
 
-def _measure(result: dict, behaviour: str) -> str:
-    """A wave's swing and frequency ratios and the waves accepted; another behaviour's elevation errors."""
-    entry = result["by_behaviour"][behaviour]
-    if "swing_ratio_median" in entry:
-        return (f"swing {entry['swing_ratio_median']:.2f}x, frequency {entry['frequency_ratio_median']:.2f}x, "
-                f"{round(entry['accepted_share'] * entry['requests'])}/{entry['requests']} accepted")
-    return (f"elevation error first / last {entry['elevation_first_error_median']:.1f} / "
-            f"{entry['elevation_last_error_median']:.1f} deg")
-
-
 def comparison_rows(results: dict) -> tuple[list[list[str]], list[list[str]]]:
     """(summary rows per behaviour and request, per-take rows) of capture.compare_held_out's results."""
     summary, takes = [], []
     for behaviour, requests in results["behaviours"].items():
         for request, methods in requests.items():
             agent, retrieval = methods["rlanimate"], methods["nearest_clip"]
+            words = [behaviour_words(behaviour, result["by_behaviour"][behaviour]) for result in (agent, retrieval)]
             summary.append([behaviour, REQUESTS[request], str(len(agent["clips"])), _method_cell(agent, behaviour),
-                            _method_cell(retrieval, behaviour), *_gaps(methods), _measure(agent, behaviour),
-                            _measure(retrieval, behaviour)])
+                            _method_cell(retrieval, behaviour), *_gaps(methods), *words])
             takes += [[ours["name"], behaviour, REQUESTS[request], f"{ours['score']:.1f} / {ours['aligned_score']:.1f}",
                        f"{theirs['score']:.1f} / {theirs['aligned_score']:.1f}"]
                       for ours, theirs in zip(agent["clips"], retrieval["clips"], strict=True)]

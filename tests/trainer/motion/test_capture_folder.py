@@ -3,6 +3,7 @@ holds, the labels from names and motion, the hold-out by take, and the manifest 
 import numpy as np
 import pytest
 
+from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_clip
 from trainer.motion import capture_folder, manifest
 
@@ -58,6 +59,7 @@ def test_the_manifest_reads_back_as_the_labels(tmp_path):
                                                                                     0.5, "test")
     assert (point.behaviour, point.kind, point.arm, point.split) == ("POINT", "target", "LEFT", "train")
     np.testing.assert_allclose(point.direction, direction, atol=1e-5)
+    np.testing.assert_allclose(spaces.pointing_direction("LEFT", point.target), direction, atol=1e-4)
     assert written["clips"][0]["tempo_hz"] == 1.25 and written["clips"][0]["notes"] == ["a note"]
 
 

@@ -44,6 +44,7 @@ def test_a_folder_of_takes_is_labelled_held_out_trained_and_compared_with_retrie
                 c["name"] for c in methods["nearest_clip"]["clips"]) and len(methods["rlanimate"]["clips"]) == 2
     page = (output / "capture_report.md").read_text()
     assert "| wave | tempo asked | 2 |" in page and "| point | label only (the paper's) | 2 |" in page
+    assert "own aim" in page and "waves accepted" in page, "each behaviour's own measures"
     assert "## Labels" in page and "wave_right_000.fbx" in page
     assert (output / "capture_hand_paths.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert len(report["hand_paths"]) == 2 and all("tempo asked" in title for title in report["hand_paths"])
