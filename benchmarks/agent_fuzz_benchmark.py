@@ -15,25 +15,24 @@ Run: `python benchmarks/agent_fuzz_benchmark.py [--mutations 3000] [--seeds 0 1 
 """
 import argparse
 import collections
+import functools
 import os
 import platform
-import resource
 import statistics
 import sys
-import tempfile
 import time
-import tracemalloc
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "core"))
 
+import fuzz_runs  # noqa: E402  (benchmarks/fuzz_runs.py)
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 import agent_fuzz  # noqa: E402  (tests/core/agent_fuzz.py)
-import report  # noqa: E402  (benchmarks/report.py)
 from rlanimate_addon.core import runtime  # noqa: E402
 
 HEADING = "## Agent file fuzz"
@@ -41,24 +40,6 @@ COMMAND = "python benchmarks/agent_fuzz_benchmark.py"
 SHIPPED = ROOT / "rlanimate_addon" / "agents" / "default.npz"
 MAX_LOAD_SECONDS = 1.0
 MAX_LOAD_MB = 300.0
-
-
-def measured_load(path):
-    """(seconds, peak MB) of one `runtime.load_agent` of the file, whatever it raises."""
-    began = time.perf_counter()
-    try:
-        runtime.load_agent(path)
-    except Exception:  # noqa: BLE001  (outcome() names what was raised)
-        pass
-    seconds = time.perf_counter() - began
-    tracemalloc.start()
-    try:
-        runtime.load_agent(path)
-    except Exception:  # noqa: BLE001
-        pass
-    peak = tracemalloc.get_traced_memory()[1] / 2 ** 20
-    tracemalloc.stop()
-    return seconds, peak
 
 
 def fuzz(reference, seed, mutations, folder, counts, measures, failures):
@@ -71,8 +52,8 @@ def fuzz(reference, seed, mutations, folder, counts, measures, failures):
         began = time.perf_counter()
         outcome = agent_fuzz.outcome(path, reference)
         elapsed = time.perf_counter() - began
-        load_seconds, load_mb = measured_load(path)
-        measures[kind].append((elapsed, load_seconds, load_mb))
+        load_seconds, load_mb = fuzz_runs.seconds_and_peak_mb(lambda: runtime.load_agent(path))
+        measures[kind].append((elapsed, load_seconds, load_mb, seed, k))
         counts[kind][outcome if outcome in agent_fuzz.ACCEPTED else "other"] += 1
         if outcome not in agent_fuzz.ACCEPTED:
             failures.append(f"seed {seed} mutation {k} ({kind}): {outcome}")
@@ -87,19 +68,9 @@ def main():
     parser.add_argument("--no-write", action="store_true", help="print the section only")
     args = parser.parse_args()
     reference = agent_fuzz.Reference(SHIPPED)
-    counts = collections.defaultdict(collections.Counter)  # kind -> outcome -> count
-    measures = collections.defaultdict(list)  # kind -> [(seconds with gesture, load seconds, load MB)]
-    failures, per_seed = [], []
-    start = time.perf_counter()
-    with tempfile.TemporaryDirectory() as folder:
-        for seed in args.seeds:
-            seed_counts = collections.defaultdict(collections.Counter)
-            fuzz(reference, seed, args.mutations, folder, seed_counts, measures, failures)
-            per_seed.append((seed, sum(seed_counts.values(), collections.Counter())))
-            for kind, counter in seed_counts.items():
-                counts[kind].update(counter)
-    elapsed = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024  # MB (Linux reports kB)
+    runs = fuzz_runs.run_seeds(functools.partial(fuzz, reference), args.seeds, args.mutations)
+    counts, measures, failures, per_seed = runs.counts, runs.measures, runs.failures, runs.per_seed
+    elapsed, peak = runs.seconds, runs.peak_mb
 
     def row(label, counter, rows):
         return (f"| {label} | {sum(counter.values()):,} | {counter['refused']:,} | {counter['identical']:,} | "
@@ -109,6 +80,8 @@ def main():
 
     total = sum(counts.values(), collections.Counter())
     every = [r for kind in measures for r in measures[kind]]
+    slow_kind, slow = max(((kind, r) for kind in measures for r in measures[kind]), key=lambda item: item[1][1])
+    big_kind, big = max(((kind, r) for kind in measures for r in measures[kind]), key=lambda item: item[1][2])
     seeds = " ".join(str(seed) for seed in args.seeds)
     text = "\n".join([
         HEADING, "",
@@ -125,13 +98,15 @@ def main():
         f"Regenerate: `{COMMAND} --mutations {args.mutations} --seeds {seeds}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python "
         f"{platform.python_version()}, numpy {np.__version__}. {elapsed:.1f} s in all, peak memory of the run "
-        f"{peak:.0f} MB (the bombs are built in memory). Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.",
+        f"{peak:.0f} MB (the bombs are built in memory). Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.",
         "",
         "| mutation | count | refused | identical | valid other file | other | median ms | worst ms | "
         "worst load ms | worst load MB |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
         *(row(kind, counts[kind], measures[kind]) for kind in agent_fuzz.KINDS),
         row("**all**", total, every), "",
+        f"Slowest load: {1e3 * slow[1]:.1f} ms, seed {slow[3]} mutation {slow[4]} ({slow_kind}). Largest peak: "
+        f"{big[2]:.1f} MB, seed {big[3]} mutation {big[4]} ({big_kind}).", "",
         "Per seed: " + "; ".join(f"seed {seed}: {sum(c.values()):,} mutations, {c['other']:,} other"
                                  for seed, c in per_seed) + ".",
     ]) + "\n"

@@ -3,7 +3,8 @@
 Run: `nice -n 10 python benchmarks/agent_synthetic_check.py [VARIANT] [EPOCHS] [--no-portrayal-loss]`
 
 It trains the both-behaviour agent of the `default` preset with trainer/agent/algorithm.py, but plays
-actions through the numpy FK environment (trainer/motion/fk.py) instead of the bpy one, on the synthetic library of the trainer tests
+actions through the numpy FK environment (trainer/motion/fk.py) instead of the bpy one, on the synthetic library of
+the trainer tests
 (20 training clips per behaviour, one held-out clip per behaviour and arm). It prints held-out
 and seen score / smoothness and the losses every 10 epochs. It is a check of the models and losses
 in minutes, not the paper's experiment (that is trainer/train.py on the sample clip library).

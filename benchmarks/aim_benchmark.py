@@ -57,8 +57,9 @@ def main():
     for k in range(args.targets):
         arm = skeleton.ARMS[k % 2]
         target = random_target(arm, rng)
-        objectives = gesture.build_objectives(agent.space, "POINT", arm, args.frames, targets=np.tile(target, (args.frames, 1)),
-                                              rest_heads=rest_heads)
+        objectives = gesture.build_objectives(
+            agent.space, "POINT", arm, args.frames, targets=np.tile(target, (args.frames, 1)), rest_heads=rest_heads
+        )
         raw = gesture.run_agent(agent, "POINT", objectives)  # (N, 15, 3)
         aimed = aim.aim_at(raw, arm, target)
         rows.append((apex_angle(raw, arm, target), apex_angle(aimed, arm, target), smoothness(raw), smoothness(aimed)))

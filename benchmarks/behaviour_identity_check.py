@@ -40,8 +40,8 @@ def core(root, out):
 
 def blender(root, out):
     sys.path.insert(0, str(root / "tests" / "addon"))
+    import bpy  # noqa: F401, I001  (before the helpers: a base tree's may import addon_utils first, which needs bpy)
     import addon_helpers
-
     from rlanimate_addon.blender import action_adapter, gestures
     settings = addon_helpers.enable_addon()
     rig = addon_helpers.load_sample_rig()
@@ -53,10 +53,12 @@ def blender(root, out):
         assert addon_helpers.generate(rig, settings, **values) == {"FINISHED"}
     keys = {}
     for placed in gestures.placed_gestures(rig):
-        for curve in action_adapter.all_fcurves(placed.action):
-            co = np.zeros(2 * len(curve.keyframe_points))
-            curve.keyframe_points.foreach_get("co", co)
-            keys[f"{placed.action.name}|{curve.data_path}|{curve.array_index}"] = co
+        # Every action of the gesture: its main and torso layers (a tree from before issue 42 has the one).
+        for action in [layer.action for layer in getattr(placed, "layers", {}).values()] or [placed.action]:
+            for curve in action_adapter.all_fcurves(action):
+                co = np.zeros(2 * len(curve.keyframe_points))
+                curve.keyframe_points.foreach_get("co", co)
+                keys[f"{action.name}|{curve.data_path}|{curve.array_index}"] = co
     np.savez(out, **keys)
 
 

@@ -15,7 +15,7 @@ import statistics
 import sys
 import time
 from contextlib import nullcontext
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 from unittest import mock
 
@@ -23,10 +23,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 import threadpoolctl  # noqa: E402
 
 from rlanimate_addon.core import blas_threads, gesture, runtime  # noqa: E402
-import report  # noqa: E402  (benchmarks/report.py)
 
 FRAMES = 120
 HEADING = "## BLAS threads"
@@ -59,8 +59,14 @@ def main():
     parser.add_argument("--no-write", action="store_true", help="print the section only")
     args = parser.parse_args()
     agent = runtime.load_agent(ROOT / "rlanimate_addon" / "agents" / "default.npz")
-    objectives = gesture.build_objectives(agent.space, "POINT", "RIGHT", FRAMES, targets=np.tile([-1.2, -2.5, 1.7], (FRAMES, 1)),
-                                          rest_heads=gesture.canonical_rig().rest_heads)
+    objectives = gesture.build_objectives(
+        agent.space,
+        "POINT",
+        "RIGHT",
+        FRAMES,
+        targets=np.tile([-1.2, -2.5, 1.7], (FRAMES, 1)),
+        rest_heads=gesture.canonical_rig().rest_heads,
+    )
     agent.rollout(objectives)
     blas = [i for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas"]
     stop = multiprocessing.Event()
@@ -92,7 +98,7 @@ def main():
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores, Python {platform.python_version()}, "
         f"numpy {np.__version__}, BLAS: " + ", ".join(f"{i['internal_api']} {i['version']} ({i['num_threads']} threads)"
                                                       for i in blas) + f". Load average {load:.1f}. "
-        f"Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.", "",
+        f"Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.", "",
         "| BLAS threads | best ms | median ms | worst ms |",
         "|---|---:|---:|---:|",
         row("one (the shipped runtime)", capped),

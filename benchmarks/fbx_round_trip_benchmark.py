@@ -17,15 +17,15 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import bpy  # noqa: E402
-import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
+import bpy  # noqa: E402, I001  (before addon_utils, Blender's module, importable once bpy is)
+import addon_utils  # noqa: E402
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 from rlanimate_addon.blender import properties  # noqa: E402
 from rlanimate_addon.core import skeleton  # noqa: E402
 from trainer.blender_io import rig_session  # noqa: E402
 from trainer.paths import SAMPLE_RIG_BLEND, SAMPLE_RIG_FBX  # noqa: E402
-import report  # noqa: E402  (benchmarks/report.py)
 
 COMMAND = "python benchmarks/fbx_round_trip_benchmark.py"
 

@@ -8,7 +8,7 @@ import os
 import platform
 import sys
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 if hasattr(os, "sched_setaffinity"):
@@ -17,11 +17,11 @@ if hasattr(os, "sched_setaffinity"):
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 from rlanimate_addon.core import kinematics, skeleton, spaces  # noqa: E402
 from trainer.blender_io import rig_session  # noqa: E402
 from trainer.blender_io.fk_env import FKEnvironment  # noqa: E402
-import report  # noqa: E402  (benchmarks/report.py)
 
 INSTANCE_COUNTS = (1, 4, 8, 16, 64, 256)
 POSES = 2048
@@ -53,7 +53,7 @@ def measure():
             rig_session.new_empty_scene()
             env = FKEnvironment(instances=instances)
             env.describe_actions(actions[:instances])
-            best[instances] = min(best[instances], timed(lambda: env.describe_actions(actions)))
+            best[instances] = min(best[instances], timed(lambda env=env: env.describe_actions(actions)))
     rows = [("bpy FKEnvironment.describe_actions", instances, best[instances]) for instances in INSTANCE_COUNTS]
     rotvecs = spaces.decode_action(actions)
     local = {joint: rotvecs[:, i] for i, joint in enumerate(skeleton.ACTION_JOINTS)}
@@ -66,16 +66,21 @@ def section(rows):
     """The markdown section for docs/BENCHMARKS.md."""
     import bpy
 
-    date = datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    date = datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC")
     lines = [
-        HEADING, "",
-        f"Poses per second of `trainer/blender_io/fk_env.py` on the sample rig ({len(skeleton.BONES)} bones): {POSES} random",
+        HEADING,
+        "",
+        f"Poses per second of `trainer/blender_io/fk_env.py` on the sample rig ({len(skeleton.BONES)} bones): "
+        f"{POSES} random",
         f"actions decoded and evaluated per call (fastest of {REPEATS} interleaved rounds), each batch of",
-        "`instances` poses in one depsgraph update. Pinned to one CPU core.", "",
-        f"Regenerate: `{COMMAND}`", "",
+        "`instances` poses in one depsgraph update. Pinned to one CPU core.",
+        "",
+        f"Regenerate: `{COMMAND}`",
+        "",
         f"Machine: {platform.machine()}, 2 CPU cores shared with other jobs, Python {platform.python_version()}, "
         f"bpy {bpy.app.version_string}, numpy {np.__version__}, load average {LOAD_AT_START:.1f} at start. "
-        f"Date: {date}.", "",
+        f"Date: {date}.",
+        "",
         "| method | instances | poses/s | ms per pose |",
         "|---|---:|---:|---:|",
     ]

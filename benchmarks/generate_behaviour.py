@@ -17,8 +17,8 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import bpy  # noqa: E402
-import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
+import bpy  # noqa: E402, I001  (before addon_utils, Blender's module, importable once bpy is)
+import addon_utils  # noqa: E402
 import numpy as np  # noqa: E402
 
 from rlanimate_addon.core import behaviour_metrics as bm  # noqa: E402
@@ -121,26 +121,60 @@ def main(argv=None):
                            f"{min(smoothness[False]):.2f} / {min(smoothness[True]):.2f}"])
 
     agent = shown(options.agent) if options.agent else "the bundled agent (rlanimate_addon/agents/default.npz)"
-    lines = ["# Generate Gesture's behaviour, measured from Blender", "",
-             f"Generate Gesture (the operator) on the sample character with {agent}, each gesture at the panel's "
-             f"default length ({settings.frame_count} frames) from a standing pose with the arms hanging; the baked "
-             "pose read back from Blender frame by frame and measured with `core/behaviour_metrics.py` "
-             "(docs/METRICS.md). Regenerate: `nice -n 10 python benchmarks/generate_behaviour.py"
-             f"{' --agent ' + str(agent) if options.agent else ''} --targets {options.targets}`.", "",
-             "## Waves", "",
-             *markdown_table(["arm", "seed", "exaggeration", "hand up (s)", "strokes", "full cycles", "frequency (Hz)",
-                              "swing (cm)", "smoothness"], wave_rows), "",
-             "Swing strictly rising with the exaggeration: "
-             + ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in rising.items()) + ".", "",
-             f"Seeds {SEEDS[0]} and {SEEDS[1]} on the same request: mean joint distance median "
-             f"{100 * np.median(seed_gaps):.1f} cm (range {100 * np.min(seed_gaps):.1f}-{100 * np.max(seed_gaps):.1f}). "
-             "The library's own waves make 6-10 strokes, 3-5 cycles at 2.1-2.8 Hz, swinging 9-33 cm.", "",
-             "## Points at random targets", "",
-             "Targets drawn over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, 1.5-4 m).", "",
-             *markdown_table(["arm", "targets", "own aim: median (deg)", "own aim: max", "Exact Aim: median",
-                              "Exact Aim: max", "smoothness, lowest: own aim / Exact Aim"], point_rows),
-             "",
-             "Smoothness: `core.metrics.smoothness` of the baked description joints (below 98.5 artefacts show).", ""]
+    lines = [
+        "# Generate Gesture's behaviour, measured from Blender",
+        "",
+        f"Generate Gesture (the operator) on the sample character with {agent}, each gesture at the panel's "
+        f"default length ({settings.frame_count} frames) from a standing pose with the arms hanging; the baked "
+        "pose read back from Blender frame by frame and measured with `core/behaviour_metrics.py` "
+        "(docs/METRICS.md). Regenerate: `nice -n 10 python benchmarks/generate_behaviour.py"
+        f"{' --agent ' + str(agent) if options.agent else ''} --targets {options.targets}`.",
+        "",
+        "## Waves",
+        "",
+        *markdown_table(
+            [
+                "arm",
+                "seed",
+                "exaggeration",
+                "hand up (s)",
+                "strokes",
+                "full cycles",
+                "frequency (Hz)",
+                "swing (cm)",
+                "smoothness",
+            ],
+            wave_rows,
+        ),
+        "",
+        "Swing strictly rising with the exaggeration: "
+        + ", ".join(f"{k}: {'yes' if v else 'no'}" for k, v in rising.items())
+        + ".",
+        "",
+        f"Seeds {SEEDS[0]} and {SEEDS[1]} on the same request: mean joint distance median "
+        f"{100 * np.median(seed_gaps):.1f} cm (range {100 * np.min(seed_gaps):.1f}-{100 * np.max(seed_gaps):.1f}). "
+        "The library's own waves make 6-10 strokes, 3-5 cycles at 2.1-2.8 Hz, swinging 9-33 cm.",
+        "",
+        "## Points at random targets",
+        "",
+        "Targets drawn over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, 1.5-4 m).",
+        "",
+        *markdown_table(
+            [
+                "arm",
+                "targets",
+                "own aim: median (deg)",
+                "own aim: max",
+                "Exact Aim: median",
+                "Exact Aim: max",
+                "smoothness, lowest: own aim / Exact Aim",
+            ],
+            point_rows,
+        ),
+        "",
+        "Smoothness: `core.metrics.smoothness` of the baked description joints (below 98.5 artefacts show).",
+        "",
+    ]
     out = RESULTS_DIR / "generate_behaviour.md"
     out.write_text("\n".join(lines))
     print("\n".join(lines))

@@ -19,20 +19,20 @@ import platform
 import statistics
 import sys
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import bpy  # noqa: E402
-import addon_utils  # noqa: E402  (Blender's module, importable once bpy is)
+import bpy  # noqa: E402, I001  (before addon_utils, Blender's module, importable once bpy is)
+import addon_utils  # noqa: E402
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 from rlanimate_addon.blender import action_adapter, gestures, preferences  # noqa: E402
 from trainer.blender_io import rig_session  # noqa: E402
 from trainer.paths import SAMPLE_RIG_BLEND  # noqa: E402
-import report  # noqa: E402  (benchmarks/report.py)
 
 SECTION = "## Generate Gesture"
 #: (label, the rig carries an idle, frames)
@@ -71,7 +71,7 @@ def key_idle(rig):
 def remove_gesture(rig, idle):
     """Remove the baked gesture; the idle (None: no animation) active again, as before Generate."""
     data = rig.animation_data
-    for action in [a for a in bpy.data.actions if gestures.RECORD in a]:
+    for action in [a for a in bpy.data.actions if gestures.RECORD in a or gestures.TORSO_OF in a]:
         bpy.data.actions.remove(action)
     for track in list(data.nla_tracks):
         data.nla_tracks.remove(track)
@@ -123,7 +123,7 @@ def ms(values):
 
 def paired(generate, playback, clock):
     """Median over rounds of Generate / playback on one clock (0: wall, 1: CPU)."""
-    return statistics.median(g[clock] / p[clock] for g, p in zip(generate, playback))
+    return statistics.median(g[clock] / p[clock] for g, p in zip(generate, playback, strict=True))
 
 
 def main():
@@ -146,8 +146,11 @@ def main():
     for label, _, _ in CASES:
         t = times[label]
         best = min(g for g, _ in t["generate"]) / min(p for p, _ in t["playback"])
-        rows.append(f"| {label} | {ms(t['generate'])} | {ms(t['playback'])} | **{paired(t['generate'], t['playback'], 0):.2f}** | "
-                    f"{best:.2f} | **{paired(t['generate'], t['playback'], 1):.2f}** | {ms(t['again'])} |")
+        rows.append(
+            f"| {label} | {ms(t['generate'])} | {ms(t['playback'])} | "
+            f"**{paired(t['generate'], t['playback'], 0):.2f}** | "
+            f"{best:.2f} | **{paired(t['generate'], t['playback'], 1):.2f}** | {ms(t['again'])} |"
+        )
     table = "\n".join(rows)
     text = f"""{SECTION}
 
@@ -168,7 +171,7 @@ Regenerate: `nice -n 10 python benchmarks/generate_benchmark.py`
 
 Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at
 start), Python {platform.python_version()},
-bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
+bpy {bpy.app.version_string}, numpy {np.__version__}. Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.
 
 | case | Generate best ms | median ms | playback best ms | median ms | ratio, paired median | best to best | CPU ratio, paired median | again best ms | median ms |
 |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|

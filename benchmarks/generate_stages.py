@@ -27,7 +27,7 @@ import platform
 import statistics
 import sys
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -43,8 +43,8 @@ def _root():
 ROOT = _root()
 sys.path[:0] = [str(ROOT / "benchmarks"), str(ROOT)]
 
-import generate_benchmark as cases  # noqa: E402  (the chosen checkout's benchmarks/generate_benchmark.py)
 import bpy  # noqa: E402
+import generate_benchmark as cases  # noqa: E402  (the chosen checkout's benchmarks/generate_benchmark.py)
 import numpy as np  # noqa: E402
 
 from rlanimate_addon.blender import action_adapter, armature_io, bake_check, generate  # noqa: E402
@@ -144,7 +144,7 @@ def measure(rounds, functions=False):
         row["Generate"] = 1000.0 * statistics.mean(clicks)
         row["other"] = row["Generate"] - sum(v for k, v in row.items() if k != "Generate")
         row["playback"] = 1000.0 * statistics.mean(plays)
-        row["ratio"] = statistics.median(c / p for c, p in zip(clicks, plays))
+        row["ratio"] = statistics.median(c / p for c, p in zip(clicks, plays, strict=True))
         out[label] = row
     return out
 
@@ -186,7 +186,7 @@ Regenerate: `nice -n 10 python benchmarks/generate_stages.py`
 
 Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at
 start), Python {platform.python_version()}, bpy {bpy.app.version_string}, numpy {np.__version__}. Date:
-{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
+{datetime.now(UTC):%Y-%m-%d %H:%M} UTC.
 
 | case | checks | rig read | rollout | numpy rest | keys | key writes | bake check | other | Generate | playback | ratio |
 |---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|

@@ -18,7 +18,7 @@ import statistics
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -26,9 +26,9 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "tests" / "trainer" / "motion"))
 
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 
 import manifest_fuzz  # noqa: E402  (tests/trainer/motion/manifest_fuzz.py)
-import report  # noqa: E402  (benchmarks/report.py)
 from trainer.blender_io import clip_import  # noqa: E402
 from trainer.blender_io.rig_session import blender_output  # noqa: E402
 
@@ -92,7 +92,7 @@ def main():
         f"Regenerate: `{COMMAND} --mutations {args.mutations} --seeds {seeds}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python "
         f"{platform.python_version()}, numpy {np.__version__}. {elapsed:.1f} s in all. "
-        f"Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.", "",
+        f"Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.", "",
         "| mutation | count | refused | skipped | accepted | failure | median ms | worst ms |",
         "|---|---:|---:|---:|---:|---:|---:|---:|",
         *(row(kind, counts[kind], times[kind]) for kind in manifest_fuzz.KINDS),

@@ -1,5 +1,6 @@
-"""Ray workers against wall time: the clip import of the sample library (and of the real capture, when it is
-beside the repository) into a fresh cache, and a small Table 4 (debug preset) trained as Ray tasks. Each
+"""Workers against wall time: the clip import of the sample library (and of the real capture, when it is
+beside the repository) into a fresh cache by import worker processes, and a small Table 4 (debug preset)
+trained as Ray tasks. Each
 worker count gets a fresh local Ray, started before the clock runs; the agents trained with every count
 are compared array by array. Writes the section "Ray workers" of docs/BENCHMARKS.md.
 
@@ -11,7 +12,7 @@ import platform
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -21,9 +22,10 @@ sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import ray  # noqa: E402
-
 import report  # noqa: E402  (benchmarks/report.py)
-from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip_directory, import_into_cache  # noqa: E402
+
+from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip_directory  # noqa: E402
+from trainer.blender_io.import_worker import import_into_cache  # noqa: E402
 from trainer.cluster import connect  # noqa: E402
 from trainer.experiments.paper import COLUMNS, PaperSettings, run_folder, train_all  # noqa: E402
 from trainer.motion.realmocap_takes import take_paths  # noqa: E402
@@ -45,24 +47,19 @@ def fresh_ray(workers):
 
 
 def import_seconds(workers, folder):
-    """Wall seconds to import the sample library into a fresh cache in `folder` with `workers` Blenders."""
+    """Wall seconds to import the sample library into a fresh cache in `folder` with `workers` import workers."""
     start = time.perf_counter()
     clips, problems = import_clip_directory(DEFAULT_MANIFEST, cache_dir=folder, workers=workers)
-    assert len(clips) == 100 and not problems, problems
-    return time.perf_counter() - start
+    assert clips and not problems, problems
+    return time.perf_counter() - start, len(clips)
 
 
 def realmocap_seconds(workers, folder):
-    """Wall seconds to import every real take (wave/, bye/, guide/) into a fresh cache with `workers` Blenders
-    (one Blender in this process when `workers` is 1); and the number of takes."""
+    """Wall seconds to import every real take (wave/, bye/, guide/) into a fresh cache with `workers` import
+    workers; and the number of takes."""
     files = [(p, EXPECTED_FPS) for sub in ("wave", "bye", "guide") for p in take_paths(REALMOCAP_DIR / sub)]
     start = time.perf_counter()
-    if workers == 1:
-        from trainer.blender_io.clip_import import import_clip
-        for path, fps in files:
-            import_clip(path, fps, cache_dir=folder)
-    else:
-        import_into_cache(files, folder, workers)
+    assert not import_into_cache(files, folder, workers)
     return time.perf_counter() - start, len(files)
 
 
@@ -97,11 +94,11 @@ def main():
     with tempfile.TemporaryDirectory() as scratch:
         for workers in args.workers:
             ray_start = fresh_ray(workers)
-            clips_s = import_seconds(workers, Path(scratch) / f"cache{workers}")
+            clips_s, clip_count = import_seconds(workers, Path(scratch) / f"cache{workers}")
             real = realmocap_seconds(workers, Path(scratch) / f"real{workers}") if realmocap else None
             table_s, settings = table4_seconds(workers, Path(scratch) / f"runs{workers}" / "experiments")
             trained.append(settings)
-            rows.append(f"| {workers} | {ray_start:.1f} | {clips_s:.1f} ({100 / clips_s:.1f} clips/s) | "
+            rows.append(f"| {workers} | {ray_start:.1f} | {clips_s:.1f} ({clip_count / clips_s:.1f} clips/s) | "
                         + (f"{real[0]:.1f} ({real[1] / real[0]:.1f} takes/s) | " if real else "")
                         + f"{table_s:.1f} |")
             print(rows[-1], flush=True)
@@ -111,11 +108,12 @@ def main():
 
     runs = len(TABLE4["seeds"]) * len(TABLE4["variants"]) * len(TABLE4["columns"])
     real_header = " real capture import (s) |" if realmocap else ""
-    text = f"""{HEADING}
+    text = (
+        f"""{HEADING}
 
 Wall seconds against the number of local Ray workers (`trainer/cluster.py`): importing the sample library's
-100 FBX clips into a fresh cache (one Blender in this process for 1 worker; N Ray tasks, each its own
-Blender, for N){", and the real capture's BVH takes (wave/, bye/, guide/)" if realmocap else ""}; and training a small Table 4,
+{clip_count} FBX clips into a fresh cache (N import worker processes, each its own Blender, for N
+workers; trainer/blender_io/import_worker.py){", and the real capture's BVH takes (wave/, bye/, guide/)" if realmocap else ""}; and training a small Table 4,
 {runs} runs (preset `debug`, 0.1 x the paper's epochs, seed 0, `rlanimate` and `supervised`, every column) as
 Ray tasks. Ray's start is timed apart. The agents trained with every worker count are
 {"identical, array by array" if same else "NOT identical"}.
@@ -125,11 +123,14 @@ machine whose load already exceeds its cores two workers share what one had.
 
 Regenerate: `{COMMAND}`
 
-Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at start), Python {platform.python_version()}, bpy {bpy.app.version_string}, Ray {ray.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
+Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average {load:.1f} at start), Python {platform.python_version()}, bpy {bpy.app.version_string}, Ray {ray.__version__}. Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.
 
 | workers | Ray start (s) | sample library import (s) |{real_header} small Table 4 training (s) |
 |---:|---:|---:|{"---:|" if realmocap else ""}---:|
-""" + "\n".join(rows) + "\n"
+"""
+        + "\n".join(rows)
+        + "\n"
+    )
     print(text)
     if not args.no_write:
         report.write_section(HEADING, text)

@@ -27,11 +27,11 @@ ROOT = Path(__file__).resolve().parents[1]
 for path in (ROOT, ROOT / "tests", ROOT / "tests" / "addon"):
     sys.path.insert(0, str(path))
 
-import addon_helpers as helpers  # noqa: E402
 import bpy  # noqa: E402
-import real_rigs  # noqa: E402
+from report import BENCHMARKS_MD, write_section  # noqa: E402  (benchmarks/report.py)
 
-from benchmarks.report import BENCHMARKS_MD, write_section  # noqa: E402
+import addon_helpers as helpers  # noqa: E402
+import real_rigs  # noqa: E402
 
 #: (row, family, source) of every rig: a ../shared/rigs file (real_rigs.FILES) or a Rigify build, still; a
 #: row '<file>_own' measures the file over its own animation (real_rigs.ACTIONS, else its active action).
@@ -42,6 +42,7 @@ RIGS = (
     ("kenney", "Mixamo-like, 3.7 units tall", "Mesh2Motion / Kenney (real file)"),
     ("quaternius", "outside the families (Palm, no Hand, one Fingers bone)", "Quaternius (real file)"),
     ("quaternius_own", "the same, over its own Female_Clapping (the file's active action)", "Quaternius (real file)"),
+    ("quaternius_palm_only", "the same, mapped with no finger: points along its palm", "Quaternius (real file)"),
     ("gdbot", "outside the families (_FK/_IK chains, no collar, hips under torso)", "GDQuest (real file)"),
     ("gdbot_own", "the same, over its own Idle (its active action is a fall)", "GDQuest (real file)"),
     ("vrm0_robot", "VRM 0.x, from the file's own humanoid map", "UNAVI (real file)"),
@@ -49,21 +50,31 @@ RIGS = (
     ("rigify_fk", "Rigify, arms in FK", "built by Rigify (real tool)"),
     ("rigify_ik", "Rigify, arms in IK", "built by Rigify (real tool)"),
     ("rigify_export", "Rigify + game export skeleton", "built by Rigify (real tool)"),
+    ("rigify_no_fingers", "Rigify without palms or fingers: points along its hand", "built by Rigify (real tool)"),
+    ("godot_no_fingers", "Godot humanoid names, no fingers: points along its hand", "sample, renamed"),
 )
 
 
 def _file(row):
     """The real_rigs.FILES name a row reads (the VRM 1.0 one is rewritten from the VRM 0.x file), or None."""
-    name = row.removesuffix("_own")
+    name = row.removesuffix("_own").removesuffix("_palm_only")
     return "vrm0_robot" if name == "vrm1_robot" else name if name in real_rigs.FILES else None
 
 
+def _bone_map(row):
+    """The real_rigs.USER_BONE_MAPS name a row is mapped with when refused as it comes, or None."""
+    return row if row in real_rigs.USER_BONE_MAPS else _file(row) if _file(row) in real_rigs.USER_BONE_MAPS else None
+
+
 def _load(name, folder):
+    if name == "godot_no_fingers":
+        return real_rigs.godot_without_fingers()
     if name.startswith("rigify_"):
-        return real_rigs.rigify_rig("FK" if name == "rigify_fk" else "IK", export=name == "rigify_export")
+        return real_rigs.rigify_rig("IK" if name == "rigify_ik" else "FK", export=name == "rigify_export",
+                                    fingers=name != "rigify_no_fingers")
     if name == "vrm1_robot":
         return real_rigs.import_gltf(real_rigs.vrm1_file(folder), folder)
-    return real_rigs.load_shared(name.removesuffix("_own"), folder, still=not name.endswith("_own"))
+    return real_rigs.load_shared(_file(name), folder, still=not name.endswith("_own"))
 
 
 def _accept(rig, settings, name, folder):
@@ -74,8 +85,8 @@ def _accept(rig, settings, name, folder):
             return ("yes" if not mute else "with Generate, Muting Constraints"), mute
         except RuntimeError as error:
             refusal = str(error).removeprefix("Error: ")
-    if _file(name) in real_rigs.USER_BONE_MAPS:
-        settings.bone_map_file = real_rigs.write_bone_map(_file(name), folder)
+    if _bone_map(name) is not None:
+        settings.bone_map_file = real_rigs.write_bone_map(_bone_map(name), folder)
         try:
             real_rigs.wave(rig, settings, "RIGHT", 5000)
             return "with a user bone map (refused before, naming the fix)", False
@@ -146,7 +157,9 @@ def _rerun(rows, seconds, date):
     which rows were rerun, when and how long they took."""
     old = re.search(r"^## Real rigs\n.*?(?=^## |\Z)", BENCHMARKS_MD.read_text(), re.S | re.M).group(0)
     lines = old.rstrip("\n").split("\n")
-    table = {line.split("|")[1].strip(): line for line in lines if line.startswith("| ") and not line.startswith("| rig |")}
+    table = {
+        line.split("|")[1].strip(): line for line in lines if line.startswith("| ") and not line.startswith("| rig |")
+    }
     table.update(rows)
     head = [line for line in lines if not line.startswith(("|---", "Rows rerun"))
             and (not line.startswith("| ") or line.startswith("| rig |"))]

@@ -19,12 +19,12 @@ ROOT = Path(__file__).resolve().parents[1]
 for path in (ROOT, ROOT / "tests", ROOT / "tests" / "addon"):
     sys.path.insert(0, str(path))
 
-import addon_helpers as helpers  # noqa: E402
 import bpy  # noqa: E402
+from report import write_section  # noqa: E402  (benchmarks/report.py)
+
+import addon_helpers as helpers  # noqa: E402
 import rig_variants  # noqa: E402
 import test_rig_variants as measures  # noqa: E402
-
-from benchmarks.report import write_section  # noqa: E402
 
 FRAMES = 120
 

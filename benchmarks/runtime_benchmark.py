@@ -12,7 +12,7 @@ import platform
 import sys
 import tempfile
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 if hasattr(os, "sched_setaffinity"):
@@ -22,14 +22,14 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO_ROOT))
 
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 import torch  # noqa: E402
 
 from rlanimate_addon.core import spaces  # noqa: E402
 from rlanimate_addon.core.runtime import load_agent  # noqa: E402
-from trainer.agent.config import load_preset  # noqa: E402
 from trainer.agent.agent_export import export_agent  # noqa: E402
+from trainer.agent.config import load_preset  # noqa: E402
 from trainer.agent.models import VARIANTS, RLAnimateAgent  # noqa: E402
-import report  # noqa: E402  (benchmarks/report.py)
 
 DEFAULT_AGENT = REPO_ROOT / "rlanimate_addon" / "agents" / "default.npz"
 LENGTH_SCALES = (0.4, 1.0, 1.5)
@@ -102,7 +102,7 @@ def section(rows):
         f"Regenerate: `{COMMAND}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average "
         f"{LOAD_AT_START:.1f} at start), Python {platform.python_version()}, numpy {np.__version__}, torch "
-        f"{torch.__version__}. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.", "",
+        f"{torch.__version__}. Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.", "",
         "| agent | frames | numpy us/frame | numpy, seeded us/frame | torch us/frame |",
         "|---|---:|---:|---:|---:|",
     ]

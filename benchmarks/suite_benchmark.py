@@ -11,7 +11,7 @@ import statistics
 import subprocess
 import sys
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,7 +51,7 @@ def main():
 
     rows = "\n".join(f"| {way} | {statistics.median(t):.1f} | {min(t):.1f} | {max(t):.1f} | "
                      f"{1 - statistics.median(t) / BASELINE_S:.0%} |" for way, t in times.items())
-    ratios = [a / b for a, b in zip(*times.values())]
+    ratios = [a / b for a, b in zip(*times.values(), strict=True)]
     text = f"""{HEADING}
 
 Wall seconds of `python -m pytest -q` (the whole suite on Blender 5.0) in one process and as
@@ -61,7 +61,7 @@ so each file's module fixtures are built once); {args.pairs} interleaved pairs. 
 
 Regenerate: `{COMMAND}`
 
-Machine: {platform.machine()}, {os.cpu_count()} CPU cores, Python {platform.python_version()}, bpy {bpy.app.version_string}, load average {load:.1f} at start. Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.
+Machine: {platform.machine()}, {os.cpu_count()} CPU cores, Python {platform.python_version()}, bpy {bpy.app.version_string}, load average {load:.1f} at start. Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.
 
 | way | median s | min s | max s | faster than 90 s |
 |---|---:|---:|---:|---:|

@@ -12,7 +12,7 @@ import os
 import platform
 import sys
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
 
 if hasattr(os, "sched_setaffinity"):
@@ -22,6 +22,7 @@ REPO_ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO_ROOT))
 
 import numpy as np  # noqa: E402
+import report  # noqa: E402  (benchmarks/report.py)
 import torch  # noqa: E402
 
 from rlanimate_addon.core import skeleton, spaces  # noqa: E402
@@ -29,7 +30,6 @@ from trainer.agent.algorithm import gradient_step  # noqa: E402
 from trainer.agent.buffer import EpisodeBuffer  # noqa: E402
 from trainer.agent.config import load_preset  # noqa: E402
 from trainer.agent.models import RLAnimateAgent  # noqa: E402
-import report  # noqa: E402  (benchmarks/report.py)
 
 ROUNDS = 15
 STEPS = 10
@@ -113,7 +113,7 @@ def section(per_step, config):
         f"Regenerate: `{COMMAND}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs (load average "
         f"{LOAD_AT_START:.1f} at start), Python {platform.python_version()}, torch {torch.__version__}. "
-        f"Date: {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC.", "",
+        f"Date: {datetime.now(UTC):%Y-%m-%d %H:%M} UTC.", "",
         "| step, median (ms) | step, least (ms) | slowest round (ms) | the run's updates at the median (CPU min) |",
         "|---:|---:|---:|---:|",
         f"| {median * 1e3:.1f} | {least * 1e3:.1f} | {per_step.max() * 1e3:.1f} | {minutes:.1f} |", "",

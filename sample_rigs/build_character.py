@@ -156,7 +156,10 @@ def export_fbx(path):
         use_armature_deform_only=False)
 
 
-def build(out_dir=Path(__file__).resolve().parent):
+SAMPLE_RIGS_DIR = Path(__file__).resolve().parent
+
+
+def build(out_dir=SAMPLE_RIGS_DIR):
     """Build the character in a fresh scene and write character.blend and character.fbx to `out_dir`."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)

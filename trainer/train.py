@@ -11,4 +11,4 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from trainer.scripts import cli, train  # noqa: E402
 
 if __name__ == "__main__":
-    sys.exit(cli.run_main(train.main))
+    sys.exit(cli.run_main(train.main, interrupted=train.INTERRUPTED))

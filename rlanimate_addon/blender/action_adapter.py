@@ -5,16 +5,21 @@ Blender 4.2 keeps F-curves on the action (`action.fcurves`). Blender 4.4+ (and 5
 F-curves live in a channelbag of a keyframe strip of a layer, one channelbag per slot. Callers get
 an `ActionTarget` (the action and, where slots exist, the slot) and never touch either layout.
 """
-import hashlib
 import math
+import zlib
 
 import bpy
 import numpy as np
 
 LAYERED = "slots" in bpy.types.Action.bl_rna.properties
+#: Blender 5.0's `ChannelbagFCurves.new` takes the channel group's name; 4.4 and 4.5 group the F-curve after.
+_NEW_FCURVE_TAKES_GROUP = LAYERED and (
+    "group_name" in bpy.types.ActionChannelbagFCurves.bl_rna.functions["new"].parameters)
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZIER"].value
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
+#: A linear key's interpolation, as Keyframe.interpolation stores it.
+LINEAR_KEY = _LINEAR
 
 
 class ActionTarget:
@@ -34,20 +39,28 @@ class ActionTarget:
     def new_fcurve(self, data_path, index, group):
         """A new F-curve of this target, in the named channel group."""
         fcurves = self._fcurves(create=True)
-        if LAYERED:
+        if not LAYERED:
+            return fcurves.new(data_path, index=index, action_group=group)
+        if _NEW_FCURVE_TAKES_GROUP:
             return fcurves.new(data_path, index=index, group_name=group)
-        return fcurves.new(data_path, index=index, action_group=group)
+        fcurve = fcurves.new(data_path, index=index)
+        groups = self._channelbag.groups
+        fcurve.group = groups.get(group) or groups.new(group)
+        return fcurve
 
     def fcurves(self):
         """The F-curves of this target (a list, empty when there are none)."""
         fcurves = self._fcurves()
         return [] if fcurves is None else list(fcurves)
 
-    def clear_fcurves(self):
-        """Remove every F-curve of this target (the action and its slot stay)."""
+    def find(self, data_path, index):
+        """The F-curve of this target for the channel, or None."""
         fcurves = self._fcurves()
-        if fcurves is not None:
-            fcurves.clear()
+        return None if fcurves is None else fcurves.find(data_path, index=index)
+
+    def remove(self, fcurve):
+        """Remove one F-curve of this target."""
+        self._fcurves().remove(fcurve)
 
 
 def _channelbag(action, slot, create):
@@ -74,40 +87,85 @@ def new_action(name, obj):
     return ActionTarget(action)
 
 
-class KeyDigest:
-    """A hash of F-curves' keys, in F-curve order: each key's frame, value and interpolation, and a
-    Bezier curve's handles. Fed as keys are written (`write_keys`, `write_bezier_keys`) or read back
-    (`read_digest`), it comes out the same until anyone edits them."""
+class KeyMemory:
+    """The keys written to F-curves, curve by curve: each key's frame and value, its interpolation and a
+    Bezier curve's handles. Fed as keys are written (`write_keys`, `write_bezier_keys`), it is kept (`pack`)
+    to tell later which curves and frames anyone changed since (`changed_frames`)."""
 
     def __init__(self):
-        self._sha = hashlib.sha1()
+        self.curves = []  # [(data path, array index, co (K, 2) float32, interpolation (K,) uint8, handles)]
 
     def add(self, fcurve, co, interpolation, handles=()):
-        """co: (K, 2) float32; interpolation: (K,) int32; handles: the Bezier keys' left and right (K, 2) float32."""
-        self._sha.update(f"{fcurve.data_path}[{fcurve.array_index}]".encode())
-        for values in (co, interpolation, *handles):
-            self._sha.update(np.ascontiguousarray(values).tobytes())
+        """co: (K, 2) float32; interpolation: (K,); handles: the Bezier keys' left and right (K, 2) float32."""
+        self.add_keys(fcurve.data_path, fcurve.array_index, co, interpolation,
+                      np.concatenate(handles, axis=1) if len(handles) else None)
 
-    def hexdigest(self):
-        return self._sha.hexdigest()
+    def add_keys(self, data_path, index, co, interpolation, handles=None):
+        """As `add`, for the channel (data path, index); handles: (K, 4) left and right, or None."""
+        self.curves.append((data_path, int(index), np.array(co, dtype=np.float32),
+                            np.asarray(interpolation, dtype=np.uint8),
+                            None if handles is None else np.array(handles, dtype=np.float32)))
+
+    def pack(self):
+        """The keys as a record keeps them: {"paths", "indices", "counts", "bezier": per curve, "keys": bytes}."""
+        data = b"".join(part.tobytes() for _, _, co, interpolation, handles in self.curves
+                        for part in (co, interpolation) + (() if handles is None else (handles,)))
+        return {"paths": [path for path, *_ in self.curves], "indices": [i for _, i, *_ in self.curves],
+                "counts": [len(co) for _, _, co, *_ in self.curves],
+                "bezier": [handles is not None for *_, handles in self.curves], "keys": zlib.compress(data, 1)}
+
+    @classmethod
+    def unpack(cls, kept):
+        """The KeyMemory that `pack` returned (`kept`)."""
+        memory, data, offset = cls(), zlib.decompress(kept["keys"]), 0
+
+        def take(dtype, shape):
+            nonlocal offset
+            array = np.frombuffer(data, dtype=dtype, count=int(np.prod(shape)), offset=offset).reshape(shape)
+            offset += array.nbytes
+            return array
+        for path, index, count, bezier in zip(kept["paths"], kept["indices"], kept["counts"], kept["bezier"],
+                                              strict=True):
+            co, interpolation = take(np.float32, (count, 2)), take(np.uint8, (count,))
+            handles = take(np.float32, (count, 4)) if bezier else None
+            memory.curves.append((path, int(index), co, interpolation, handles))
+        return memory
 
 
-def read_digest(fcurves):
-    """The KeyDigest of the F-curves' keys as they are now."""
-    digest = KeyDigest()
-    for fcurve in fcurves:
-        points = fcurve.keyframe_points
-        count = len(points)
-        co = np.empty((count, 2), dtype=np.float32)
-        points.foreach_get("co", co.ravel())
-        interpolation = read_enum(points, "interpolation")
-        handles = ()
-        if (interpolation == _BEZIER).any():
-            handles = (np.empty((count, 2), dtype=np.float32), np.empty((count, 2), dtype=np.float32))
-            points.foreach_get("handle_left", handles[0].ravel())
-            points.foreach_get("handle_right", handles[1].ravel())
-        digest.add(fcurve, co, interpolation, handles)
-    return digest
+def read_keys(fcurve):
+    """(co (K, 2) float32, interpolation (K,) uint8, handles (K, 4) float32 or None when no key is Bezier) of
+    an F-curve's keys as they are now."""
+    points = fcurve.keyframe_points
+    count = len(points)
+    co = np.empty((count, 2), dtype=np.float32)
+    points.foreach_get("co", co.ravel())
+    interpolation = np.empty(count, dtype=np.uint8)
+    points.foreach_get("interpolation", interpolation)
+    if not (interpolation == _BEZIER).any():
+        return co, interpolation, None
+    handles = np.empty((count, 4), dtype=np.float32)
+    for k, side in enumerate(("handle_left", "handle_right")):
+        values = np.empty((count, 2), dtype=np.float32)
+        points.foreach_get(side, values.ravel())
+        handles[:, 2 * k:2 * k + 2] = values
+    return co, interpolation, handles
+
+
+def changed_frames(written, now):
+    """Frames (sorted ints) at which keys differ: written and now are `read_keys` triples (now None for a
+    curve that is gone: every written frame)."""
+    if now is None:
+        return sorted({int(round(f)) for f in written[0][:, 0]})
+    if all(a is None and b is None or a is not None and b is not None and np.array_equal(a, b)
+           for a, b in zip(written, now, strict=True)):
+        return []
+
+    def by_frame(co, interpolation, handles):
+        rows = [co, interpolation[:, None].astype(np.float32)] + ([] if handles is None else [handles])
+        return {float(row[0]): row[1:].tobytes() for row in np.concatenate(rows, axis=1)}
+    before, after = by_frame(*written), by_frame(*now)
+    frames = {f for f in before.keys() | after.keys() if before.get(f) != after.get(f)}
+    return sorted({int(round(f)) for f in frames})
 
 
 def _stored(enum_values):
@@ -123,9 +181,9 @@ def read_enum(points, name):
     return stored.astype(np.int32)
 
 
-def write_keys(fcurve, frames, values, digest=None):
-    """Bulk-write keys (frames (N,), values (N,)) into an empty F-curve, linear between frames, fed to
-    the KeyDigest given.
+def write_keys(fcurve, frames, values, memory=None):
+    """Bulk-write keys (frames (N,), values (N,)) into an empty F-curve, linear between frames, remembered by
+    the KeyMemory given.
 
     The keys arrive sorted, one per frame, with linear interpolation, so no handles need recomputing.
     """
@@ -137,13 +195,13 @@ def write_keys(fcurve, frames, values, digest=None):
     interpolation = np.full(count, _LINEAR, dtype=np.int32)
     points.foreach_set("co", co.ravel())
     points.foreach_set("interpolation", _stored(interpolation))
-    if digest is not None:
-        digest.add(fcurve, co, interpolation)
+    if memory is not None:
+        memory.add(fcurve, co, interpolation)
 
 
-def write_bezier_keys(fcurve, frames, values, tangents, digest=None):
+def write_bezier_keys(fcurve, frames, values, tangents, memory=None):
     """Bulk-write Bezier keys (frames (K,), values (K,), slopes per frame (K,)) into an empty F-curve,
-    fed to the KeyDigest given.
+    remembered by the KeyMemory given.
 
     Each key's handles sit a third of the way to its neighbouring keys along its slope (free handles,
     so Blender keeps them): every segment then plays the cubic Hermite curve core.key_reduction predicts.
@@ -163,9 +221,24 @@ def write_bezier_keys(fcurve, frames, values, tangents, digest=None):
         points.foreach_set(name, data.ravel())
     for name, value in (("interpolation", _BEZIER), ("handle_left_type", _FREE), ("handle_right_type", _FREE)):
         points.foreach_set(name, _stored(np.full(count, value)))
-    if digest is not None:
-        digest.add(fcurve, written["co"], np.full(count, _BEZIER, dtype=np.int32),
-                   (written["handle_left"], written["handle_right"]))
+    if memory is not None:
+        memory.add(fcurve, written["co"], np.full(count, _BEZIER), (written["handle_left"], written["handle_right"]))
+
+
+def write_points(fcurve, co, interpolation, handles=None):
+    """Replace an F-curve's keys with co (K, 2), interpolation (K,) and, where some are Bezier, free handles
+    (K, 4: left, right); without handles each key's handles sit on it."""
+    points = fcurve.keyframe_points
+    points.clear()
+    points.add(len(co))
+    co = np.asarray(co, dtype=np.float32)
+    points.foreach_set("co", co.ravel())
+    points.foreach_set("interpolation", _stored(interpolation))
+    left, right = (co, co) if handles is None else (handles[:, :2], handles[:, 2:])
+    for name, data in (("handle_left", left), ("handle_right", right)):
+        points.foreach_set(name, np.ascontiguousarray(data, dtype=np.float32).ravel())
+    for name in ("handle_left_type", "handle_right_type"):
+        points.foreach_set(name, _stored(np.full(len(co), _FREE)))
 
 
 def all_fcurves(action):
@@ -204,6 +277,20 @@ def is_animated(obj):
                                  or any(len(track.strips) for track in data.nla_tracks))
 
 
+def plays(obj):
+    """True when anything of the object's animation plays: an unmuted F-curve of its active action or of an
+    unmuted NLA strip, or an unmuted driver (`is_animated` counts muted ones too)."""
+    data = obj.animation_data
+    if data is None:
+        return False
+    if any(not d.mute for d in data.drivers):
+        return True
+    targets = [strip_target(s) for t in data.nla_tracks if not t.mute for s in t.strips
+               if not s.mute and s.action is not None]
+    active = active_target(obj)
+    return any(not f.mute for t in targets + ([active] if active is not None else []) for f in t.fcurves())
+
+
 def assign(obj, target):
     """Make `target` the object's active action."""
     data = obj.animation_data or obj.animation_data_create()
@@ -237,20 +324,33 @@ def push_down(obj, frames):
     data.action = None
 
 
-def add_strip(obj, target, start_frame, name):
-    """Put `target` on a new NLA track on top, starting at start_frame, with no effect outside it."""
+def add_strip(obj, target, frames, name, below=None):
+    """Put `target` on a new NLA track (on top, or right above the track `below`), playing its frames
+    (first, last) at those same frames with no effect outside them; returns the strip."""
     data = obj.animation_data or obj.animation_data_create()
-    track = data.nla_tracks.new()
+    track = data.nla_tracks.new(prev=below)
     track.name = name
-    return fill_track(track, target, start_frame, name)
+    return fill_track(track, target, frames, name)
 
 
-def fill_track(track, target, start_frame, name):
-    """Put `target` on the track as a strip called `name` from start_frame, with no effect outside it."""
-    strip = _new_strip(track, target, start_frame)
+def fill_track(track, target, frames, name):
+    """Put `target` on the track as a strip called `name` playing its frames (first, last) at those same
+    frames (keys of others in the action elsewhere do not shift it), with no effect outside them."""
+    strip = _new_strip(track, target, frames[0])
+    set_action_range(strip, *frames)
     strip.name = name
     strip.extrapolation = "NOTHING"
     return strip
+
+
+def set_action_range(strip, first, last):
+    """Have the strip play its action's frames first-last, unscaled, from its start frame."""
+    if first > strip.action_frame_end:
+        strip.action_frame_end = last
+        strip.action_frame_start = first
+    else:
+        strip.action_frame_start = first
+        strip.action_frame_end = last
 
 
 def _new_strip(track, target, start):

@@ -1,4 +1,4 @@
-"""Reading a rig, its animation and a target out of Blender, and writing a gesture's keys back in.
+"""Reading a rig, its animation and a target out of Blender (blender/key_layers.py writes a gesture's keys).
 
 Bones are matched to roles by core.rig_roles (Mixamo names with any prefix, Rigify, Unreal, Auto-Rig
 Pro, VRoid/VRM, Character Creator, Blender's metarig) or by a bone-map file. Positions are in the
@@ -10,9 +10,10 @@ from pathlib import Path
 import bpy
 import numpy as np
 
-from ..core import key_reduction, rig_roles, vrm
+from ..core import rig_roles, vrm
 from ..core.errors import RLAnimateError
 from ..core.gesture import RigState, role_skeleton
+from ..core.regular_file import open_regular
 from . import action_adapter, pose_underneath, rigify, vrm_map
 
 #: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
@@ -23,35 +24,42 @@ def rotation_path(mode):
     return ROTATION_PATHS.get(mode, "rotation_euler")
 
 
-def rig_roles_of(obj, bone_map_path=""):
+def rig_roles_of(obj, bone_map_path="", read_vrm=True):
     """(family name, {role: bone name}) of an armature: from the bone-map file when one is given, else
     from its VRM humanoid map (its VRM file, or the VRM add-on's data; blender/vrm_map.py), else
-    detected from its bone names. RLAnimateError when obj is not an armature."""
+    detected from its bone names. RLAnimateError when obj is not an armature. read_vrm=False (the panel's
+    draw()): a VRM file is not read, only looked up where an operator read it."""
     if obj is None or obj.type != "ARMATURE":
         raise RLAnimateError("The active object is not an armature: select the character's armature.")
     names = obj.data.bones.keys()
     if bone_map_path:
-        path = Path(bpy.path.abspath(bone_map_path))
-        try:
-            with open(path, "rb") as handle:  # bounded: a bone map is a few KB, /dev/zero is endless
-                data = handle.read(rig_roles.MAX_BONE_MAP_BYTES + 1)
-            if len(data) > rig_roles.MAX_BONE_MAP_BYTES:
-                raise RLAnimateError(f"The bone-map file {str(path)!r} is larger than "
-                                     f"{rig_roles.MAX_BONE_MAP_BYTES >> 10} KB, so it is not a bone map: pick a "
-                                     "bone-map JSON file saved from the panel, or clear the Bone Map field.")
-            text = data.decode("utf-8")
-        except OSError as error:
-            raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({error.strerror}): pick an "
-                                 "existing file, or clear the Bone Map field to detect the bones.") from None
-        except UnicodeDecodeError:
-            raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file "
-                                 "saved from the panel, or clear the Bone Map field.") from None
-        return rig_roles.read_bone_map(text, names)
-    roles = vrm_map.roles_of(obj)
+        return rig_roles.read_bone_map(_bone_map_text(Path(bpy.path.abspath(bone_map_path))), names)
+    roles = vrm_map.roles_of(obj, read_vrm)
     if roles:
         return vrm.FAMILY, roles
     family, roles = rig_roles.detect(names, rigify=rigify.is_generated(obj))
     return family.name, roles
+
+
+def _bone_map_text(path):
+    """The text of the bone-map file at `path`: a regular file (a FIFO or /dev/stdin would block every
+    redraw) of at most MAX_BONE_MAP_BYTES (/dev/zero is endless), UTF-8."""
+    try:
+        with open_regular(path) as handle:
+            data = handle.read(rig_roles.MAX_BONE_MAP_BYTES + 1)
+    except (OSError, ValueError) as error:  # ValueError: a NUL in the path
+        reason = getattr(error, "strerror", None) or error
+        raise RLAnimateError(f"Cannot read the bone-map file {str(path)!r} ({reason}): pick a bone-map JSON "
+                             "file saved from the panel, or clear the Bone Map field to detect the bones.") from None
+    if len(data) > rig_roles.MAX_BONE_MAP_BYTES:
+        raise RLAnimateError(f"The bone-map file {str(path)!r} is larger than {rig_roles.MAX_BONE_MAP_BYTES >> 10} KB, "
+                             "so it is not a bone map: pick a bone-map JSON file saved from the panel, or clear the "
+                             "Bone Map field.")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise RLAnimateError(f"The bone-map file {str(path)!r} is not UTF-8 text: pick a bone-map JSON file saved "
+                             "from the panel, or clear the Bone Map field.") from None
 
 
 def check_hips(obj, roles):
@@ -76,6 +84,13 @@ def read_skeleton(obj, roles):
     return role_skeleton(roles, rest, {b: bones[b].length for b in roles.values()})
 
 
+def rotation_basis(pose_bone, values):
+    """(4, 4) basis matrix of the rotation given by channel values (C,) in the bone's own rotation mode."""
+    basis = np.eye(4)
+    basis[:3, :3] = pose_underneath.rotation_matrices(pose_bone.rotation_mode, np.asarray([values], dtype=float))[0]
+    return basis
+
+
 def _rotation_values(pose_bone):
     return tuple(getattr(pose_bone, rotation_path(pose_bone.rotation_mode)))
 
@@ -91,7 +106,7 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
     at each frame where anything can move it. The caller restores the scene's frame.
     """
     scene = context.scene
-    animated = action_adapter.is_animated(obj)
+    animated = action_adapter.plays(obj)
     target_moves = target is not None and (may_move(target) or (target_bone and action_adapter.is_animated(target)))
     moving = animated or may_move(obj) or target_moves
     skeleton = read_skeleton(obj, roles)
@@ -100,7 +115,7 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
     if animated and not may_move(obj) and not target_moves:
         evaluated = pose_underneath.sample(obj, skeleton.names, frames)
     if evaluated is not None:
-        under, poses, values = evaluated
+        under, poses, values = _one_frame_if_still(*evaluated)
         rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
         return rig, values, np.broadcast_to(target_point(obj, target, target_bone, scene), (count, 3))
     pose_bones = [obj.pose.bones[name] for name in skeleton.names]
@@ -116,8 +131,21 @@ def sample_rig(context, obj, roles, family, frames, target=None, target_bone="")
         targets.append(target_point(obj, target, target_bone, scene))
     under, poses = (np.broadcast_to(np.array(m), (count,) + np.shape(m)[1:]) for m in (under, poses))
     values = {b: np.broadcast_to(np.array(v), (count, len(v[0]))) for b, v in values.items()}
+    under, poses, values = _one_frame_if_still(under, poses, values)
     rig = RigState(obj.name, skeleton, roles, family, under, animated, under_pose=poses)
     return rig, values, np.broadcast_to(np.array(targets), (count, 3))
+
+
+def _one_frame_if_still(under, poses, values):
+    """(basis, pose, {bone: channel values}) underneath as their first frame broadcast over the frames when
+    nothing moves over them: a pose that stands still is then read as a still rig's is, to the last bit."""
+    if under.strides[0] == 0 or np.ptp(under, axis=0).any() or np.ptp(poses, axis=0).any() or any(
+            np.ptp(v, axis=0).any() for v in values.values()):
+        return under, poses, values
+
+    def first(m):
+        return np.broadcast_to(np.array(m[:1]), m.shape)
+    return first(under), first(poses), {bone: first(v) for bone, v in values.items()}
 
 
 def may_move(obj):
@@ -156,46 +184,3 @@ def _world_point(target, target_bone, scene):
 
 def _to_armature(obj, point):
     return (np.array(obj.matrix_world.inverted(), dtype=np.float64) @ np.append(point, 1.0))[:3]
-
-
-def write_gesture(obj, name, start_frame, keys, blend_type, played, digest=None, properties=None):
-    """Key a gesture from start_frame into a new action called `name`; returns the new action.
-
-    keys: {bone name: (rotation mode, (N, C) channel values per frame, kept frame indices or None)}:
-    with kept indices, Bezier keys on those frames only (core.key_reduction), else a linear key on
-    every frame. On a rig with no animation the action
-    becomes the active action. Otherwise the active action (if any) is pushed down to the NLA, as
-    Blender's Push Down does, playing as before over its keys and the `played` frames (first, last:
-    the scene's range and the gesture's), and the gesture goes on a new NLA track above it with the
-    blend type ('REPLACE' or 'COMBINE') and no effect outside its frames. The keys feed the
-    action_adapter.KeyDigest given. properties: {data path: (N,) values} of other channels to key on
-    every frame (a Rigify arm's IK-FK switch).
-    """
-    target = action_adapter.new_action(name, obj)
-    key_action(target, start_frame, keys, digest, properties)
-    if action_adapter.is_animated(obj):
-        action_adapter.push_down(obj, played)
-        strip = action_adapter.add_strip(obj, target, start_frame, target.action.name)
-        strip.blend_type = blend_type
-    else:
-        action_adapter.assign(obj, target)
-    return target.action
-
-
-def key_action(target, start_frame, keys, digest=None, properties=None):
-    """Key a gesture from start_frame into an ActionTarget without F-curves (keys, digest and properties
-    as `write_gesture`'s)."""
-    for bone, (mode, values, kept) in keys.items():
-        frames = start_frame + np.arange(len(values))
-        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{rotation_path(mode)}'
-        tangents = None if kept is None else key_reduction.slopes(values)
-        for channel in range(values.shape[1]):
-            fcurve = target.new_fcurve(path, channel, bone)
-            if kept is None:
-                action_adapter.write_keys(fcurve, frames, values[:, channel], digest)
-            else:
-                action_adapter.write_bezier_keys(fcurve, frames[kept], values[kept, channel], tangents[kept, channel],
-                                                 digest)
-    for path, values in (properties or {}).items():
-        fcurve = target.new_fcurve(path, 0, path.split('"')[1])
-        action_adapter.write_keys(fcurve, start_frame + np.arange(len(values)), values, digest)

@@ -90,8 +90,8 @@ def _saved_keys(curve):
 def _restore_keys(curve, keys):
     curve.keyframe_points.clear()
     curve.keyframe_points.add(len(keys))
-    for point, values in zip(curve.keyframe_points, keys):
-        for field, value in zip(_KEY_FIELDS, values):
+    for point, values in zip(curve.keyframe_points, keys, strict=True):
+        for field, value in zip(_KEY_FIELDS, values, strict=True):
             setattr(point, field, value)
 
 
@@ -146,7 +146,7 @@ def verify(scene, plan):
     scale = float(np.cbrt(abs(np.linalg.det(np.array(obj.matrix_world.to_3x3())))))
     rest_points, carrier_rests = bake_measure.rest_points(rig, arm), _rest_matrices(obj, carriers)
     start = int(plan.settings.start_frame)
-    for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0]):
+    for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0], plan.shown):
         frame = start + index
         scene.frame_set(frame)
         played = bake_measure.carried(_armature_matrices(obj, carriers)[None], carrier_rests, rest_points)
@@ -177,7 +177,7 @@ def _check_target(obj, plan, frame, sampled, scale):
 
 def _cause(obj, rig, planned, measured, carriers, keyed):
     """Why the deformed hand is off, naming the bone and what drives it, with the fix."""
-    evaluated = dict(zip(rig.skeleton.names, _armature_matrices(obj, rig.skeleton.names)))
+    evaluated = dict(zip(rig.skeleton.names, _armature_matrices(obj, rig.skeleton.names), strict=True))
     size = float(np.linalg.norm(rig.skeleton.rest_head(measured[0]) - rig.skeleton.rest_head(rig.skeleton.names[0])))
     for i in rig.skeleton.ancestors(measured[0]) + [rig.skeleton.index[b] for b in measured[1:]]:
         name = rig.skeleton.names[i]
@@ -185,7 +185,7 @@ def _cause(obj, rig, planned, measured, carriers, keyed):
             evaluated[name][:3, 3] - planned[i, :3, 3]) > _OVERRIDE_SHARE * size
         if off:
             return f"The bone {name} does not play the gesture: {_drivers(obj, name, keyed)}"
-    for bone, carrier in zip(measured, carriers):
+    for bone, carrier in zip(measured, carriers, strict=True):
         if carrier != bone:
             return (f"The mesh deforms with {carrier}, which does not follow {bone}, the bone the gesture keys: "
                     f"{_drivers(obj, carrier, keyed, bone)}")

@@ -18,7 +18,13 @@ def save_bone_map(context, filepath):
     except OSError as error:
         raise RLAnimateError(f"Could not write {path} ({error.strerror}): choose a folder you can write to.") from None
     missing = [r for r in rig_roles.ROLES if r not in roles]
-    return f"Saved the {family} bone map of {obj.name!r} ({len(roles)} roles, {len(missing)} unmapped) to {path}"
+    needed = ([] if any(r in roles for r in rig_roles.SPINE) else ["Spine"]) + [
+        r for r in dict.fromkeys(rig_roles.required_roles("LEFT") + rig_roles.required_roles("RIGHT")) if r in missing]
+    found = f"{len(roles)} of {len(rig_roles.ROLES)} roles found"
+    if not missing:
+        return f"Saved the {family} bone map of {obj.name!r} ({found}) to {path}"
+    return (f"Saved the {family} bone map of {obj.name!r} ({found}) to {path}: the other {len(missing)} are written as "
+            f'"" to fill in' + (f", of which a gesture needs {', '.join(needed)}" if needed else ""))
 
 
 class RLANIMATE_OT_save_bone_map(bpy.types.Operator, ExportHelper):

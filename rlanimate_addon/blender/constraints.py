@@ -65,9 +65,10 @@ def against_gesture(obj, bone_names):
     return overriding(obj, bone_names) + held_below(obj, bone_names)
 
 
-def driven_bones(names, behaviour, arm):
-    """The rig's names of the bones a gesture keys: the action joints, and for Point the pointing hand."""
-    canonical = list(skeleton.ACTION_JOINTS)
+def driven_bones(names, behaviour, arm, still=True):
+    """The rig's names of the bones a gesture keys: the action joints it owns (the other arm only made as on a
+    still rig: gesture.owned_joints), and for Point the pointing hand."""
+    canonical = list(gesture.owned_joints(arm, still))
     if behaviour == "POINT":
         canonical += [skeleton.ARM_PREFIX[arm] + bone for bone in gesture.POINTING_HAND]
     return [names[name] for name in canonical if name in names]
@@ -235,12 +236,17 @@ def _targets(constraint):
     return found + [(t.target, t.subtarget) for t in getattr(constraint, "targets", ()) if t.target is not None]
 
 
+#: A basis location (in bone lengths) and scale this close to rest are at rest: float rounding.
+_OFF_REST = 5e-4
+
+
 def _at_rest(pose_bone):
-    """Whether the bone's basis is its rest: no rotation (within gesture.AT_REST), location or scale."""
+    """Whether the bone's basis is its rest: no rotation (within gesture.AT_REST: an importer's rounding),
+    location or scale (within _OFF_REST)."""
     basis = np.array(pose_bone.matrix_basis)
     rotation = np.array(pose_bone.matrix_basis.to_quaternion())
-    return (np.linalg.norm(rotation[1:]) < gesture.AT_REST and np.abs(basis[:3, 3]).max() <= gesture.AT_REST
-            * pose_bone.bone.length and np.abs(np.linalg.norm(basis[:3, :3], axis=0) - 1.0).max() < gesture.AT_REST)
+    return (np.linalg.norm(rotation[1:]) < gesture.AT_REST and np.abs(basis[:3, 3]).max() <= _OFF_REST
+            * pose_bone.bone.length and np.abs(np.linalg.norm(basis[:3, :3], axis=0) - 1.0).max() < _OFF_REST)
 
 
 def mute(obj, found, start, end, hold=False):
@@ -266,7 +272,7 @@ def mute(obj, found, start, end, hold=False):
         else:
             kept, evaluate = _keys(curve), curve.evaluate
         prior = {int(f): float(evaluate(float(f))) for f in frames}
-        keys = {**kept, **{f: v * k for (f, v), k in zip(prior.items(), keep)}}
+        keys = {**kept, **{f: v * k for (f, v), k in zip(prior.items(), keep, strict=True)}}
         if hold:
             prior = {**kept, **prior}
             keys = dict.fromkeys(keys, 0.0)

@@ -22,22 +22,51 @@ FBX_SETTINGS = dict(
 )
 
 
+class _OneFrameOn:
+    """The scene as Blender's exporter sees it while it times the scene's take: frame_set(F) plays frame F + 1,
+    so the exporter writes frame F + 1 at time F / fps. Everything else is the scene's."""
+
+    def __init__(self, scene):
+        self._scene = scene
+
+    def frame_set(self, frame, subframe=0.0):
+        self._scene.frame_set(frame + 1, subframe=subframe)
+
+    def __getattr__(self, name):
+        return getattr(self._scene, name)
+
+
 @contextmanager
-def take_from_time_zero():
-    """Blender's exporter writes the scene's take with frame F at time F / fps, and its importer puts time 0
-    on frame 1 by default (anim_offset=1): a gesture baked from frame 1 came back one frame late (8 cm at
-    the sample's right hand). Within this context the scene's take starts at time 0 on its first frame, as
-    a Mixamo download's does and as the exporter already writes each NLA strip's and action's take
-    (its start_zero): `fbx_animations_do`, the exporter's one function that times a take, is called with
-    start_zero on. The exporter is left as it was on exit."""
+def take_at_own_frames(first, last):
+    """Within this context Blender's exporter writes the scene's take over frames first-last with frame F at
+    time (F - 1) / fps, which its importer, at its defaults (Animation Offset 1: time 0 on frame 1), puts back
+    on frame F: every keyed frame plays at its own time whatever the scene's start (frames before 1 at
+    negative times; the scene's own range cannot start below 0).
+
+    The exporter writes a scene's take over the scene's range with frame F at time F / fps (a gesture baked
+    from frame 1 came back one frame late, 8 cm at the sample's right hand), and has no option for another
+    range or offset. Its one function that times a take, `fbx_animations_do`, is called for the scene's take
+    with the range one frame earlier on a scene whose frame_set plays one frame on (`_OneFrameOn`), and the
+    scene's frame put back; the exporter is left as it was on exit."""
     from io_scene_fbx import export_fbx_bin  # Blender's bundled FBX add-on (4.2 to 5.0)
 
     timed = export_fbx_bin.fbx_animations_do
 
-    def from_zero(scene_data, ref_id, f_start, f_end, start_zero, *args, **kwargs):
-        return timed(scene_data, ref_id, f_start, f_end, True, *args, **kwargs)
+    def at_own_frames(scene_data, ref_id, f_start, f_end, start_zero, *args, **kwargs):
+        if ref_id is not None or start_zero:  # a strip's or an action's take: timed as the exporter times it
+            return timed(scene_data, ref_id, f_start, f_end, start_zero, *args, **kwargs)
+        scene = scene_data.scene
+        frame, subframe = scene.frame_current, scene.frame_subframe
+        try:
+            # Sampled to half a frame past the end: the exporter's np.arange(start, nextafter(end)) drops the last
+            # frame of a range starting below 0 (the nextafter is lost in the sum); the take keeps its true end.
+            taken = timed(scene_data._replace(scene=_OneFrameOn(scene)), ref_id, first - 1, last - 0.5, False,
+                          *args, **kwargs)
+        finally:
+            scene.frame_set(frame, subframe=subframe)
+        return None if taken is None else (*taken[:-1], last - 1)  # (..., its first frame, its last frame)
 
-    export_fbx_bin.fbx_animations_do = from_zero
+    export_fbx_bin.fbx_animations_do = at_own_frames
     try:
         yield
     finally:
@@ -82,8 +111,8 @@ def check_path(filepath):
 def export_rig(context, filepath):
     """Write the active armature and its meshes to `filepath`; returns a one-line summary.
 
-    The scene's frame range is widened for the export to take in all of the rig's animation, then
-    restored along with the selection.
+    The take spans the scene's frame range widened to all of the rig's animation (take_at_own_frames); the
+    selection is restored.
     """
     rig = context.active_object
     if rig is None or rig.type != "ARMATURE":
@@ -92,30 +121,27 @@ def export_rig(context, filepath):
     scene, view_layer = context.scene, context.view_layer
     objects = [rig] + rig_meshes(rig, scene)
     selected = [o for o in view_layer.objects if o.select_get()]
-    frame_range = (scene.frame_start, scene.frame_end)
+    first, last = scene.frame_start, scene.frame_end
     keyed = animation_range(rig)
+    if keyed is not None:
+        first, last = min(first, keyed[0]), max(last, keyed[1])
     try:
         for obj in selected:
             obj.select_set(False)
         for obj in objects:
             obj.select_set(True)
-        if keyed is not None:
-            scene.frame_start, scene.frame_end = min(frame_range[0], keyed[0]), max(frame_range[1], keyed[1])
-        first = scene.frame_start
-        with take_from_time_zero():
+        with take_at_own_frames(first, last):
             bpy.ops.export_scene.fbx(filepath=str(path), **FBX_SETTINGS)
     except RuntimeError as error:
         raise RLAnimateError(f"Could not write {path}: {operator_error_reason(error)}. Choose a folder you can write "
                              "to.") from None
     finally:
-        scene.frame_start, scene.frame_end = frame_range
         for obj in objects:
             obj.select_set(False)
         for obj in selected:
             obj.select_set(True)
-    where = "" if first == 1 else (f"; its take starts at time 0 on frame {first}, which Blender's FBX importer "
-                                   f"places on frame 1 (Animation Offset 1; give {first} to keep the frames)")
-    return f"Exported {rig.name!r} with {len(objects) - 1} mesh(es) to {filepath}{where}"
+    return (f"Exported {rig.name!r} with {len(objects) - 1} mesh(es), frames {first}-{last} each at its "
+            f"own time, to {filepath}")
 
 
 class RLANIMATE_OT_export_fbx(bpy.types.Operator, ExportHelper):

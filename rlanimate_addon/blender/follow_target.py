@@ -11,7 +11,6 @@ the gesture that the panel shows, until Generate bakes it again. A gesture baked
 Constraints is re-baked muting them again.
 """
 import time
-from types import SimpleNamespace
 
 import bpy
 import numpy as np
@@ -27,15 +26,10 @@ MOVED = 1e-6
 _state = {"busy": False, "last": -np.inf, "pending": False}
 
 
-def _gesture_settings(record):
-    """The recorded settings as Generate reads them (no target: None), replacing the gesture in place."""
-    return SimpleNamespace(**{"target": None, **record["settings"].to_dict(), "keep_previous": False})
-
-
 def _moved(obj, gesture, scene):
     """Whether the gesture's target sits elsewhere than it aimed at on the current frame."""
     record = gesture.record
-    settings = _gesture_settings(record)
+    settings = generate.recorded_settings(record)
     target = settings.target
     if target is None or len(record["aimed_at"]) == 0:
         return False  # the 3D cursor is not followed
@@ -59,18 +53,18 @@ def follow(scene, moved=None):
         gesture = gestures.last_targeted(obj)
         if gesture is None or gesture.record["note"]:
             continue
-        target = _gesture_settings(gesture.record).target
+        target = generate.recorded_settings(gesture.record).target
         if moved is not None and obj not in moved and target not in moved:
             continue
         if not _moved(obj, gesture, scene):
             continue
-        if gestures.edited_by_hand(gesture):
+        if gestures.edited(gesture):
             _stop(gesture, "its keys were edited by hand since it was baked, and a re-bake would lose the edits. "
                            "Generate it again to follow its target")
             continue
         try:
             # A gesture baked muting constraints had the animator's consent to mute them: it still has.
-            generate.bake(bpy.context, [(obj, _gesture_settings(gesture.record))],
+            generate.bake(bpy.context, [(obj, generate.recorded_settings(gesture.record), gesture.name)],
                           mute_constraints=bool(gesture.record.get("influence_before")))
         except RLAnimateError as error:
             _stop(gesture, str(error))

@@ -1,11 +1,43 @@
-"""Generate Gesture: run the agent for the scene's settings and bake the result onto the selected armatures."""
+"""Generate Gesture: run the agent for the scene's settings and bake the result onto the selected armatures.
+
+On an armature with gestures a Generate either bakes one of them again in place (the one selected in the
+panel's list, else the one on the same arm that starts on the same frame) or adds one (core/composition.py):
+over an earlier gesture on its arm that still plays at its start it takes over there, starting from that
+gesture's pose, which is trimmed there; before a later one it is trimmed where that one takes over. Then the
+gestures that depend on the one it changed (their aim, their start pose) are baked again from their records,
+unless edited by hand. blender/gestures.py describes how a gesture's keys are laid out.
+"""
+import types
+
 import bpy
 import numpy as np
 
-from ..core import behaviours, blas_threads, channels, frame_rate, gesture, key_reduction, rig_roles, rig_scale
+from ..core import (
+    behaviours,
+    blas_threads,
+    channels,
+    composition,
+    frame_rate,
+    gesture,
+    key_reduction,
+    rig_roles,
+    rig_scale,
+)
 from ..core import rigify as rig_rigify
 from ..core.errors import RLAnimateError
-from . import action_adapter, armature_io, bake_check, constraints, gestures, preferences, properties, rigify
+from . import (
+    action_adapter,
+    armature_io,
+    bake_check,
+    constraints,
+    gestures,
+    key_layers,
+    pose_underneath,
+    preferences,
+    properties,
+    rigify,
+)
+from .gestures import MAIN, TORSO
 
 
 def _check_request(settings, agent):
@@ -51,6 +83,15 @@ def check_keepable(obj):
                              "Editable) and generate again.")
 
 
+def check_not_editing(obj):
+    """RLAnimateError when the armature is in Edit mode, where its pose does not play (the bake check failed
+    there). Refused rather than left and returned to: the undo step Blender pushes in Edit mode is an Edit-mode
+    step, and that it takes back a gesture's action cannot be checked headless (ed.undo needs a window)."""
+    if obj.mode == "EDIT":
+        raise RLAnimateError(f"Armature {obj.name!r} is in Edit mode, where its pose does not play: leave Edit mode "
+                             "(Tab, or choose Pose Mode) and generate again.")
+
+
 def check_inherited_rotation(obj, roles):
     """RLAnimateError when a bone playing a role does not inherit its parent's rotation: the gesture's
     retargeting and aim turn each bone relative to its parent."""
@@ -87,13 +128,18 @@ def check_frames(start, frame_count):
 
 
 def selected_armatures(context, settings):
-    """The armatures to bake onto: the active object, which must be one, then every other selected
-    armature (the Point target excluded)."""
-    active = context.active_object
-    if active is None or active.type != "ARMATURE":
-        raise RLAnimateError("The active object is not an armature: select the character's armature.")
-    return [active] + [o for o in context.selected_objects
-                       if o.type == "ARMATURE" and o is not active and o is not settings.target]
+    """The armatures to bake onto: the active object's (itself, or the armature deforming a selected mesh),
+    then every other selected object's (the Point target excluded)."""
+    active = properties.armature_of(context.active_object)
+    if active is None:
+        raise RLAnimateError("The active object is not an armature, nor a mesh an armature deforms: select the "
+                             "character's armature or its mesh.")
+    found = [active]
+    for obj in context.selected_objects:
+        rig = properties.armature_of(obj)
+        if rig is not None and rig not in found and rig is not settings.target and obj is not settings.target:
+            found.append(rig)
+    return found
 
 
 class _Plan:
@@ -102,17 +148,35 @@ class _Plan:
     def __init__(self, obj, family, roles, overriding, ik_share=None):
         self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
         self.ik_share = ik_share  # a Rigify arm in IK: its IK_FK value, switched to FK over the gesture
+        self.from_ik = False  # ... and whether it stands in IK (IK_FK below 1) on any of the gesture's frames
         self.properties = None
-        self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.settings = None
+        self.settings = self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.action = None
         self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
-        self.previous = None  # the gesture it replaces (blender/gestures.py)
+        self.previous = self.before = None  # the gesture it bakes again in place, and its Span before
+        self.taken = None  # the earlier gesture on its arm it takes over from (trimmed at its start)
+        self.taking = None  # the Span of the later gesture on its arm that takes over from it
+        self.still = False  # made as on a still rig: the rig's base (blender/gestures.py)
         self.under = {}  # {bone: channel values} of keyed bones that stand still underneath
         self.worst = 0.0
         self.hold = False  # the constraints it mutes stay muted beyond its frames (constraints.follow_rest)
 
+    @property
+    def frames(self):
+        """(first, last) frame of the gesture."""
+        start = int(self.settings.start_frame)
+        return start, start + int(self.settings.frame_count) - 1
 
-def _check(obj, settings, start, end, mute_constraints):
+    @property
+    def shown(self):
+        """Frames from its start the gesture plays at full influence: all, or up to where a later one on its
+        arm takes over."""
+        start, end = self.frames
+        return end - start + 1 if self.taking is None else min(end, self.taking.start) - start + 1
+
+
+def _check(obj, settings, start, end, mute_constraints, still):
     """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
+    check_not_editing(obj)
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
     ik_share = rigify.ik_share(obj, settings.arm) if family == rig_roles.RIGIFY.name else None
@@ -120,16 +184,57 @@ def _check(obj, settings, start, end, mute_constraints):
     check_nla(obj)
     check_inherited_rotation(obj, roles)
     armature_io.check_hips(obj, roles)
-    rig_scale.check_nonzero_scale(obj.name, obj.matrix_world,
-                                  _scales(obj, constraints.driven_bones(roles, settings.behaviour, settings.arm)))
+    driven = constraints.driven_bones(roles, settings.behaviour, settings.arm, still)
+    rig_scale.check_nonzero_scale(obj.name, obj.matrix_world, _scales(obj, driven))
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
-    driven = constraints.driven_bones(roles, settings.behaviour, settings.arm)
+    driven = constraints.driven_bones(roles, settings.behaviour, settings.arm, still)
     constraints.check_drivers(obj, driven)
     overriding = constraints.against_gesture(obj, driven)
     constraints.check(obj, overriding, start, end, mute_constraints)
     return _Plan(obj, family, roles, overriding, ik_share)
+
+
+def _plan(obj, settings, selected, mute_constraints):
+    """The checked _Plan of a gesture on an armature, and what it does to the armature's other gestures: the
+    one it bakes again (`selected`: a gesture's name, else the one on its arm starting on its frame), the one it
+    takes over from and the one taking over from it (none with Keep Previous: it layers)."""
+    start = int(settings.start_frame)
+    end = start + int(settings.frame_count) - 1
+    placed = gestures.placed_gestures(obj)
+    spans = [g.span for g in placed]
+    named = {g.name: g for g in placed}
+    match = composition.regenerated(spans, settings.arm, start, selected, settings.keep_previous)
+    previous = None if match is None else named[match.id]
+    still = previous.still if previous is not None else not action_adapter.is_animated(obj)
+    plan = _check(obj, settings, start, end, mute_constraints, still)
+    plan.settings, plan.previous, plan.still = settings, previous, still
+    if previous is not None:
+        plan.before = previous.span
+        _check_unedited(previous, settings, "bake it again")
+    if previous is not None and previous.span.layered:
+        return plan
+    if not settings.keep_previous:
+        exclude = () if previous is None else (previous.name,)
+        taken = composition.taken_over(spans, settings.arm, start, exclude)
+        plan.taken = None if taken is None else named[taken.id]
+        plan.taking = composition.taking_over(spans, settings.arm, start, end, exclude)
+        if plan.taken is not None and plan.taken.still:  # a base fades its own keys: its edits would be lost
+            _check_unedited(plan.taken, settings, "take over from it at frame {start}, fading its keys",
+                            skip=plan.taken.other_arm_curves())
+    return plan
+
+
+def _check_unedited(placed, settings, doing, skip=()):
+    """RLAnimateError naming the bones and frames of the gesture's keys edited by hand (but those of `skip`),
+    unless Replace Edited Keys is on."""
+    found = {channel: frames for channel, frames in gestures.edited(placed).items() if channel not in skip}
+    if found and not getattr(settings, "replace_edited_keys", False):
+        raise RLAnimateError(
+            f"The keys of {placed.name!r} were edited by hand on {gestures.describe_edits(found)}, and Generate "
+            f"would {doing.format(start=int(settings.start_frame))}, overwriting them: tick 'Replace Edited Keys' "
+            "to do so anyway, or 'Keep Previous' to layer the new gesture over it instead.")
 
 
 def _scales(obj, names):
@@ -144,11 +249,11 @@ def _scales(obj, names):
     return scales
 
 
-def _compute(context, plan, settings, agent, frames):
+def _compute(context, plan, agent, frames):
     """Fill in the plan's gesture and keys (nothing written), on one BLAS thread: every product here is
     small, and on a machine with busy cores BLAS threads only wait (core/blas_threads.py)."""
     with blas_threads.single_blas_thread():
-        obj, scene = plan.obj, context.scene
+        obj, scene, settings = plan.obj, context.scene, plan.settings
         original_frame = scene.frame_current
         targeted = agent.kind(settings.behaviour) == behaviours.TARGET
         target = settings.target if targeted else None
@@ -158,12 +263,10 @@ def _compute(context, plan, settings, agent, frames):
             with constraints.muted(context.view_layer, plan.overriding):
                 rig, below_values, targets = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames,
                                                                     target, bone)
-            if plan.previous is not None and not plan.previous.record.get("animated", True):
-                # It replaces a gesture made on a still rig: with nothing else moving these frames (other
-                # gestures elsewhere make the rig animated), it plays as that first one did.
-                rig, below_values = rig.standing_still(below_values) or (rig, below_values)
+            rig = _as_made(plan, rig, below_values, frames)
             if plan.ik_share is not None:  # the FK controls start where the arm stands in IK
                 played, switch = rigify.played_arm(context, obj, settings.arm, frames, rig.animated)
+                plan.from_ik = bool(np.any(switch < 1.0))
                 rig = rig_rigify.snap_fk(rig, rig_rigify.fk_controls(settings.arm), played)
         finally:
             if scene.frame_current != original_frame:
@@ -173,68 +276,125 @@ def _compute(context, plan, settings, agent, frames):
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
                                          tempo=settings.tempo or None, exact_aim=settings.exact_aim,
                                          fps=properties.scene_fps(scene))
-        plan.bones, keyed, below = gesture.gesture_rotations(agent, request, rig)
-        plan.keyed = keyed
+        plan.bones, plan.keyed, below = gesture.gesture_rotations(agent, request, rig)
         if target is not None:
             plan.target, plan.target_bone, plan.targets = target, bone, targets
-        plan.rig, plan.blend_type = rig, settings.blend_type if rig.animated else "REPLACE"
+        plan.rig, plan.blend_type = rig, "REPLACE" if plan.still else settings.blend_type
         # A still rig held at rest by its constraints stands as any still rig does: they stay muted.
-        plan.hold = bool(plan.overriding) and not rig.animated and constraints.follow_rest(obj, plan.overriding)
+        plan.hold = bool(plan.overriding) and plan.still and constraints.follow_rest(obj, plan.overriding)
         if plan.ik_share is not None:
             plan.properties = rigify.switch_keys(obj, settings.arm, switch, plan.blend_type, rig.animated)
-        plan.under = {bone: below_values[bone][0] for bone in plan.bones if not np.ptp(below_values[bone], axis=0).any()}
-        plan.keys = {}
-        for column, bone in enumerate(plan.bones):
-            mode = obj.pose.bones[bone].rotation_mode
-            values = channels.rotation_keys(mode, keyed[:, column], below[:, column], below_values[bone],
-                                            plan.blend_type)
-            kept = None
-            if settings.editable_keys:
-                added = below_values[bone] if plan.blend_type == "COMBINE" and mode != "QUATERNION" else None
-                kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
-                plan.worst = max(plan.worst, deviation)
-            plan.keys[bone] = (mode, values, kept)
+        plan.under = {bone: below_values[bone][0] for bone in plan.bones
+                      if not np.ptp(below_values[bone], axis=0).any()}
+        if rig.resting:  # a base keeps where its bones first stood, whatever gestures above move them since
+            plan.under.update({bone: values for bone, values in plan.previous.record["under"].items()
+                               if bone in rig.resting and bone in plan.bones})
+        plan.keys = _keys(plan, below, below_values)
+
+
+def _as_made(plan, rig, values, frames):
+    """The rig as the gesture is made over it (gesture.RigState's still, held, resting and bare): as on a still
+    rig for the rig's base, whose bones that nothing but gestures move start where it first found them (so it
+    plays as it did, whatever gestures above it do); from the pose of the gesture it takes over from at its
+    start frame, over its blend in; the spine, neck and head as the animation plays them without the turns
+    other gestures add. values: {bone: (N, C) rotation channel values underneath}."""
+    animated, resting, count = rig.animated, {}, len(frames)
+    pose_bones = plan.obj.pose.bones
+    if plan.previous is not None and plan.previous.still:
+        animated, moved = gestures.animator_bones(plan.obj)
+        resting = {bone: armature_io.rotation_basis(pose_bones[bone], kept)
+                   for bone, kept in plan.previous.record["under"].items()
+                   if bone in rig.skeleton.index and bone not in moved}
+    torso = {rig.roles[role]: values[rig.roles[role]] for role in gesture.TORSO if role in rig.roles}
+    own = plan.previous.torso.track if plan.previous is not None and plan.previous.torso is not None else None
+    animation, above = gestures.torso_layers(plan.obj, torso, frames, own)
+    bare = {}
+    for bone, kept in animation.items():
+        bare[bone] = np.tile(np.eye(4), (count, 1, 1))
+        bare[bone][:, :3, :3] = pose_underneath.rotation_matrices(pose_bones[bone].rotation_mode, kept)
+    held = gesture.blend_ramp(count) + 1 if plan.taken is not None else 0
+    return gesture.RigState(rig.name, rig.skeleton, rig.roles, rig.family, rig.under, animated, rig.under_pose,
+                            still=plan.still, held=held, resting=resting, bare=bare, above=above)
+
+
+def _keys(plan, below, below_values):
+    """{MAIN: keys, TORSO: keys} (key_layers.key_action's) of the plan's bones in their own rotation modes: the
+    spine, neck and head on the Combine torso layer, the others on the main one, of the plan's blend type. A
+    torso bone in axis-angle goes on the main layer: the NLA adds axis-angle channels over nothing below as
+    over zeros, not over the mode's rest (0, 0, 1, 0), so a Combine key of it would not play as planned."""
+    settings = plan.settings
+    torso = {plan.roles[role] for role in gesture.TORSO
+             if role in plan.roles and plan.obj.pose.bones[plan.roles[role]].rotation_mode != "AXIS_ANGLE"}
+    keys = {MAIN: {}, TORSO: {}}
+    for column, bone in enumerate(plan.bones):
+        layer = TORSO if bone in torso else MAIN
+        blend_type = "COMBINE" if layer == TORSO else plan.blend_type
+        mode = plan.obj.pose.bones[bone].rotation_mode
+        values = channels.rotation_keys(mode, plan.keyed[:, column], below[:, column], below_values[bone],
+                                        blend_type)
+        kept = None
+        if settings.editable_keys:
+            added = below_values[bone] if blend_type == "COMBINE" and mode != "QUATERNION" else None
+            kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
+            plan.worst = max(plan.worst, deviation)
+        keys[layer][bone] = (mode, values, kept)
+    return keys
 
 
 def generate(context, settings, progress=lambda step: None, mute_constraints=False):
     """Bake a gesture onto the active armature and every other selected one; returns a summary, one line
     per armature. Each armature uses its own settings where it has them switched on (Object.rlanimate),
-    else the shared `settings` (one target for all).
+    else the shared `settings` (one target for all), and bakes again the gesture selected in the panel's list
+    (Object.rlanimate.gesture), if any.
 
     Every check, for every armature, runs before the first write, so an RLAnimateError leaves the file
     as it was (the scene frame included). Constraints that would override the gesture are refused, or
     muted over its frames with mute_constraints (blender/constraints.py). After the writes each rig is
     played and its deformed hand measured (blender/bake_check.py): a bake that does not play is undone,
-    every armature's, and refused. A gesture on the same arm over overlapping frames is
-    replaced in place unless Keep Previous is on (blender/gestures.py).
+    every armature's, and refused.
     """
     armatures = selected_armatures(context, settings)
-    return bake(context, [(obj, properties.settings_for(obj, settings)) for obj in armatures], progress,
-                mute_constraints)
+    requests = [(obj, properties.settings_for(obj, settings), gestures.selected(obj)) for obj in armatures]
+    return bake(context, requests, progress, mute_constraints)
 
 
-def bake(context, requests, progress=lambda step: None, mute_constraints=False):
-    """`generate` for [(armature, its settings)]; returns the summary."""
-    plans = []
-    for obj, own in requests:
-        start = int(own.start_frame)
-        end = start + int(own.frame_count) - 1
-        plan = _check(obj, own, start, end, mute_constraints)
-        plan.settings = own
-        plan.previous = None if own.keep_previous else gestures.overlapping(obj, own.arm, start, end)
-        plans.append(plan)
+def bake(context, requests, progress=lambda step: None, mute_constraints=False, cascade=True):
+    """`generate` for [(armature, its settings, the name of the gesture to bake again or "")]; returns the
+    summary. With cascade, the gestures that depend on those it changed are baked again after."""
+    plans = [_plan(obj, own, selected, mute_constraints) for obj, own, selected in requests]
     agent = preferences.selected_agent(context)
     for plan in plans:
         gesture.check_length(int(plan.settings.frame_count))
         check_frames(int(plan.settings.start_frame), int(plan.settings.frame_count))
         _check_request(plan.settings, agent)
     progress(1)
-    for plan in plans:
-        start, count = int(plan.settings.start_frame), int(plan.settings.frame_count)
-        with gestures.detached(plan.previous, context.view_layer):
-            _compute(context, plan, plan.settings, agent, start + np.arange(count))
+    # Backups of the gestures it changes (rewritten in place, trimmed), made before BakeUndo records the file.
+    trimmed = [key_layers.Backup(plan.taken) for plan in plans if plan.taken is not None]
+    rewritten = [key_layers.Backup(plan.previous) for plan in plans if plan.previous is not None]
+    try:
+        for plan in plans:
+            start, count = plan.frames[0], int(plan.settings.frame_count)
+            if plan.taken is not None:  # its pose at the handover is where this one starts
+                key_layers.trim(plan.taken, start, gesture.blend_ramp(count))
+            with gestures.detached([plan.previous] if plan.previous is not None else [], context.view_layer):
+                _compute(context, plan, agent, start + np.arange(count))
+    except BaseException:
+        for backup in trimmed:
+            backup.restore()
+        for backup in rewritten:
+            backup.discard()
+        raise
     progress(3)
-    replaced = [gestures.Backup(plan.previous) for plan in plans if plan.previous is not None]
+    lines = _write_and_verify(context, plans, agent, trimmed + rewritten)
+    progress(4)
+    if cascade:
+        lines = [line + _cascade(context, plan) for line, plan in zip(lines, plans, strict=True)]
+    return "\n".join(lines)
+
+
+def _write_and_verify(context, plans, agent, backups):
+    """Write every plan, then play each and verify it (blender/bake_check.py): a bake that does not play is
+    undone, every plan's, the gestures it changed put back. Returns the summary lines."""
     undo = [bake_check.BakeUndo(plan.obj, plan.overriding, rigify.switches(plan.obj, plan.properties))
             for plan in plans]
     scene = context.scene
@@ -249,63 +409,148 @@ def bake(context, requests, progress=lambda step: None, mute_constraints=False):
     except RLAnimateError:
         for record in reversed(undo):
             record.restore()
-        for backup in replaced:
+        for backup in backups:
             backup.restore()
         raise
     finally:
         scene.frame_set(original_frame)
-    for backup in replaced:
+    for backup in backups:
         backup.discard()
-    progress(4)
-    return "\n".join(lines)
+    return lines
+
+
+#: The role prefix of the arm a gesture on each arm does not gesture with.
+_OTHER = {"LEFT": "Right", "RIGHT": "Left"}
 
 
 def _write(plan, agent, scene):
     """Write one armature's planned gesture; returns its summary line."""
-    settings = plan.settings
-    start, count = int(settings.start_frame), int(settings.frame_count)
-    end = start + count - 1
+    settings, obj = plan.settings, plan.obj
+    (start, end), count = plan.frames, int(settings.frame_count)
     label = f"{behaviours.title(settings.behaviour)} {settings.arm.title()}"
-    note = ""
-    span = frame_rate.agent_frames(count, properties.scene_fps(scene))
-    kind = agent.kind(settings.behaviour)
-    steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], kind)
-    if steps != span:
-        note += f" (time-scaled from the agent's {steps}-frame gesture)"
-    note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
-    if settings.behaviour == behaviours.POINT and not settings.exact_aim:
-        note += " (the agent's own aim: Exact Aim is off)"
-    digest = action_adapter.KeyDigest()
+    played = (min(scene.frame_start, start), max(scene.frame_end, end))
     if plan.previous is not None:  # its constraints' fade undone first, so the new one applies once
-        constraints.unmute(plan.obj, gestures.influence_before(plan.previous))
-        action = gestures.replace(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type, digest,
-                                  plan.properties)
-        note += " (replaced the previous gesture)"
+        constraints.unmute(obj, gestures.influence_before(plan.previous))
+        gesture_id = int(plan.previous.record.get("id", gestures.next_id(obj)))
+        memories = key_layers.rewrite(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
+                                      plan.properties, gesture_id)
+        plan.action = plan.previous.action
     else:
-        action = armature_io.write_gesture(plan.obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                           (min(scene.frame_start, start), max(scene.frame_end, end)), digest,
-                                           plan.properties)
-    if plan.ik_share is not None:
+        gesture_id = gestures.next_id(obj)
+        plan.action, memories = key_layers.place(obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
+                                                 played, plan.properties, plan.still, gesture_id)
+    influence_before = constraints.mute(obj, plan.overriding, start, end, plan.hold)
+    kind = agent.kind(settings.behaviour)
+    other = {bone for role, bone in plan.roles.items() if role.startswith(_OTHER[settings.arm]) and "Eye" not in role}
+    gestures.record(plan.action, {
+        "id": gesture_id, "behaviour": settings.behaviour, "kind": kind, "arm": settings.arm, "start": start,
+        "end": end, "settings": gestures.snapshot(settings), "under": plan.under, "aimed_at": plan.targets,
+        "influence_before": influence_before, "animated": not plan.still},
+        memories, {(path, i) for path, i, *_ in memories[MAIN].curves if gestures.bone_of(path) in other})
+    placed = next(g for g in gestures.placed_gestures(obj) if g.action == plan.action)
+    if plan.taking is not None:  # plays until the later gesture on its arm takes over
+        key_layers.trim(placed, plan.taking.start, gesture.blend_ramp(plan.taking.end - plan.taking.start + 1))
+    gestures.renamed(obj, plan.before.id if plan.before else "", plan.action.name)
+    return _summary(plan, agent, scene, placed, count)
+
+
+def _summary(plan, agent, scene, placed, count):
+    """The report line of a written plan: what was baked where, and how it composes with the others."""
+    settings = plan.settings
+    start, end = plan.frames
+    label = f"{behaviours.title(settings.behaviour)} {settings.arm.title()}"
+    note = _length_notes(plan, agent, scene, count) + _composing_notes(plan, placed)
+    if plan.from_ik:  # an animated switch already at FK is keyed at FK, and nothing is said
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
-    influence_before = constraints.mute(plan.obj, plan.overriding, start, end, plan.hold)
-    gestures.record(action, gestures.snapshot(settings), kind, start, end, plan.under, plan.targets,
-                    digest.hexdigest(), influence_before, plan.rig.animated)
-    muted = ""
     if plan.overriding:
         held = (", held muted beyond them: they hold the rig at rest, so it stands as a still rig does"
                 if plan.hold else "")
-        muted = f" (muted {constraints.describe(plan.overriding)} over its frames{held})"
-    layer = f", {plan.blend_type.title()} layer over its animation" if plan.rig.animated else ""
+        note += f" (muted {constraints.describe(plan.overriding)} over its frames{held})"
+    layer = "" if plan.still else f", {plan.blend_type.title()} layer over its animation"
     editable = ""
     if settings.editable_keys:
-        keys = sum(len(kept) * values.shape[1] for _, values, kept in plan.keys.values())
+        keys = sum(len(kept) * values.shape[1] for layer_keys in plan.keys.values()
+                   for _, values, kept in layer_keys.values())
         editable = f"; editable: {keys} Bezier keys, worst deviation {plan.worst:.2f} deg"
+    if end > scene.frame_end:
+        note += (f" ({gesture.LENGTH_WARNING} frames {start}-{end} run past the scene's end, frame "
+                 f"{scene.frame_end}: click 'Extend Scene End' in the RLAnimate panel to play them)")
     return (f"Baked {label} on {plan.obj.name!r} ({plan.family} bones): {len(plan.bones)} bones, frames "
-            f"{start}-{end}, action {action.name!r}{layer}{muted}{note}{editable}")
+            f"{start}-{end}, action {plan.action.name!r}{layer}{note}{editable}")
+
+
+def _length_notes(plan, agent, scene, count):
+    """Notes on the gesture's length and aim: time-scaled, rushed, the agent's own aim."""
+    settings = plan.settings
+    span = frame_rate.agent_frames(count, properties.scene_fps(scene))
+    steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], agent.kind(settings.behaviour))
+    note = f" (time-scaled from the agent's {steps}-frame gesture)" if steps != span else ""
+    note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
+    if settings.behaviour == behaviours.POINT and not settings.exact_aim:
+        note += " (the agent's own aim: Exact Aim is off)"
+    return note
+
+
+def _composing_notes(plan, placed):
+    """Notes on how the gesture composes with the armature's others: baked again, taking over, trimmed, its
+    spine and head turns added to others'."""
+    note = " (replaced the previous gesture)" if plan.previous is not None else ""
+    start, end = plan.frames
+    if plan.taken is not None:
+        note += f" (takes over from {plan.taken.name!r} at frame {start}, which plays until there)"
+    if plan.taking is not None:
+        note += f" (plays until frame {plan.taking.start}, where {plan.taking.id!r} takes over)"
+    span = placed.span
+    sharing = [g for g in gestures.placed_gestures(plan.obj) if g.action != plan.action and g.span.overlaps(span)
+               and not (plan.taken is not None and g.action == plan.taken.action)]
+    for other in sharing:
+        first, last = max(start, other.span.start), min(end, other.span.end)
+        note += (f" (its spine, neck and head turns add to those of {other.name!r} over frames {first}-{last}, "
+                 "so both play)")
+    return note
+
+
+def _cascade(context, plan):
+    """Bake again, from their records, the armature's gestures that depend on the one the plan changed
+    (core.composition.dependants), but those edited by hand; returns a note on what was and was not."""
+    obj = plan.obj
+    placed = gestures.placed_gestures(obj)
+    now = next(g for g in placed if g.action == plan.action)
+    return rebake(context, obj, composition.dependants([g.span for g in placed], plan.before, now.span))
+
+
+def rebake(context, obj, spans):
+    """Bake the armature's gestures of `spans` again from their records, bottom first, each with the constraint
+    mutes it was baked with; a gesture edited by hand, or whose bake is refused now, is left as it is. Returns
+    a note saying which were baked again and which not, and why."""
+    again, left = [], []
+    for span in spans:
+        placed = gestures.find(obj, span.id)
+        if placed is None:
+            continue
+        if gestures.edited(placed):
+            left.append(f"{span.id!r} was edited by hand, so it keeps its keys: select it and Generate to "
+                        "bake it over the new pose")
+            continue
+        try:
+            bake(context, [(obj, recorded_settings(placed.record), span.id)],
+                 mute_constraints=bool(placed.record.get("influence_before")), cascade=False)
+            again.append(repr(span.id))
+        except RLAnimateError as error:
+            left.append(f"{span.id!r} could not be baked again over it: {error}")
+    note = f" (baked again over the new pose: {', '.join(again)})" if again else ""
+    return note + "".join(f" ({text})" for text in left)
+
+
+def recorded_settings(record):
+    """A gesture's recorded settings as Generate reads them (no target: None)."""
+    return types.SimpleNamespace(**{"target": None, "replace_edited_keys": False,
+                                    **record["settings"].to_dict()})
 
 
 class RLANIMATE_OT_generate_gesture(bpy.types.Operator):
-    """Bake the chosen behaviour's gesture onto the selected armatures with the RLAnimate agent"""
+    """Bake the chosen behaviour's gesture onto the selected armatures with the RLAnimate agent (or bake the
+    gesture selected in the panel's list again)"""
     bl_idname = "rlanimate.generate_gesture"
     bl_label = "Generate Gesture"
     bl_options = {"REGISTER", "UNDO"}
@@ -328,4 +573,3 @@ class RLANIMATE_OT_generate_gesture(bpy.types.Operator):
             window_manager.progress_end()
         self.report({"WARNING"} if gesture.LENGTH_WARNING in summary else {"INFO"}, summary)
         return {"FINISHED"}
-

@@ -51,7 +51,9 @@ def _layers(obj):
     for track in data.nla_tracks:
         if track.mute:
             continue
-        strips = [s for s in track.strips if not s.mute and s.action is not None]
+        # A strip whose F-curves are all muted (a gesture set aside while it is baked again) plays nothing.
+        strips = [s for s in track.strips if not s.mute and s.action is not None
+                  and any(not f.mute for f in action_adapter.strip_target(s).fcurves())]
         if any(not _plain_strip(s) for s in strips):
             return None
         layers += [(action_adapter.strip_target(s), _strip_mapping(s, k == 0)) for k, s in enumerate(strips)]
@@ -170,7 +172,7 @@ def _matrices(collection, field, names):
     return flat.reshape(-1, 4, 4).transpose(0, 2, 1)[[order[name] for name in names]].astype(np.float64)
 
 
-def _rotation(mode, values):
+def rotation_matrices(mode, values):
     """(N, 3, 3) rotations of (N, C) channel values in a bone's rotation mode."""
     if mode == "QUATERNION":
         return quat_to_matrix(values)
@@ -223,7 +225,7 @@ def sample(obj, names, frames):
             continue
         times, played = mapping(frames)
         values = evaluate_fcurves([f for f, _ in curves], times)  # (F, N)
-        for (fcurve, key), row in zip(curves, values):
+        for (fcurve, key), row in zip(curves, values, strict=True):
             channels[key][played, fcurve.array_index] = row[played]
             covered[key] |= played
     # A channel the NLA plays on some frames only, or a connected bone's location: Blender's call.
@@ -249,7 +251,8 @@ def sample(obj, names, frames):
             path = _rotation_path(pose_bone.rotation_mode)
             value = {p: channels[name, p] if (name, p) in channels else _standing(pose_bone, p, count)
                      for p in ("location", "scale", path)}
-            basis[:, column, :3, :3] = _rotation(pose_bone.rotation_mode, value[path]) * value["scale"][:, None, :]
+            rotation = rotation_matrices(pose_bone.rotation_mode, value[path])
+            basis[:, column, :3, :3] = rotation * value["scale"][:, None, :]
             basis[:, column, :3, 3] = value["location"]
         frames = slice(None) if name in keyed else slice(0, 1)  # an unkeyed bone's basis is the same every frame
         local = offsets[column] @ basis[frames, column]

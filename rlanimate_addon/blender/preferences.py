@@ -4,20 +4,21 @@ The preferences are looked up under the add-on's own module name, derived from `
 they are found both as a legacy add-on (`rlanimate_addon`) and as an extension
 (`bl_ext.<repository>.rlanimate`).
 """
-import os
 from pathlib import Path
 
 import bpy
 
 from ..core import behaviours
 from ..core.errors import RLAnimateError
+from . import file_versions
 
 _PARTS = __package__.split(".")
 #: The add-on's module name: the package above rlanimate_addon (the extension), else rlanimate_addon.
 ADDON_PACKAGE = ".".join(_PARTS[:_PARTS.index("rlanimate_addon")]) or "rlanimate_addon"
 BUNDLED_AGENT = Path(__file__).resolve().parents[1] / "agents" / "default.npz"
 
-_cache = {}
+#: The agent read, or why it could not be, for the latest file version asked for.
+_agents = file_versions.PerVersion(kept=1)
 
 
 class RLANIMATE_AP_preferences(bpy.types.AddonPreferences):
@@ -54,21 +55,10 @@ def load_agent(path):
     from ..core import runtime
 
     path = Path(path)
-    try:
-        stat = os.stat(path)
-    except OSError:
+    if file_versions.version(path) is None:
         raise RLAnimateError(f"Agent file {path} does not exist: choose another in Preferences > Add-ons > "
-                             "RLAnimate, or clear it to use the bundled agent.") from None
-    key = (str(path), stat.st_mtime_ns, stat.st_size)
-    if key not in _cache:
-        _cache.clear()
-        try:
-            _cache[key] = runtime.load_agent(path)
-        except RLAnimateError as error:
-            _cache[key] = str(error)
-    if isinstance(_cache[key], str):
-        raise RLAnimateError(_cache[key])
-    return _cache[key]
+                             "RLAnimate, or clear it to use the bundled agent.")
+    return _agents.read(path, runtime.load_agent)
 
 
 def selected_agent(context):

@@ -1,7 +1,8 @@
 """`Scene.rlanimate`: the gesture settings the panel shows and Generate Gesture reads.
 
 The names behaviour, arm, target, exaggeration, tempo, frame_count, start_frame, seed and exact_aim are a
-contract that outside tools and checks use: keep them. `behaviour` lists the selected agent's behaviours
+contract that outside tools and checks use: keep them. Until set, frame_count is the agent's average length of
+the behaviour's clips and start_frame the scene's current frame. `behaviour` lists the selected agent's behaviours
 (`behaviour_items`): its values are their ids, "POINT" and "WAVE" for those; `behaviour_name` keeps the id chosen,
 so that an agent that lacks it still shows and names it.
 """
@@ -18,15 +19,25 @@ from . import preferences
 FALLBACK_LENGTH = 60
 
 
+def _bundled_lengths():
+    """{behaviour: the bundled agent's average length of its clips, in its frames}, {} when it cannot be read."""
+    try:
+        averages = preferences.load_agent(preferences.BUNDLED_AGENT).average_frames
+    except (RLAnimateError, ImportError):
+        return {}
+    return {behaviour: int(round(frames)) for behaviour, frames in averages.items()}
+
+
+#: The bundled agent's average lengths at its 30 fps, read once at start-up.
+BUNDLED_LENGTHS = _bundled_lengths()
+
+
 def learned_length(behaviour=POINT):
     """The bundled agent's average gesture length for the behaviour, in frames."""
-    try:
-        return int(round(preferences.load_agent(preferences.BUNDLED_AGENT).average_frames[behaviour]))
-    except (RLAnimateError, ImportError):
-        return FALLBACK_LENGTH
+    return BUNDLED_LENGTHS.get(behaviour, FALLBACK_LENGTH)
 
 
-#: The bundled agent's average Point length at its 30 fps, read once at start-up.
+#: The bundled agent's average Point length at its 30 fps.
 DEFAULT_LENGTH = learned_length()
 
 
@@ -42,18 +53,48 @@ def _owning_scene(settings):
     return owner if isinstance(owner, bpy.types.Scene) else bpy.context.scene
 
 
+def _learned_length(behaviour):
+    """The selected agent's average length of the behaviour's clips, in its frames (the bundled agent's when it
+    cannot be read or lacks the behaviour)."""
+    try:
+        return int(round(preferences.selected_agent(bpy.context).average_frames[behaviour]))
+    except (RLAnimateError, KeyError):
+        return BUNDLED_LENGTHS.get(behaviour, DEFAULT_LENGTH)
+
+
 def _get_frame_count(settings):
-    """The length set, else the agent's learned seconds at the scene's rate (core/frame_rate.py)."""
+    """The length set, else the agent's average length of the chosen behaviour's clips, in seconds at the
+    scene's rate (core/frame_rate.py)."""
     stored = settings.get("frame_count")
     if stored is not None:
         return int(stored)
     scene = _owning_scene(settings)
-    return DEFAULT_LENGTH if scene is None else frame_rate.scene_frames(DEFAULT_LENGTH, scene_fps(scene))
+    learned = _learned_length(chosen_behaviour(settings, bpy.context))
+    return learned if scene is None else frame_rate.scene_frames(learned, scene_fps(scene))
 
 
 def _set_frame_count(settings, value):
     length = RLANIMATE_PG_settings.bl_rna.properties["frame_count"]
     settings["frame_count"] = min(max(int(value), length.hard_min), length.hard_max)
+
+
+def _get_start_frame(settings):
+    """The start frame set, else the scene's current frame (the playhead)."""
+    stored = settings.get("start_frame")
+    if stored is not None:
+        return int(stored)
+    scene = _owning_scene(settings)
+    return 1 if scene is None else scene.frame_current
+
+
+def _set_start_frame(settings, value):
+    settings["start_frame"] = int(value)
+
+
+def follow_playhead(settings):
+    """Have the settings' Start Frame follow the scene's current frame again (it is unset)."""
+    if "start_frame" in settings:
+        del settings["start_frame"]
 
 
 #: Tooltips of the paper's pair; another behaviour's says what its kind asks for.
@@ -166,10 +207,11 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     frame_count: bpy.props.IntProperty(
         name="Length", min=0, soft_min=2, max=100000, default=DEFAULT_LENGTH,
         get=_get_frame_count, set=_set_frame_count,
-        description="Length of the gesture in frames; until set, the agent's average length from the clips "
-                    "in seconds, at the scene's frame rate")
+        description="Length of the gesture in frames; until set, the agent's average length of the behaviour's "
+                    "clips in seconds, at the scene's frame rate")
     start_frame: bpy.props.IntProperty(
-        name="Start Frame", default=1, description="First frame of the gesture")
+        name="Start Frame", default=1, get=_get_start_frame, set=_set_start_frame,
+        description="First frame of the gesture; until set, the scene's current frame")
     target_bone: bpy.props.StringProperty(
         name="Target Bone", default="",
         description="When the target is an armature, point at this bone's head (another character's head); "
@@ -205,6 +247,10 @@ class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     seed: bpy.props.IntProperty(
         name="Variation Seed", min=0, default=0,
         description="0 gives the agent's most likely gesture; other values give variations")
+    replace_edited_keys: bpy.props.BoolProperty(
+        name="Replace Edited Keys", default=False,
+        description="Bake a gesture again, or take over from it, even where its keys were edited by hand, "
+                    "overwriting the edits (off: Generate refuses, naming the bones and frames edited)")
 
 
 class RLANIMATE_PG_object(bpy.types.PropertyGroup):
@@ -218,6 +264,10 @@ class RLANIMATE_PG_object(bpy.types.PropertyGroup):
         name="VRM File", default="", subtype="FILE_PATH",
         description="The VRM file this armature was imported from: its humanoid map names the bones "
                     "(set by Bone Map from VRM File)")
+    gesture: bpy.props.StringProperty(
+        name="Selected Gesture", default="",
+        description="The gesture selected in the panel's list (its action's name), which Generate bakes again; "
+                    "empty: Generate adds a gesture")
 
 
 def settings_for(obj, shared):
@@ -226,8 +276,16 @@ def settings_for(obj, shared):
     return own.settings if own.use_own_settings else shared
 
 
+def armature_of(obj):
+    """The armature an object stands for: itself, or the armature whose Armature modifier deforms a mesh; None
+    for anything else."""
+    if obj is not None and obj.type == "MESH":
+        obj = next((m.object for m in obj.modifiers if m.type == "ARMATURE" and m.object is not None), None)
+    return obj if obj is not None and obj.type == "ARMATURE" else None
+
+
 def panel_settings(context):
     """The settings the panel edits: the active armature's own when switched on, else the scene's."""
-    obj = context.active_object
+    obj = armature_of(context.active_object)
     shared = context.scene.rlanimate
-    return shared if obj is None or obj.type != "ARMATURE" else settings_for(obj, shared)
+    return shared if obj is None else settings_for(obj, shared)

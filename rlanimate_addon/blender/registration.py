@@ -1,7 +1,7 @@
 """Registration in one place: the ordered class list and the property namespaces (Scene and Object)."""
 import bpy
 
-from . import bone_map, export, follow_target, generate, panel, preferences, properties, vrm_map
+from . import bone_map, export, follow_target, generate, gesture_list, panel, preferences, properties, vrm_map
 
 #: Registered in this order, unregistered in reverse (property groups before what points at them).
 CLASSES = (
@@ -9,6 +9,9 @@ CLASSES = (
     properties.RLANIMATE_PG_settings,
     properties.RLANIMATE_PG_object,
     generate.RLANIMATE_OT_generate_gesture,
+    gesture_list.RLANIMATE_OT_select_gesture,
+    gesture_list.RLANIMATE_OT_delete_gesture,
+    gesture_list.RLANIMATE_OT_extend_scene_end,
     export.RLANIMATE_OT_export_fbx,
     bone_map.RLANIMATE_OT_save_bone_map,
     vrm_map.RLANIMATE_OT_bone_map_from_vrm,

@@ -6,28 +6,57 @@ imports from a file with a VRM humanoid keeps the file's path (`Object.rlanimate
 before, "Bone Map from VRM File" reads the file's map, checks it against the armature's bones and
 keeps its path. An armature the VRM add-on imported or set up carries the map itself
 (`Armature.vrm_addon_extension`), read here without importing the add-on.
+
+A file's map, or why it cannot be read, is kept per path, modification time and size (`file_map`):
+operators read the file (Generate, Save Bone Map, Bone Map from VRM File, the import), the panel's
+draw() only looks up what they read (`roles_of(obj, read=False)`), never the file itself.
 """
+import contextlib
+
 import bpy
 from bpy_extras.io_utils import ImportHelper
 
 from ..core import vrm
 from ..core.errors import RLAnimateError
+from . import file_versions
+
+#: The bone maps of the VRM files read, per file version.
+_maps = file_versions.PerVersion(kept=16)
 
 
-def roles_of(obj):
+def file_map(path, read=True):
+    """{role: bone name} of the VRM file at `path` (core.vrm.file_map), read once per version of the file;
+    RLAnimateError when it cannot be read (the same message each time). With read=False (in draw()) the
+    file is never read: None when no operator read this version of it yet."""
+    return _maps.read(path, vrm.file_map, read)
+
+
+def known(path):
+    """Whether an operator has read this version of the file at `path` (its map or why it cannot be)."""
+    return _maps.known(path)
+
+
+def roles_of(obj, read=True):
     """{role: bone name} from the VRM add-on's map on the armature (kept up to date as bones are
-    renamed), else from its VRM file, or None when it has neither."""
+    renamed), else from its VRM file, or None when it has neither. read=False (in draw()): the file is
+    not read; RLAnimateError when no operator has read it yet."""
     names = obj.data.bones.keys()
     roles = addon_roles(obj.data, set(names))
     path = obj.rlanimate.vrm_file
+    if roles:
+        vrm.check_one_role_per_bone(roles, f"The VRM add-on's humanoid map of {obj.name!r}", "generate again")
     if roles or not path:
         return roles
     try:
-        return vrm.file_roles(bpy.path.abspath(path), names, repr(obj.name))
+        roles = file_map(bpy.path.abspath(path), read)
+        if roles is None:
+            raise RLAnimateError(f"The VRM file of {obj.name!r} is read when the gesture is generated.")
+        vrm.check_bones(roles, names, bpy.path.abspath(path), repr(obj.name))
     except RLAnimateError as error:
         raise RLAnimateError(f"{error} (Armature {obj.name!r} takes its bone map from that VRM file: pick the "
                              "right one with 'Bone Map from VRM File', or clear its VRM File field in the RLAnimate "
                              "panel to detect the bones by name.)") from None
+    return roles
 
 
 def remember_vrm_file(gltf):
@@ -40,6 +69,8 @@ def remember_vrm_file(gltf):
         obj = getattr(vnode, "blender_object", None)
         if obj is not None and obj.type == "ARMATURE":
             obj.rlanimate.vrm_file = gltf.filename
+            with contextlib.suppress(RLAnimateError):  # read now, in the import, for the panel; Generate reports it
+                file_map(gltf.filename)
 
 
 def addon_roles(armature, bone_names):
@@ -82,9 +113,10 @@ class RLANIMATE_OT_bone_map_from_vrm(bpy.types.Operator, ImportHelper):
         if obj is None or obj.type != "ARMATURE":
             self.report({"ERROR"}, "The active object is not an armature: select the character's armature.")
             return {"CANCELLED"}
+        path = bpy.path.abspath(self.filepath)
         try:
-            roles = vrm.file_roles(bpy.path.abspath(self.filepath), [b.name for b in obj.data.bones],
-                                   repr(obj.name))
+            roles = file_map(path)
+            vrm.check_bones(roles, obj.data.bones.keys(), path, repr(obj.name))
         except RLAnimateError as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}

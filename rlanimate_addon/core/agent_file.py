@@ -4,7 +4,8 @@ Layout (format FORMAT_NAME, version FORMAT_VERSION):
     "__metadata__"   0-d numpy unicode array holding JSON text (see docs/AGENT.md for its fields)
     "<module>.<parameter>"   one float32 array per torch parameter, named as in the torch state_dict:
         portrayal.layers.K.{weight,bias}        o_t -> self-description d_t     (absent in single_state)
-        task_rnn.{weight,bias}_{ih,hh}_l0       GRU h_t = f1(h_{t-1}, o_t)      (absent in single_state, single_dynamics)
+        task_rnn.{weight,bias}_{ih,hh}_l0       GRU h_t = f1(h_{t-1}, o_t)      (absent in single_state and
+                                                                         single_dynamics)
         behaviour_cell.{weight,bias}_{ih,hh}    GRUCell e_t = f2(e_{t-1}; x_t)
         prior.layers.K.*, posterior.layers.K.*  Gaussian p(z_t | e_t), q(z_t | e_t, d_t)
         animation.layers.K.*, decoder.layers.K.*  Beta over a_t, and p(d_t | h_t, b_t)
@@ -73,7 +74,7 @@ def mlp_shapes(name, inputs, hidden, layers, outputs):
     """Shapes of an MLP's arrays: `layers` hidden Linear(+tanh) layers of width `hidden`, then a Linear."""
     widths = [inputs] + [hidden] * layers + [outputs]
     shapes = {}
-    for k, (n_in, n_out) in enumerate(zip(widths[:-1], widths[1:])):
+    for k, (n_in, n_out) in enumerate(zip(widths[:-1], widths[1:], strict=True)):
         shapes[f"{name}.layers.{k}.weight"] = (n_out, n_in)
         shapes[f"{name}.layers.{k}.bias"] = (n_out,)
     return shapes
@@ -100,7 +101,7 @@ def expected_weight_shapes(agent_config, variant, objective_size):
         raise RLAnimateError(f"Unknown agent variant {variant!r}: the file must name one of "
                              f"{', '.join(VARIANTS)}.")
     c = agent_config
-    O, D, A = objective_size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
+    O, D, A = objective_size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE  # noqa: E741 (the paper's sizes)
     E, Z, hid, n = c["behaviour_size"], c["stochastic_size"], c["hidden_size"], c["hidden_layers"]
     task = task_width(c, variant, O)  # what f2 and the heads see of the task
     head_inputs = (task if uses_task_state(variant) else 0) + E + Z
@@ -402,6 +403,10 @@ def _check_metadata_values(path, metadata):
     if not isinstance(metadata["variant"], str):
         raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
                              f"{', '.join(VARIANTS)}.")
+    if metadata["variant"] not in VARIANTS:
+        raise RLAnimateError(f"The agent file {path} names an unknown agent variant {metadata['variant']!r:.40}: "
+                             f"it must name one of {', '.join(VARIANTS)}; re-export it with "
+                             "trainer/agent/agent_export.py.")
     space = _checked_space(path, metadata)
     expected = expected_weight_shapes(config, metadata["variant"], space.size)
     parameters = sum(math.prod(shape) for shape in expected.values())
@@ -428,7 +433,10 @@ def _check_metadata_values(path, metadata):
             raise RLAnimateError(f"The agent file {path} has a wave_rhythm value of {_describe(largest)}, beyond "
                                  f"+-{MAX_RHYTHM_VALUE:g} (exaggerations, wave frequencies and fractions of a "
                                  f"gesture are small numbers): re-export it with trainer/agent/agent_export.py.")
-        rhythm.RhythmModel.from_dict(metadata["wave_rhythm"])  # raises RLAnimateError naming the problem
+        problem = rhythm.invalid_field(metadata["wave_rhythm"])
+        if problem:
+            raise RLAnimateError(f"The agent file {path} has an invalid wave_rhythm ({problem}): re-export it with "
+                                 f"trainer/agent/agent_export.py.")
     still = metadata.get("still_free_arm", [])
     if not isinstance(still, list) or any(not isinstance(b, str) or b not in space.names for b in still):
         raise RLAnimateError(f"The agent file {path} has an invalid still_free_arm (need a list of the behaviours, "

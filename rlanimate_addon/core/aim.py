@@ -9,6 +9,7 @@ with its rotation vector scaled by a pointing-phase weight that ramps with minim
 the start of the stroke to 1 by its middle, and back to 0 over the return.
 """
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from . import kinematics, skeleton
@@ -24,7 +25,7 @@ PHASE_RAMP = (0.01, 0.5)
 MIN_RAMP_SHARE = 0.2
 
 
-def _finger_line_ends(arm):
+def _finger_line_ends(arm: str) -> tuple[str, str, str]:
     prefix = skeleton.ARM_PREFIX[arm]
     return prefix + "Arm", prefix + "HandIndex1", prefix + "HandIndex4"
 
@@ -35,7 +36,9 @@ def finger_line_joints(arm: str) -> list[int]:
     return [k for k, joint in enumerate(skeleton.ACTION_JOINTS) if joint in chain]
 
 
-def finger_lines(rotvecs: ArrayLike, arm: str) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def finger_lines(
+    rotvecs: npt.NDArray[np.float64], arm: str,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Posed shoulder S, index base b and unit finger direction f, each (N, 3), and the Arm bone's
     armature-space pose rotation W (N, 3, 3), for canonical action-joint rotations (N, 15, 3), of which
     only the `finger_line_joints` are read."""
@@ -50,7 +53,7 @@ def finger_lines(rotvecs: ArrayLike, arm: str) -> tuple[np.ndarray, np.ndarray, 
     return heads[:, arm_index], base, finger, pose[:, arm_index, :3, :3]
 
 
-def rotation_between(a: ArrayLike, b: ArrayLike) -> np.ndarray:
+def rotation_between(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N, 3, 3) shortest rotations taking unit vectors a (N, 3) onto unit vectors b (N, 3)."""
     axis = np.cross(a, b)
     sin = np.linalg.norm(axis, axis=1)
@@ -59,7 +62,8 @@ def rotation_between(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     return rotvec_to_matrix(rotvec)
 
 
-def shoulder_corrections(shoulder: ArrayLike, base: ArrayLike, finger: ArrayLike, targets: ArrayLike) -> np.ndarray:
+def shoulder_corrections(shoulder: npt.NDArray[np.float64], base: npt.NDArray[np.float64],
+                         finger: npt.NDArray[np.float64], targets: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N, 3) armature-space rotation vectors about the shoulder that aim each finger line at its target.
 
     shoulder, base, targets: (N, 3) positions; finger: (N, 3) unit directions. In the arm's own frame
@@ -77,11 +81,12 @@ def shoulder_corrections(shoulder: ArrayLike, base: ArrayLike, finger: ArrayLike
     return matrix_to_rotvec(rotation_between(_unit(on_line), _unit(to_target)))
 
 
-def _unit(vectors):
-    return vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
+def _unit(vectors: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    unit: npt.NDArray[np.float64] = vectors / np.linalg.norm(vectors, axis=1, keepdims=True)
+    return unit
 
 
-def pointing_phase(base: ArrayLike) -> np.ndarray:
+def pointing_phase(base: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N,) weight in [0, 1] for finger-base positions (N, 3): 0 at the first and last frames, 1 from
     the middle of the stroke to the middle of the return.
 
@@ -108,7 +113,8 @@ def pointing_phase(base: ArrayLike) -> np.ndarray:
     return weight
 
 
-def aim_at(rotvecs: ArrayLike, arm: str, targets: ArrayLike, weights: ArrayLike | None = None) -> np.ndarray:
+def aim_at(rotvecs: ArrayLike, arm: str, targets: ArrayLike,
+           weights: ArrayLike | None = None) -> npt.NDArray[np.float64]:
     """Canonical action-joint rotations (N, 15, 3) with the pointing Arm bone turned towards targets.
 
     targets: (N, 3) or (3,) positions on the canonical skeleton. weights: (N,) in [0, 1], the share of

@@ -8,10 +8,14 @@ helper bones included, and the bones the mesh deforms with carry the same points
 bone is carried by a deformed bone rigidly from its rest: p' = pose_D @ rest_D^-1 @ p_rest, so it
 needs no assumption about which deformed bone sits where, only that it moves with the role bone.
 """
+from collections.abc import Mapping, Sequence
+
 import numpy as np
+import numpy.typing as npt
+from numpy.typing import ArrayLike
 
 from . import skeleton
-from .gesture import blend_weights, finger_line_bones
+from .gesture import RigState, blend_weights, finger_line_bones
 from .rig import each_frame, inverse
 from .rotations import quat_to_matrix
 
@@ -21,21 +25,24 @@ HAND_TOLERANCE = 0.02
 FINGER_TOLERANCE_DEG = 3.0
 
 
-def measured_bones(roles, arm):
+def measured_bones(roles: Mapping[str, str], arm: str) -> tuple[str, str, str]:
     """The role bones carrying the wrist (the hand), the finger base and the finger tip: the finger line
-    Exact Aim solves on (gesture.finger_line_bones, from one joint's head through another's)."""
-    start, end = finger_line_bones(roles, arm)
-    return roles[skeleton.ARM_PREFIX[arm] + "Hand"], start, end
+    Exact Aim solves on (gesture.finger_line_bones: from one joint's head through another's, or a hand
+    without an index finger along itself)."""
+    line = finger_line_bones(roles, arm)
+    return roles[skeleton.ARM_PREFIX[arm] + "Hand"], line.start, line.end
 
 
-def rest_points(rig, arm):
-    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist, the finger base and the
-    finger tip, each its bone's head (joint positions; an imported bone's tail may point anywhere).
-    rig: a gesture.RigState."""
-    return np.stack([rig.skeleton.rest_head(bone) for bone in measured_bones(rig.roles, arm)])
+def rest_points(rig: RigState, arm: str) -> npt.NDArray[np.float64]:
+    """(3, 3) armature-space rest points measured, by `measured_bones`: the wrist (the hand's head), the
+    finger line's base and tip (gesture.FingerLine.points: joint positions, or the hand's tail for a hand
+    without an index finger)."""
+    hand = rig.skeleton.rest_head(rig.roles[skeleton.ARM_PREFIX[arm] + "Hand"])
+    return np.stack([hand, *finger_line_bones(rig.roles, arm).points(rig.skeleton, rig.skeleton.rest)])
 
 
-def planned_pose(rig, arm, bones, keyed):
+def planned_pose(rig: RigState, arm: str, bones: Sequence[str],
+                 keyed: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N, B, 4, 4) armature-space pose of the rig's role bones as the gesture plans it: the keyed
     rotations (N, D, 4) on `bones` over the pose underneath; the measured bones (`measured_bones`)
     and their ancestors are updated, the others keep the pose underneath."""
@@ -49,43 +56,50 @@ def planned_pose(rig, arm, bones, keyed):
     scale = each_frame(lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True),
                        under)  # (N, D, 1, 3)
     basis[:, columns, :3, :3] = quat_to_matrix(np.asarray(keyed, dtype=np.float64)[:, picked]) * scale
-    return rig.skeleton.pose_after(rig.under_pose_at(count), under, basis, columns, only=measured)
+    under_pose = rig.under_pose_at(count)
+    pose: npt.NDArray[np.float64] = rig.skeleton.pose_after(under_pose, under, basis, columns, only=measured)
+    return pose
 
 
-def planned_points(rig, arm, pose):
+def planned_points(rig: RigState, arm: str, pose: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N, 3, 3) wrist, finger base and tip (armature space) carried by the role bones' pose (N, B, 4, 4)."""
     rows = [rig.skeleton.index[b] for b in measured_bones(rig.roles, arm)]
     return carried(pose[:, rows], rig.skeleton.rest[rows], rest_points(rig, arm))
 
 
-def carried(poses, rests, points):
+def carried(poses: ArrayLike, rests: ArrayLike, points: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(K, P, 3) points (P, 3) at rest, each carried rigidly by its bone: poses (K, P, 4, 4) posed and
     rests (P, 4, 4) rest matrices of the bone carrying each point."""
     homogeneous = np.append(points, np.ones((len(points), 1)), axis=1)  # (P, 4)
     local = np.einsum("pij,pj->pi", inverse(np.asarray(rests, dtype=np.float64)), homogeneous)
-    return np.einsum("kpij,pj->kpi", np.asarray(poses, dtype=np.float64), local)[..., :3]
+    points_posed: npt.NDArray[np.float64] = np.einsum("kpij,pj->kpi", np.asarray(poses, dtype=np.float64), local)
+    return points_posed[..., :3]
 
 
-def turned(a, b):
+def turned(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """Degrees between the rotations of pose matrices a and b (..., 4, 4)."""
     ra, rb = (m[..., :3, :3] / np.linalg.norm(m[..., :3, :3], axis=-2, keepdims=True) for m in (a, b))
     trace = np.trace(np.swapaxes(ra, -1, -2) @ rb, axis1=-2, axis2=-1)
-    return np.degrees(np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0)))
+    degrees: npt.NDArray[np.float64] = np.degrees(np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0)))
+    return degrees
 
 
-def check_frames(count, hand_path):
+def check_frames(count: int, hand_path: npt.NDArray[np.float64], shown: int | None = None) -> list[int]:
     """Indices of three frames of a gesture of `count` frames to check: its apex (where the planned hand
     (N, 3) is farthest from where it starts), and the frames a third and two thirds of the way through
     the frames the gesture plays at full weight (no blend with the pose underneath, so constraints the
-    bake mutes are fully off)."""
-    full = np.flatnonzero(blend_weights(count) == 1.0)
+    bake mutes are fully off), of its first `shown` frames (all when None; fewer where a later gesture
+    takes over from it)."""
+    shown = count if shown is None else min(count, int(shown))
+    full = np.flatnonzero(blend_weights(count)[:shown] == 1.0)
     if not len(full):
-        full = np.arange(count)
+        full = np.arange(shown)
     apex = full[int(np.argmax(np.linalg.norm(hand_path[full] - hand_path[0], axis=1)))]
     return sorted({int(apex), int(full[len(full) // 3]), int(full[(2 * len(full)) // 3])})
 
 
-def misses(planned, played, world_scale):
+def misses(planned: npt.NDArray[np.float64], played: npt.NDArray[np.float64],
+           world_scale: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """(hand distances (K,), finger angles in degrees (K,)) between planned and played points (K, 3, 3)
     (wrist, finger base, finger tip in armature space); world_scale: the armature's world scale, so
     distances are the scene's."""

@@ -10,19 +10,27 @@ restores the user's setting afterwards. Where it is not installed, nothing is ca
 """
 from contextlib import AbstractContextManager, nullcontext
 from functools import lru_cache
+from typing import Protocol
+
+
+class _Controller(Protocol):
+    """What this module uses of threadpoolctl's ThreadpoolController (threadpoolctl ships no types)."""
+
+    def limit(self, *, limits: int, user_api: str) -> AbstractContextManager[object]: ...
 
 
 @lru_cache(maxsize=1)
-def _controller():
+def _controller() -> _Controller | None:
     """threadpoolctl's view of the loaded BLAS libraries (found once: about 10 ms), or None."""
     try:
         from threadpoolctl import ThreadpoolController
     except ImportError:
         return None
-    return ThreadpoolController()
+    controller: _Controller = ThreadpoolController()
+    return controller
 
 
-def single_blas_thread() -> AbstractContextManager:
+def single_blas_thread() -> AbstractContextManager[object]:
     """A context manager in which numpy's BLAS uses one thread."""
     controller = _controller()
     return nullcontext() if controller is None else controller.limit(limits=1, user_api="blas")

@@ -5,30 +5,24 @@ Blender's NLA Combine blends each channel by its kind: quaternions multiply
 keys the difference from the rotation underneath, and a Replace layer the rotation itself.
 """
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
-from .rotations import matrix_to_euler, matrix_to_quat, quat_to_axis_angle, quat_to_matrix  # noqa: F401
+from .rotations import matrix_to_euler, matrix_to_quat, quat_multiply, quat_to_axis_angle, quat_to_matrix  # noqa: F401
 
 MODES = ("QUATERNION", "AXIS_ANGLE", "XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 BLEND_TYPES = ("REPLACE", "COMBINE")
 
 
-def _quat_multiply(a, b):
-    """Hamilton product of (..., 4) quaternions (w, x, y, z)."""
-    aw, ax, ay, az = np.moveaxis(a, -1, 0)
-    bw, bx, by, bz = np.moveaxis(b, -1, 0)
-    return np.stack([aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by,
-                     aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw], axis=-1)
-
-
-def _continuous(quats):
+def _continuous(quats: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N, 4) quaternions with each on the same hemisphere as the frame before."""
     steps = np.where(np.sum(quats[1:] * quats[:-1], axis=-1) < 0.0, -1.0, 1.0)
-    return quats * np.concatenate([[1.0], np.cumprod(steps)])[:, None]
+    signs: npt.NDArray[np.float64] = np.concatenate([[1.0], np.cumprod(steps)])  # (N,)
+    return quats * signs[:, None]
 
 
 def rotation_keys(mode: str, keyed: ArrayLike, below: ArrayLike, below_values: ArrayLike,
-                  blend_type: str) -> np.ndarray:
+                  blend_type: str) -> npt.NDArray[np.float64]:
     """(N, C) values for a bone's rotation channels: 4 for QUATERNION and AXIS_ANGLE, 3 for Euler orders.
 
     keyed: (N, 4) the rotation the bone must have; below: (N, 4) the rotation underneath, and
@@ -40,7 +34,7 @@ def rotation_keys(mode: str, keyed: ArrayLike, below: ArrayLike, below_values: A
     if mode == "QUATERNION":
         if blend_type == "COMBINE":
             inverse = below * np.array([1.0, -1.0, -1.0, -1.0])
-            return _continuous(_quat_multiply(inverse, keyed))
+            return _continuous(quat_multiply(inverse, keyed))
         aligned = np.where(np.sum(keyed[:1] * below_values[:1]) < 0.0, -keyed, keyed)
         return _continuous(aligned)
     if mode == "AXIS_ANGLE":

@@ -9,7 +9,7 @@ class RLAnimateError(Exception):
 _NAMED_ERROR = re.compile(r"[A-Za-z_.]*(Error|Exception): ")
 
 
-def operator_error_reason(error):
+def operator_error_reason(error: BaseException) -> str:
     """The one-line reason in the RuntimeError a failing `bpy.ops` call raises: the last line that names
     a Python error ("IndexError: list index out of range"), not the traceback or "Location: .../ops.py"."""
     lines = [line.strip() for line in str(error).splitlines() if line.strip()]

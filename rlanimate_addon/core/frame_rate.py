@@ -9,16 +9,16 @@ the scene's N: a wave swings at the same Hz, and a point holds for the same seco
 AGENT_FPS = 30.0
 
 
-def agent_frames(frame_count, fps):
+def agent_frames(frame_count: int, fps: float) -> int:
     """Frames at the agent's rate spanning the seconds of `frame_count` scene frames at `fps`."""
     return int(round((int(frame_count) - 1) * AGENT_FPS / float(fps))) + 1
 
 
-def scene_frames(agent_frame_count, fps):
+def scene_frames(agent_frame_count: float, fps: float) -> int:
     """Scene frames at `fps` spanning the seconds of `agent_frame_count` frames at the agent's rate."""
     return int(round((float(agent_frame_count) - 1.0) * float(fps) / AGENT_FPS)) + 1
 
 
-def seconds(frame_count, fps):
+def seconds(frame_count: int, fps: float) -> float:
     """Seconds a gesture of `frame_count` frames lasts at `fps`, first key to last."""
     return max(int(frame_count) - 1, 0) / float(fps)

@@ -24,13 +24,23 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
     and Point's aim is solved on the rig's own bones against that pose (`aim_rig`), so the finger
     line passes through the target whatever the rig's proportions and whatever moves underneath.
 """
+import math
+from typing import NamedTuple
+
 import numpy as np
 
 from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, each_frame, inverse
-from .rotations import (matrix_to_quat, matrix_to_rotvec, quat_to_matrix, quat_to_rotvec, rotvec_to_matrix,
-                        rotvec_to_quat)
+from .rotations import (
+    matrix_to_quat,
+    matrix_to_rotvec,
+    quat_multiply,
+    quat_to_matrix,
+    quat_to_rotvec,
+    rotvec_to_matrix,
+    rotvec_to_quat,
+)
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
 SUPPORTED_LENGTH = (0.4, 1.5)
@@ -147,7 +157,9 @@ def arm_reach(arm, rest_heads):
     if prefix + "HandIndex1" in rest_heads:
         return float(np.linalg.norm(np.subtract(rest_heads[prefix + "HandIndex1"], shoulder)))
     canonical = {name: np.asarray(skeleton.BONE_BY_NAME[prefix + name].head) for name in ("Arm", "Hand", "HandIndex1")}
-    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(canonical["Hand"] - canonical["Arm"])
+    ratio = np.linalg.norm(canonical["HandIndex1"] - canonical["Arm"]) / np.linalg.norm(
+        canonical["Hand"] - canonical["Arm"]
+    )
     return float(ratio * np.linalg.norm(np.subtract(rest_heads[prefix + "Hand"], shoulder)))
 
 
@@ -290,8 +302,16 @@ def rest_swings(roles, rest_heads, rest_tails, to_character):
     directed = [n for n in names if directions[n] is not None]
     rig = np.array([directions[n] for n in directed]).reshape(-1, 3) @ np.asarray(to_character).T
     canonical = np.array([_CANONICAL_DIRECTIONS[n] for n in directed]).reshape(-1, 3)
-    turns = dict(zip(directed, aim.rotation_between(rig / np.linalg.norm(rig, axis=1, keepdims=True),
-                                                     canonical / np.linalg.norm(canonical, axis=1, keepdims=True))))
+    turns = dict(
+        zip(
+            directed,
+            aim.rotation_between(
+                rig / np.linalg.norm(rig, axis=1, keepdims=True),
+                canonical / np.linalg.norm(canonical, axis=1, keepdims=True),
+            ),
+            strict=True,
+        )
+    )
     swings = {}
     for name in names:
         parent = _parent_role(name, roles)
@@ -419,22 +439,41 @@ def _standing_pose():
 
 #: Canonical local rotation vectors (3,) of the standing pose, by bone (others stay at rest).
 STANDING_POSE = _standing_pose()
-#: A bone whose rotation underneath is within this of its rest (sin of half the angle: 0.06 degrees) is
-#: at rest: a rest pose read back from float32 bind matrices (FBX, glTF) is a few 1e-5 radians off.
-AT_REST = 5e-4
+#: Degrees: a bone whose rotation underneath is within this of its rest is at rest. An importer's rounding
+#: leaves a rest pose off by up to about a degree (a VRM 0.x's arms 0.6-0.9 degrees, after Blender's glTF
+#: importer guessed its bind pose; float32 bind matrices a few 1e-5 radians), while a pose an animator sets
+#: turns a bone by more. (At 0.06 degrees, such a VRM started and ended every gesture in its T-pose.)
+AT_REST_DEGREES = 3.0
+#: ... as the sine of half that angle, the length of a unit quaternion's vector part.
+AT_REST = math.sin(math.radians(AT_REST_DEGREES) / 2)
+
+
+class FingerLine(NamedTuple):
+    """The rig's pointing line: from `start`'s head through `end`'s head, or through `end`'s tail with
+    `to_tail` (a hand without an index finger: the hand's own line)."""
+    start: str
+    end: str
+    to_tail: bool = False
+
+    def points(self, skeleton: RigSkeleton, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(base (..., 3), tip (..., 3)) of the line in (..., B, 4, 4) pose (or rest) matrices of `skeleton`."""
+        base = pose[..., skeleton.index[self.start], :3, 3]
+        tip = skeleton.tails(pose, self.end) if self.to_tail else pose[..., skeleton.index[self.end], :3, 3]
+        return base, tip
 
 
 def finger_line_bones(roles, arm):
-    """(start bone, end bone) of the rig's pointing line, which runs from the start bone's head through
-    the end bone's head: joint positions, as the mesh shows them, never a bone's tail (an imported
-    bone's tail may point anywhere). The index finger from its base (Index1) to the farthest index joint
-    the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index base; without an
-    index finger, the forearm's head through the hand's head."""
+    """The rig's pointing line (a FingerLine): joint positions, as the mesh shows them, not a finger bone's
+    tail (an imported bone's tail may point anywhere). The index finger from its base (Index1) to the
+    farthest index joint the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index
+    base; without an index finger, the hand's own line, from its head (the wrist) to its tail (the hand's
+    end): a hand without fingers points along itself (aimed along the forearm's line, the hand was 9-17
+    degrees off the target: tests/addon/test_fingerless_hands.py)."""
     prefix = skeleton.ARM_PREFIX[arm]
     if f"{prefix}HandIndex1" not in roles:
-        return roles[prefix + "ForeArm"], roles[prefix + "Hand"]
+        return FingerLine(roles[prefix + "Hand"], roles[prefix + "Hand"], to_tail=True)
     index = [roles[f"{prefix}HandIndex{k}"] for k in (1, 2, 3, 4) if f"{prefix}HandIndex{k}" in roles]
-    return (index[0], index[-1]) if len(index) > 1 else (roles[prefix + "Hand"], index[0])
+    return FingerLine(index[0], index[-1]) if len(index) > 1 else FingerLine(roles[prefix + "Hand"], index[0])
 
 
 def aim_rig(rig, basis, changed, arm, targets, weights):
@@ -446,13 +485,12 @@ def aim_rig(rig, basis, changed, arm, targets, weights):
     `changed`, over the pose underneath.
     """
     arm_bone = rig.roles[skeleton.ARM_PREFIX[arm] + "Arm"]
-    start, end = finger_line_bones(rig.roles, arm)
+    line = finger_line_bones(rig.roles, arm)
     pose = rig.skeleton.pose_after(rig.under_pose_at(len(basis)), rig.under_at(len(basis)), basis, changed,
-                                   only=(end, arm_bone))
+                                   only=(line.end, arm_bone))
     i = rig.skeleton.index[arm_bone]
-    base = pose[:, rig.skeleton.index[start], :3, 3]
-    finger = pose[:, rig.skeleton.index[end], :3, 3] - base
-    finger /= np.linalg.norm(finger, axis=1, keepdims=True)
+    base, tip = line.points(rig.skeleton, pose)
+    finger = (tip - base) / np.linalg.norm(tip - base, axis=1, keepdims=True)
     correction = aim.shoulder_corrections(pose[:, i, :3, 3], base, finger, targets)  # (N, 3)
     turn = rotvec_to_matrix(correction * np.asarray(weights)[:, None])
     world = pose[:, i, :3, :3] / np.linalg.norm(pose[:, i, :3, :3], axis=1, keepdims=True)  # (N, 3, 3)
@@ -516,97 +554,165 @@ def played_finger_base(canonical, arm):
     return aim.finger_lines(played, arm)[1]
 
 
+#: The roles whose turn a gesture adds to the pose underneath instead of replacing it: the spine, the neck
+#: and the head. Gestures on both arms at once both turn them.
+TORSO = rig_roles.SPINE + ("Neck", "Head")
+
+
 def free_arm_columns(names, arm):
     """The columns of `names` (canonical roles) that are the joints of the arm other than `arm`, collar to index
     base."""
-    side = skeleton.ARM_PREFIX["RIGHT" if arm == "LEFT" else "LEFT"]
+    side = skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
     return [k for k, name in enumerate(names) if name in skeleton.ACTION_JOINTS and name.startswith(side)]
 
 
-def gesture_rotations(agent, request, rig):
-    """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
+def owned_joints(arm, still):
+    """The action joints a gesture on `arm` keys: the spine, neck and head (a turn added to what plays
+    underneath), its own arm, and, made as on a still rig, the other arm too (from its natural standing
+    pose; on an animated rig the other arm is the animation's)."""
+    other = skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
+    return tuple(joint for joint in skeleton.ACTION_JOINTS if still or not joint.startswith(other))
 
-    request: a GestureRequest. rig: a RigState (the rig's bones, roles and the pose underneath).
-    `underneath` is the rotation each bone would have without the gesture (its animation, else its
-    pose), which a Combine layer needs. For a behaviour whose free arm has no part in it (the agent's
-    `still_free_arm`), that arm stays where the gesture starts from on every frame. Every RLAnimateError is
-    raised before anything is returned, so callers can write all or nothing.
-    """
-    rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
-    rest_heads = rig.rest_heads
-    check_length(request.frame_count)
-    span = request.agent_frames  # M: the gesture's seconds at the agent's rate
+
+def _objectives(agent, request, rig):
+    """(M, O) objectives of the request at the agent's rate (M: the gesture's seconds at the agent's rate)."""
+    span = request.agent_frames
     rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed, request.tempo, request.arm)
               if request.behaviour == behaviours.WAVE else None)
     if request.targets is not None:
         check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))
     asked = None if request.targets is None else resample(
         hips_relative_targets(rig, request.targets, request.frame_count), span)  # (M, 3)
-    objectives = build_objectives(agent.space, request.behaviour, request.arm, span, targets=asked,
-                                  rest_heads=rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
-    canonical = run_agent(agent, request.behaviour, objectives, seed=request.seed,
-                          frame_count=request.frame_count)  # (N, 15, 3)
-    targeted = agent.kind(request.behaviour) == behaviours.TARGET
-    phase_base = played_finger_base(canonical, request.arm) if targeted else None
+    return build_objectives(agent.space, request.behaviour, request.arm, span, targets=asked,
+                            rest_heads=rig.rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
+
+
+def _conversions(names, rig, to_character):
+    """((D, 3, 3) C, (D, 3, 3) P) of the named roles for `retarget`."""
+    swings = rest_swings(rig.roles, rig.rest_heads, rig.rest_tails, to_character)
+    frames = [rig.skeleton.rest_frame(rig.roles[n]) for n in names]
+    parent_swings = [np.eye(3) if p is None else swings[p] for p in (_parent_role(n, rig.roles) for n in names)]
+    return (retarget_matrices(names, frames, to_character, np.array([swings[n] for n in names])),
+            retarget_matrices(names, frames, to_character, np.array(parent_swings)))
+
+
+def _played(request, rig, canonical):
+    """(names of the roles keyed, (N, D, 4) the gesture's rotations of them on the rig, (D, 4) the standing
+    pose, to_character): the owned action joints, then Point's hand shape."""
     names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
+    kept = [k for k, name in enumerate(names) if name in owned_joints(request.arm, rig.still)]
+    names, canonical = [names[k] for k in kept], canonical[:, kept]
     joints = len(names)
     if request.behaviour == behaviours.POINT:  # one hand shape, held on every frame
         hand_names, hand = pointing_hand_rotations(request.arm, 1)
         present = [i for i, name in enumerate(hand_names) if name in rig.roles]
         names += [hand_names[i] for i in present]
         hand = hand[:, present]  # (1, H, 3)
-    bones = [rig.roles[n] for n in names]
-    columns = [rig.skeleton.index[b] for b in bones]  # the eyes, keyed for Point, come after these
-    to_character = character_frame(rest_heads)
-    swings = rest_swings(rig.roles, rest_heads, rig.rest_tails, to_character)
-    frames = [rig.skeleton.rest_frame(b) for b in bones]
-    conversions = retarget_matrices(names, frames, to_character, np.array([swings[n] for n in names]))
-    parents = [_parent_role(n, rig.roles) for n in names]
-    parent_swings = np.array([np.eye(3) if p is None else swings[p] for p in parents])
-    parent_conversions = retarget_matrices(names, frames, to_character, parent_swings)
-    under_basis = rig.under_at(request.frame_count)
-    under = each_frame(lambda frames: matrix_to_quat(frames[:, columns, :3, :3]), under_basis)  # (N, D, 4)
-    start = under
-    if not rig.animated:  # bones at rest start from the standing pose, not the bind pose
-        standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions,
-                            parent_conversions)  # (D, 4)
-        at_rest = np.linalg.norm(under[..., 1:], axis=-1) < AT_REST
-        start = np.where(at_rest[..., None], standing, under)
+    to_character = character_frame(rig.rest_heads)
+    conversions, parent_conversions = _conversions(names, rig, to_character)
+    standing = retarget(np.array([STANDING_POSE.get(n, np.zeros(3)) for n in names]), conversions,
+                        parent_conversions)  # (D, 4)
     played = retarget(canonical, conversions[:joints], parent_conversions[:joints])  # (N, J, 4)
     if len(names) > joints:  # the hand shape retargeted once
         held = retarget(hand, conversions[joints:], parent_conversions[joints:])  # (1, H, 4)
         played = np.concatenate([played, np.broadcast_to(held, (len(played),) + held.shape[1:])], axis=1)
+    return names, played, standing, to_character
+
+
+def _blended(rig, names, columns, played, standing, held=()):
+    """((N, D, 4) keyed, (N, D, 4) underneath): each bone blended from the pose it starts from into the
+    gesture and back (on a still rig, bones at rest start from the standing pose, not the bind pose); the
+    columns `held` (a free arm with no part in the gesture) stay on that start pose on every frame. The
+    spine, neck and head take the turn that carries the animation's pose of them (`RigState.animation_at`)
+    into the gesture's, by the same weights, on top of the pose underneath: over the animation alone the
+    gesture's pose, and over other gestures that turn them too, the turns of all."""
+    count = len(played)
+    quats = lambda frames: matrix_to_quat(frames[:, columns, :3, :3])  # noqa: E731
+    under = each_frame(quats, rig.under_at(count))  # (N, D, 4)
+    start = each_frame(quats, rig.start_at(count))
+    torso = [k for k, name in enumerate(names) if name in TORSO]
+    animation = each_frame(lambda frames: quats(frames)[:, torso], rig.animation_at(count))  # (N, T, 4)
+    at_rest = np.zeros(animation.shape[:-1], dtype=bool)
+    if rig.still:
+        start = np.where((np.linalg.norm(start[..., 1:], axis=-1) < AT_REST)[..., None], standing, start)
+        at_rest = np.linalg.norm(animation[..., 1:], axis=-1) < AT_REST
+        animation = np.where(at_rest[..., None], standing[torso], animation)
+    played = played.copy()
+    played[:, list(held)] = start[:, list(held)]  # an arm that has no part in the gesture stays where it was
+    weights = blend_weights(count)
+    keyed = blend_from_pose(start, played, weights)
+    blended = blend_from_pose(animation, played[:, torso], weights)
+    conjugate = np.array([1.0, -1.0, -1.0, -1.0])
+    turn = np.where(at_rest[..., None], blended, quat_multiply(animation * conjugate, blended))  # (N, T, 4)
+    keyed[:, torso] = quat_multiply(under[:, torso], turn)
+    for k, bone in ((k, rig.roles[names[column]]) for k, column in enumerate(torso)):
+        if bone in rig.above:  # layers above multiply in after this one: under = below above
+            above = rig.above[bone]
+            keyed[:, torso[k]] = quat_multiply(quat_multiply(quat_multiply(under[:, torso[k]], above * conjugate),
+                                                             turn[:, k]), above)
+            under[:, torso[k]] = quat_multiply(keyed[:, torso[k]], turn[:, k] * conjugate)
+    return keyed, under
+
+
+def gesture_rotations(agent, request, rig):
+    """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
+
+    request: a GestureRequest. rig: a RigState (the rig's bones, roles and the pose underneath).
+    `keyed` is each bone's rotation as the gesture plays it over the pose underneath; `underneath` the
+    rotation it would have without the gesture (its animation, else its pose), which a Combine layer
+    needs. The bones are those the gesture owns (`owned_joints`, Point's hand shape, a target behaviour's
+    eyes). On a still rig, a behaviour whose free arm has no part in it (the agent's `still_free_arm`) holds
+    that arm where it was; on an animated rig the gesture does not key that arm at all. Every RLAnimateError
+    is raised before anything is returned, so callers can write all or nothing.
+    """
+    rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
+    check_length(request.frame_count)
+    canonical = run_agent(agent, request.behaviour, _objectives(agent, request, rig), seed=request.seed,
+                          frame_count=request.frame_count)  # (N, 15, 3)
+    targeted = agent.kind(request.behaviour) == behaviours.TARGET
+    phase_base = played_finger_base(canonical, request.arm) if targeted else None
+    names, played, standing, to_character = _played(request, rig, canonical)
+    bones = [rig.roles[n] for n in names]
+    columns = [rig.skeleton.index[b] for b in bones]  # the eyes, keyed for Point, come after these
     held = free_arm_columns(names, request.arm) if request.behaviour in agent.still_free_arm else []
-    played[:, held] = start[:, held]  # an arm that has no part in the gesture stays where it was
-    keyed = blend_from_pose(start, played, blend_weights(request.frame_count))
-    if targeted:  # the eyes look at the target; Point's finger is aimed exactly on the rig
-        phase = aim.pointing_phase(phase_base)
-        targets = np.broadcast_to(request.targets, (request.frame_count, 3))
-        basis = under_basis.copy()
-        basis[:, columns, :3, :3] = quat_to_matrix(keyed) * each_frame(
-            lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True), under_basis)
-        if request.exact_aim and request.behaviour == behaviours.POINT:
-            arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
-            aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
-            keyed[:, arm_column] = matrix_to_quat(_rotation_part(aimed))
-            basis[:, columns[arm_column]] = aimed
-        eyes = [role for role in ("LeftEye", "RightEye") if role in rig.roles]
-        if eyes:
-            eye_bones = [rig.roles[e] for e in eyes]
-            looking = look_at(rig, basis, columns, eye_bones, to_character, targets, phase)  # (N, E, 4)
-            bones += eye_bones
-            keyed = np.concatenate([keyed, looking], axis=1)
-            eye_columns = [rig.skeleton.index[b] for b in eye_bones]
-            under = np.concatenate([under, each_frame(
-                lambda frames: matrix_to_quat(frames[:, eye_columns, :3, :3]), under_basis)], axis=1)
+    keyed, under = _blended(rig, names, columns, played, standing, held)
+    if targeted:
+        bones, keyed, under = _aimed(rig, request, names, columns, keyed, under, phase_base, to_character)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
-    broken = [bone for bone, ok in zip(bones, finite) if not ok]
+    broken = [bone for bone, ok in zip(bones, finite, strict=True) if not ok]
     if broken:
         raise RLAnimateError(f"The gesture's rotations of {', '.join(broken)} are not numbers (NaN): check those "
                              "bones' pose and animation at the gesture's frames and the rig's rest pose for NaN "
                              "values.")
     return tuple(bones), keyed, under
+
+
+def _aimed(rig, request, names, columns, keyed, under, phase_base, to_character):
+    """(bones, keyed, under) of a target behaviour: the eyes look at the target, and Point's finger is aimed
+    exactly on the rig, solved against the pose as it will play."""
+    count = request.frame_count
+    bones = [rig.roles[n] for n in names]
+    phase = aim.pointing_phase(phase_base)
+    targets = np.broadcast_to(request.targets, (count, 3))
+    under_basis = rig.under_at(count)
+    basis = under_basis.copy()
+    basis[:, columns, :3, :3] = quat_to_matrix(keyed) * each_frame(
+        lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True), under_basis)
+    if request.exact_aim and request.behaviour == behaviours.POINT:
+        arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
+        aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
+        keyed[:, arm_column] = matrix_to_quat(_rotation_part(aimed))
+        basis[:, columns[arm_column]] = aimed
+    eyes = [role for role in ("LeftEye", "RightEye") if role in rig.roles]
+    if not eyes:
+        return bones, keyed, under
+    eye_bones = [rig.roles[e] for e in eyes]
+    looking = look_at(rig, basis, columns, eye_bones, to_character, targets, phase)  # (N, E, 4)
+    eye_columns = [rig.skeleton.index[b] for b in eye_bones]
+    under = np.concatenate([under, each_frame(
+        lambda frames: matrix_to_quat(frames[:, eye_columns, :3, :3]), under_basis)], axis=1)
+    return bones + eye_bones, np.concatenate([keyed, looking], axis=1), under
 
 
 class GestureRequest:
@@ -635,35 +741,60 @@ class RigState:
     nearest canonical ancestor's role; roles: {role: bone name} (core.rig_roles); family: the naming
     it was matched by (for messages); under, under_pose: (B, 4, 4) or (N, B, 4, 4) each bone's basis
     and armature-space pose matrices as the rig plays without the gesture, at each gesture frame (the
-    pose by forward kinematics when None); animated: whether they are animation (when not, bones at
-    rest start and end in the standing pose).
+    pose by forward kinematics when None); animated: whether they are animation (Point's targets are then
+    carried back by the hips' motion underneath).
+
+    still: the gesture is made as on a rig without animation (default: when not animated): bones at rest
+    start and end in the standing pose, and the other arm is keyed too. held: frames at the start over which
+    the gesture starts from the pose of its first frame (a handover: the pose the earlier gesture has there).
+    resting: {bone: (4, 4) basis} bones that start from this basis whatever plays underneath (a gesture
+    made on a still rig, baked again under gestures that move those bones: it starts where it first did).
+    bare: {bone: (N, 4, 4) basis} the spine, neck and head as the animation plays them without the turns
+    other gestures add to them (where those differ from `under`). above: {bone: (N, 4) quaternion} the turn
+    the layers above the gesture's own add to them (their Combine layers multiply in, in the stack's order).
     """
 
-    def __init__(self, name, skeleton_, roles, family, under, animated, under_pose=None):
+    def __init__(self, name, skeleton_, roles, family, under, animated, under_pose=None, *, still=None, held=0,
+                 resting=None, bare=None, above=None):
         self.name, self.skeleton, self.roles, self.family = name, skeleton_, dict(roles), family
         self.under, self.animated = np.asarray(under, dtype=np.float64), animated
         if under_pose is None:
             every = [skeleton_.names[i] for i in range(len(skeleton_.names))]
             under_pose = skeleton_.pose_matrices(self.under, only=every)
         self.under_pose = np.asarray(under_pose, dtype=np.float64)
+        self.still = (not animated) if still is None else bool(still)
+        self.held, self.resting = int(held), dict(resting or {})
+        self.bare, self.above = dict(bare or {}), dict(above or {})
 
-    def standing_still(self, values):
-        """(this rig as a still one, its rotation channel values {bone: (N, C)}) from the first frame
-        underneath, each broadcast over the frames, as a rig without animation is read; None when the pose
-        underneath moves over the frames. values: {bone: (N, C)} the channel values underneath."""
-        if self.under.ndim == 4 and (np.ptp(self.under, axis=0).any() or np.ptp(self.under_pose, axis=0).any()):
-            return None
-        if any(np.ptp(v, axis=0).any() for v in values.values()):
-            return None
-        count = len(next(iter(values.values())))
-        frame = (lambda m: np.broadcast_to(m[:1], m.shape)) if self.under.ndim == 4 else (lambda m: m)
-        still = RigState(self.name, self.skeleton, self.roles, self.family, frame(self.under), False,
-                         under_pose=frame(self.under_pose))
-        return still, {bone: np.broadcast_to(np.asarray(v)[:1], (count, np.shape(v)[1])) for bone, v in values.items()}
+    def with_pose(self, under, under_pose):
+        """This rig with another pose underneath (basis, pose), its other settings kept."""
+        return RigState(self.name, self.skeleton, self.roles, self.family, under, self.animated, under_pose,
+                        still=self.still, held=self.held, resting=self.resting, bare=self.bare, above=self.above)
 
     def under_at(self, count):
         """(N, B, 4, 4) basis matrices underneath at each of `count` frames."""
         return np.broadcast_to(self.under, (count,) + self.under.shape[-3:])
+
+    def animation_at(self, count):
+        """(N, B, 4, 4) basis matrices of the animation underneath: `under`, but the spine, neck and head
+        without other gestures' turns (`bare`) and the `resting` bones at their basis."""
+        pose = self.under_at(count)
+        if not self.resting and not self.bare:
+            return pose
+        pose = np.array(pose)
+        for bone, basis in (self.bare | self.resting).items():
+            pose[:, self.skeleton.index[bone]] = basis
+        return pose
+
+    def start_at(self, count):
+        """(N, B, 4, 4) basis matrices the gesture blends from and back to: `animation_at`, but over the `held`
+        frames the pose underneath at the first frame (where the gesture it takes over from is)."""
+        start = self.animation_at(count)
+        if not self.held:
+            return start
+        start = np.array(start)
+        start[:self.held] = self.under_at(count)[0]
+        return start
 
     def under_pose_at(self, count):
         """(N, B, 4, 4) pose matrices underneath at each of `count` frames."""

@@ -6,23 +6,28 @@ and two thirds of it in time is a cubic Hermite curve in time, so `hermite` pred
 Blender plays. Keys are added greedily where the played rotation strays furthest from the per-frame
 one, until it stays within the tolerance on every frame; all channels of a bone share their keys.
 """
+from collections.abc import Sequence
+
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from .rotations import euler_to_matrix, quat_to_matrix, rotvec_to_matrix
 
 
-def slopes(values: np.ndarray) -> np.ndarray:
+def slopes(values: ArrayLike) -> npt.NDArray[np.float64]:
     """(N, C) per-frame slopes of (N, C) values: central differences, one-sided at the ends."""
-    return np.gradient(np.asarray(values, dtype=np.float64), axis=0)
+    gradient: npt.NDArray[np.float64] = np.gradient(np.asarray(values, dtype=np.float64), axis=0)
+    return gradient
 
 
-def hermite(values: np.ndarray, tangents: np.ndarray, keys: np.ndarray) -> np.ndarray:
+def hermite(values: ArrayLike, tangents: npt.NDArray[np.float64],
+            keys: Sequence[int] | npt.NDArray[np.int_]) -> npt.NDArray[np.float64]:
     """(N, C) values played between the keys (sorted frame indices into values (N, C)), with handles a
     third of the way to the neighbouring keys along the slopes `tangents` (N, C)."""
-    values = np.asarray(values, dtype=np.float64)
+    values = np.asarray(values, dtype=np.float64)  # (N, C)
     out = values.copy()
-    for a, b in zip(keys[:-1], keys[1:]):
+    for a, b in zip(keys[:-1], keys[1:], strict=True):
         t = (np.arange(a, b + 1) - a)[:, None] / float(b - a)
         span = float(b - a)
         h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t
@@ -31,7 +36,7 @@ def hermite(values: np.ndarray, tangents: np.ndarray, keys: np.ndarray) -> np.nd
     return out
 
 
-def rotation_matrices(mode: str, values: np.ndarray) -> np.ndarray:
+def rotation_matrices(mode: str, values: ArrayLike) -> npt.NDArray[np.float64]:
     """(N, 3, 3) rotations that Blender plays from (N, C) channel values in a rotation mode."""
     values = np.asarray(values, dtype=np.float64)
     if mode == "QUATERNION":
@@ -42,14 +47,15 @@ def rotation_matrices(mode: str, values: np.ndarray) -> np.ndarray:
     return euler_to_matrix(values, mode)
 
 
-def angles_between(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def angles_between(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(N,) degrees between (N, 3, 3) rotations a and b."""
     cos = (np.trace(np.swapaxes(a, -1, -2) @ b, axis1=-2, axis2=-1) - 1.0) / 2.0
-    return np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    degrees: npt.NDArray[np.float64] = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    return degrees
 
 
 def reduce_keys(mode: str, values: ArrayLike, tolerance_deg: float,
-                offset: ArrayLike | None = None) -> tuple[np.ndarray, float]:
+                offset: ArrayLike | None = None) -> tuple[npt.NDArray[np.int_], float]:
     """(kept frame indices (K,), worst deviation in degrees) for one bone's (N, C) rotation channels.
 
     offset: (N, C) values the channels are added to when played (an Euler or axis-angle Combine layer

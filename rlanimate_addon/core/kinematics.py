@@ -7,6 +7,7 @@ the clip generator's inverse kinematics, can predict what Blender will show.
 from collections.abc import Collection, Mapping
 
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from . import skeleton, spaces
@@ -23,7 +24,8 @@ def bone_index(name: str) -> int:
     return _INDEX[name]
 
 
-def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] | None = None) -> np.ndarray:
+def pose_matrices(local_rotvecs: Mapping[str, ArrayLike],
+                  only: Collection[str] | None = None) -> npt.NDArray[np.float64]:
     """Armature-space pose matrices (..., B, 4, 4) from {bone name: (..., 3) local rotation vector}.
 
     Bones not named keep their rest rotation. Every value must share one batch shape. only: bone
@@ -48,16 +50,16 @@ def pose_matrices(local_rotvecs: Mapping[str, ArrayLike], only: Collection[str] 
 
 def ancestors(names: Collection[str]) -> list[int]:
     """Sorted indices of the named bones and all their ancestors (parents come before children)."""
-    indices = set()
+    indices: set[int] = set()
     for name in names:
         i = _INDEX[name]
         while i >= 0 and i not in indices:
             indices.add(i)
-            i = _PARENT[i]
+            i = int(_PARENT[i])
     return sorted(indices)
 
 
-def head_positions(pose: np.ndarray) -> np.ndarray:
+def head_positions(pose: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(..., B, 4, 4) pose matrices -> (..., B, 3) bone head positions."""
     return pose[..., :3, 3]
 
@@ -66,7 +68,7 @@ _DESCRIBED = tuple(sorted({b for _, b in skeleton.DESCRIPTION_JOINTS}
                           | {b for _, start, end in skeleton.EFFECTORS for b in (start, end) if b}))
 
 
-def describe(action_rotvecs: ArrayLike) -> np.ndarray:
+def describe(action_rotvecs: ArrayLike) -> npt.NDArray[np.float64]:
     """(..., 42) descriptions (spaces.describe) of the canonical skeleton posed by action-joint
     rotations (..., 15, 3): what the Blender environment reports, without Blender."""
     rotvecs = np.asarray(action_rotvecs, dtype=np.float64)

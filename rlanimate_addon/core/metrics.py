@@ -14,6 +14,7 @@ the high-frequency residual that a Savitzky-Golay filter removes, relative to th
 (its joints' path length), so it does not depend on the character's size or the gesture's extent.
 """
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from .errors import RLAnimateError
@@ -30,7 +31,7 @@ ARTEFACT_THRESHOLD = 98.5
 PENALTY_BASE = 1.01
 
 
-def _check_sequence(positions, name):
+def _check_sequence(positions: ArrayLike, name: str) -> npt.NDArray[np.float64]:
     p = np.asarray(positions, dtype=np.float64)
     if p.ndim != 3 or p.shape[-1] != 3 or p.shape[0] == 0:
         raise RLAnimateError(f"{name} must be joint positions of shape (frames, joints, 3), got {p.shape}.")
@@ -39,21 +40,23 @@ def _check_sequence(positions, name):
     return p
 
 
-def frame_errors(generated: ArrayLike, reference: ArrayLike) -> np.ndarray:
+def frame_errors(generated: ArrayLike, reference: ArrayLike) -> npt.NDArray[np.float64]:
     """(F,) per-frame error: the sum over joints of |dx| + |dy| + |dz|, in metres."""
     gen = _check_sequence(generated, "The generated clip")
     ref = _check_sequence(reference, "The reference clip")
     if gen.shape != ref.shape:
         raise RLAnimateError(f"The generated clip has shape {gen.shape} but the reference has {ref.shape}: "
                              "generate the same number of frames as the reference clip.")
-    return np.abs(gen - ref).sum(axis=(1, 2))
+    errors: npt.NDArray[np.float64] = np.abs(gen - ref).sum(axis=(1, 2))
+    return errors
 
 
-def frame_penalties(errors: ArrayLike) -> np.ndarray:
+def frame_penalties(errors: ArrayLike) -> npt.NDArray[np.float64]:
     """(F,) the paper's penalty max(0, log_1.01 error_t): zero for errors of 1 m or less."""
     e = np.asarray(errors, dtype=np.float64)
     over = np.maximum(e, 1.0)  # log of anything <= 1 is <= 0, which the max clips to 0
-    return np.log(over) / np.log(PENALTY_BASE)
+    penalties: npt.NDArray[np.float64] = np.log(over) / np.log(PENALTY_BASE)
+    return penalties
 
 
 def score(generated: ArrayLike, reference: ArrayLike) -> float:
@@ -63,7 +66,7 @@ def score(generated: ArrayLike, reference: ArrayLike) -> float:
     return float(100.0 - total_error / len(errors))
 
 
-def savgol_coefficients(window: int = SMOOTHING_WINDOW, order: int = SMOOTHING_ORDER) -> np.ndarray:
+def savgol_coefficients(window: int = SMOOTHING_WINDOW, order: int = SMOOTHING_ORDER) -> npt.NDArray[np.float64]:
     """(window, window) least-squares projection: row k evaluates at offset k the polynomial of
     degree `order` fitted to `window` equally spaced samples."""
     if window % 2 == 0 or order >= window:
@@ -73,7 +76,8 @@ def savgol_coefficients(window: int = SMOOTHING_WINDOW, order: int = SMOOTHING_O
     return basis @ np.linalg.pinv(basis)  # (W, W)
 
 
-def savgol_smooth(values: ArrayLike, window: int = SMOOTHING_WINDOW, order: int = SMOOTHING_ORDER) -> np.ndarray:
+def savgol_smooth(values: ArrayLike, window: int = SMOOTHING_WINDOW,
+                  order: int = SMOOTHING_ORDER) -> npt.NDArray[np.float64]:
     """Savitzky-Golay smoothing along axis 0 of (F, ...) values.
 
     Equals scipy.signal.savgol_filter(values, window, order, axis=0) in its default 'interp' mode:

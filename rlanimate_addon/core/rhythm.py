@@ -25,6 +25,7 @@ rate, start and stop near the exaggeration alone at the circular mean phase of a
 request weighs only the training waves of its own arm (`by_arm`, as retrieval fetches only that arm's), are
 chosen on real-capture validation takes (docs/results/realmocap_length.md) and kept in the file.
 """
+import json
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
@@ -110,7 +111,9 @@ class RhythmModel:
         if len(exaggerations) < 2:
             raise RLAnimateError("Fitting the wave rhythm needs at least 2 wave clips whose hand swings side to "
                                  "side: add such wave clips.")
-        examples = [[float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms)]
+        examples = [
+            [float(e)] + [getattr(r, name) for name in PARAMETERS] for e, r in zip(exaggerations, rhythms, strict=True)
+        ]
         phases = np.array([r.phase for r in rhythms])
         phase = float(np.angle(np.mean(np.exp(1j * phases))))
         return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases, arms=arms)
@@ -135,34 +138,15 @@ class RhythmModel:
 
     @classmethod
     def from_dict(cls, values: dict) -> "RhythmModel":
-        try:
-            phases = values.get("phases")
-            model = cls(np.asarray(values["examples"], dtype=np.float64), float(values["phase"]),
-                        float(values["ramp"]), float(values["bandwidth"]),
-                        None if phases is None else np.asarray(phases, dtype=np.float64),
-                        values.get("typical_tempo"), values.get("tempo_bandwidth", EARLIER_TEMPO_BANDWIDTH),
-                        values.get("arms"), values.get("by_arm", False))
-            if not isinstance(model.typical_tempo, bool) or not isinstance(model.by_arm, bool):
-                raise TypeError("typical_tempo and by_arm must be true or false")
-        except (KeyError, TypeError, ValueError) as error:
-            raise RLAnimateError(f"The agent's wave_rhythm metadata is invalid ({error!r}): re-export the "
-                                 f"agent with trainer/agent/agent_export.py.") from error
-        shape_ok = model.examples.ndim == 2 and model.examples.shape[0] >= 2 \
-            and model.examples.shape[1] == 1 + len(PARAMETERS)
-        phases_ok = model.phases is None or model.phases.shape == model.examples.shape[:1]
-        arms_ok = model.arms is None or (len(model.arms) == len(model.examples) and set(model.arms) <= set(ARMS))
-        numbers = np.concatenate([model.examples.ravel(),
-                                  [model.phase, model.ramp, model.bandwidth, model.tempo_bandwidth],
-                                  [] if model.phases is None else model.phases])
-        positive = min(model.ramp, model.bandwidth, model.tempo_bandwidth) > 0
-        if not (shape_ok and phases_ok and arms_ok and positive) or not np.all(np.isfinite(numbers)) \
-                or (model.typical_tempo and model.phases is None) or (model.by_arm and model.arms is None):
-            raise RLAnimateError(f"The agent's wave_rhythm metadata holds invalid numbers (need at least 2 "
-                                 f"examples of {1 + len(PARAMETERS)} finite numbers, a finite phase for each "
-                                 f"when typical_tempo is on, LEFT or RIGHT for each wave when by_arm is on or "
-                                 f"any arms are given, and a positive ramp, bandwidth and tempo_bandwidth): "
-                                 f"re-export the agent.")
-        return model
+        """The model an agent file's `wave_rhythm` holds; RLAnimateError naming the field that is wrong
+        (`invalid_field`)."""
+        problem = invalid_field(values)
+        if problem:
+            raise RLAnimateError(f"The agent's wave_rhythm metadata is invalid ({problem}): re-export the agent "
+                                 f"with trainer/agent/agent_export.py.")
+        return cls(values["examples"], values["phase"], values["ramp"], values["bandwidth"], values.get("phases"),
+                   values.get("typical_tempo"), values.get("tempo_bandwidth", EARLIER_TEMPO_BANDWIDTH),
+                   values.get("arms"), bool(values.get("by_arm")))
 
     def weights(self, exaggeration: float, tempo: float | None = None, arm: str | None = None) -> np.ndarray:
         """(K,) how much each training wave weighs in a request of this exaggeration (sum 1): with `by_arm`, only
@@ -233,3 +217,53 @@ def _normalised(log_weights):
     """Weights (sum 1) from their logarithms, shifted so that far ones still have weights."""
     weights = np.exp(log_weights - log_weights.max())
     return weights / weights.sum()
+
+
+#: The numbers of a rhythm model, each: JSON numbers within this (1e300 squared is infinite).
+_LARGEST = 1e300
+
+
+def _finite(value) -> bool:
+    """A JSON number (not a boolean) that is finite and within +-_LARGEST."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return False
+    return abs(value) <= _LARGEST if isinstance(value, int) else math.isfinite(value) and abs(value) <= _LARGEST
+
+
+def _json_type(value) -> str:
+    """How a message names a JSON value's type."""
+    names = {bool: "a boolean", str: "a string", list: "a list", dict: "an object", type(None): "null"}
+    return names.get(type(value), "a number")
+
+
+def invalid_field(values) -> str | None:
+    """What is wrong with an agent file's `wave_rhythm` value, naming the field (None: nothing). Every field
+    RhythmModel reads is checked for its JSON type, its length (one per training wave) and its range."""
+    if not isinstance(values, dict):
+        return f"wave_rhythm is {_json_type(values)}, not an object holding the training waves' rhythms"
+    missing = [key for key in ("examples", "phase", "ramp", "bandwidth") if key not in values]
+    if missing:
+        return f"wave_rhythm lacks {', '.join(missing)}"
+    examples, width = values["examples"], 1 + len(PARAMETERS)
+    if not isinstance(examples, list) or len(examples) < 2 or not all(
+            isinstance(row, list) and len(row) == width and all(_finite(v) for v in row) for row in examples):
+        return f"wave_rhythm.examples must be a list of at least 2 lists of {width} finite numbers"
+    count = len(examples)
+    if not _finite(values["phase"]):
+        return "wave_rhythm.phase must be a finite number"
+    for key in ("ramp", "bandwidth", "tempo_bandwidth"):
+        if key in values and not (_finite(values[key]) and values[key] > 0):
+            return f"wave_rhythm.{key} must be a positive number, not {json.dumps(values[key])[:40]}"
+    phases, arms = values.get("phases"), values.get("arms")
+    if phases is not None and not (isinstance(phases, list) and len(phases) == count and all(map(_finite, phases))):
+        return f"wave_rhythm.phases must be null or a list of {count} finite numbers, one per training wave"
+    if arms is not None and not (isinstance(arms, list) and len(arms) == count
+                                 and all(isinstance(a, str) and a in ARMS for a in arms)):
+        return f"wave_rhythm.arms must be null or a list of {count} arms, each {' or '.join(map(repr, ARMS))}"
+    for key, needs, needed in (("typical_tempo", "phases", phases), ("by_arm", "arms", arms)):
+        flag = values.get(key)
+        if flag is not None and not isinstance(flag, bool):
+            return f"wave_rhythm.{key} must be true or false, not {_json_type(flag)}"
+        if flag and needed is None:
+            return f"wave_rhythm.{key} is true but the file keeps no {needs}"
+    return None

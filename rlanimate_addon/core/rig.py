@@ -6,10 +6,14 @@ with rest a bone's `matrix_local` and basis its `matrix_basis` (the keyed locati
 helper bones (Rigify's FK controls and the bones that copy them): from the pose Blender evaluated,
 a bone whose basis changes, or whose parent moves, moves rigidly with them.
 """
+from collections.abc import Callable, Collection, Iterable, Sequence
+
 import numpy as np
+import numpy.typing as npt
+from numpy.typing import ArrayLike
 
 
-def _orthonormal(rotation):
+def _orthonormal(rotation: npt.NDArray[np.float64]) -> bool:
     """Whether R^T R is the identity for every (..., 3, 3) matrix, as np.allclose(R^T R, I, atol=1e-6)
     tests it: entry by entry over all matrices at once (a product per 3x3 matrix costs several times more)."""
     columns = np.ascontiguousarray(np.moveaxis(rotation, (-2, -1), (0, 1))).reshape(3, 3, -1)  # (3, 3, M)
@@ -22,7 +26,7 @@ def _orthonormal(rotation):
     return True
 
 
-def inverse(matrices):
+def inverse(matrices: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """Inverses of (..., 4, 4) affine matrices: by transposition where the 3x3 part is a rotation
     (bones' pose matrices, unless scaled), else by np.linalg.inv."""
     rotation = matrices[..., :3, :3]
@@ -35,7 +39,8 @@ def inverse(matrices):
     return out
 
 
-def each_frame(function, values):
+def each_frame(function: Callable[[npt.NDArray[np.float64]], npt.NDArray[np.float64]],
+               values: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """function(values) of (N, ...) per-frame values whose result is per frame too; when the frames are one
     frame broadcast (a rig standing still: stride 0) it runs on that frame once and its result is broadcast."""
     if len(values) > 1 and values.strides[0] == 0:
@@ -44,7 +49,7 @@ def each_frame(function, values):
     return function(values)
 
 
-def _frames_inverse(matrices, bones):
+def _frames_inverse(matrices: npt.NDArray[np.float64], bones: Sequence[int]) -> npt.NDArray[np.float64]:
     """(N, len(bones), 4, 4) `inverse` of (N, B, 4, 4) matrices' bones at indices `bones`, frame by frame
     (`each_frame`), laid out frame after frame as the products that read them expect."""
     return np.ascontiguousarray(each_frame(lambda m: inverse(m[:, bones]), matrices))
@@ -53,7 +58,8 @@ def _frames_inverse(matrices, bones):
 class RigSkeleton:
     """Bone names, parent names (None for a root), (B, 4, 4) rest matrices and (B,) rest lengths."""
 
-    def __init__(self, names, parents, rest, lengths):
+    def __init__(self, names: Iterable[str], parents: Iterable[str | None], rest: ArrayLike,
+                 lengths: ArrayLike) -> None:
         self.names = tuple(names)
         self.index = {name: i for i, name in enumerate(self.names)}
         self.parents = np.array([-1 if p is None else self.index[p] for p in parents])
@@ -63,28 +69,34 @@ class RigSkeleton:
         self._rest_local = np.where((self.parents < 0)[:, None, None], self.rest,
                                     inverse(self.rest[self.parents]) @ self.rest)
 
-    def rest_frame(self, name):
+    def rest_frame(self, name: str) -> npt.NDArray[np.float64]:
         """(3, 3) armature-space rest rotation of a bone (columns: its local X, Y, Z axes, unit length)."""
         rotation = self.rest[self.index[name], :3, :3]
-        return rotation / np.linalg.norm(rotation, axis=0, keepdims=True)
+        frame: npt.NDArray[np.float64] = rotation / np.linalg.norm(rotation, axis=0, keepdims=True)
+        return frame
 
-    def rest_head(self, name):
+    def rest_head(self, name: str) -> npt.NDArray[np.float64]:
         return self.rest[self.index[name], :3, 3].copy()
 
-    def tails(self, pose, name):
+    def tails(self, pose: npt.NDArray[np.float64], name: str) -> npt.NDArray[np.float64]:
         """(..., 3) tail positions of a bone from (..., B, 4, 4) pose matrices (head + length along Y)."""
         i = self.index[name]
-        return pose[..., i, :3, 3] + self.lengths[i] * pose[..., i, :3, 1]
+        length = float(self.lengths[i])
+        tails: npt.NDArray[np.float64] = pose[..., i, :3, 3] + length * pose[..., i, :3, 1]
+        return tails
 
-    def ancestors(self, name):
+    def ancestors(self, name: str) -> list[int]:
         """Indices of the bone and all its ancestors, root first."""
-        chain, i = [], self.index[name]
+        chain: list[int] = []
+        i = self.index[name]
         while i >= 0:
             chain.append(i)
-            i = self.parents[i]
+            i = int(self.parents[i])
         return chain[::-1]
 
-    def pose_after(self, pose, basis, new_basis, changed, only):
+    def pose_after(self, pose: npt.NDArray[np.float64], basis: npt.NDArray[np.float64],
+                   new_basis: npt.NDArray[np.float64], changed: Iterable[int],
+                   only: Collection[str]) -> npt.NDArray[np.float64]:
         """(N, B, 4, 4) pose matrices once the bones at indices `changed` take `new_basis`.
 
         pose, basis: (N, B, 4, 4) the evaluated pose and basis matrices underneath; new_basis: (N, B, 4, 4)
@@ -96,7 +108,10 @@ class RigSkeleton:
         changed = set(changed)
         bones = self._evaluation_order(only)
         slot = {i: k for k, i in enumerate(bones)}
-        pose_inverse, basis_inverse = _frames_inverse(pose, bones), _frames_inverse(basis, bones)  # (N, len(bones), 4, 4)
+        pose_inverse, basis_inverse = (
+            _frames_inverse(pose, bones),
+            _frames_inverse(basis, bones),
+        )  # (N, len(bones), 4, 4)
         still = pose.strides[0] == 0 and basis.strides[0] == 0  # one frame broadcast: a rig standing still
         out = np.array(pose, dtype=np.float64)
         moved = np.zeros(len(self.names), dtype=bool)
@@ -113,7 +128,7 @@ class RigSkeleton:
             moved[i] = True
         return out
 
-    def pose_matrices(self, basis, only):
+    def pose_matrices(self, basis: npt.NDArray[np.float64], only: Collection[str]) -> npt.NDArray[np.float64]:
         """(..., B, 4, 4) armature-space pose matrices from (..., B, 4, 4) basis matrices.
 
         Only the bones named in `only` and their ancestors are evaluated; the others are NaN.
@@ -125,7 +140,7 @@ class RigSkeleton:
             pose[..., i, :, :] = local if parent < 0 else pose[..., parent, :, :] @ local
         return pose
 
-    def _evaluation_order(self, only):
+    def _evaluation_order(self, only: Iterable[str]) -> list[int]:
         """Indices of the bones named in `only` and their ancestors, parents before children."""
         return sorted({i for name in only for i in self.ancestors(name)},
                       key=lambda i: len(self.ancestors(self.names[i])))

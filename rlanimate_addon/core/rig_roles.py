@@ -149,13 +149,17 @@ FAMILIES = (MIXAMO, RIGIFY, UNREAL, AUTO_RIG_PRO, VROID, VRM_HUMANOID, VRM_ADDON
 #: Prefixes dropped before matching: Mixamo's ('mixamorig', 'mixamorig1_') and 3ds Max Biped's
 #: ('Bip01 ', 'Bip001 ').
 _PREFIX = re.compile(r"^(mixamorig\d*_?|bip0*1)")
+#: A side suffix after a separator ('hand_l', 'hand.L', 'hand-l'), compared as '.l': UE names with
+#: Blender's side suffixes ('upperarm.l', 'hand.l') are the UE family's 'upperarm_l', 'hand_l'.
+_SIDE_SUFFIX = re.compile(r"[._-]([lr])$")
 
 
 @lru_cache(maxsize=4096)
 def name_key(name):
-    """A bone name as matching compares it: namespace, spaces and a Mixamo or Biped prefix dropped, lower
-    case (cached: detection compares every bone with every family's names on each Generate)."""
-    return _PREFIX.sub("", re.split(r"[:|]", name)[-1].lower().replace(" ", ""))
+    """A bone name as matching compares it: namespace, spaces and a Mixamo or Biped prefix dropped, a side
+    suffix's separator made '.', lower case (cached: detection compares every bone with every family's
+    names on each Generate)."""
+    return _SIDE_SUFFIX.sub(r".\1", _PREFIX.sub("", re.split(r"[:|]", name)[-1].lower().replace(" ", "")))
 
 
 def _side_templates(family, role):
@@ -223,15 +227,23 @@ def check_roles(rig_name, roles, arm, family_name):
     if missing:
         raise RLAnimateError(
             f"Armature {rig_name!r} has no bone for the roles {', '.join(missing)} (closest bone naming: "
-            f"{family_name}). Rename those bones to Mixamo names, or map them: in the RLAnimate panel, "
-            "'Save Bone Map' writes the detected map as a JSON file; add the missing roles with your "
-            "bone names and pick the file as Bone Map. For a VRM character, 'Bone Map from VRM File' reads "
-            "the map its .vrm file carries.")
+            f"{family_name}). For a VRM character, click 'Bone Map from VRM File' in the RLAnimate panel and pick "
+            "its .vrm file: the map the file carries names the bones. Otherwise map them: 'Save Bone Map' "
+            "writes the detected map as a JSON file, with every role it could not find left empty; type your "
+            "bone names for those and pick the file as Bone Map. Or rename those bones to Mixamo names.")
+
+
+#: The note a saved bone-map file carries for whoever edits it.
+BONE_MAP_NOTE = ('Each role names one bone of the armature; "" marks a role it could not find: type that bone\'s name, '
+                 'or leave it "" (Spine or Spine1 or Spine2, Neck, Head and the gesturing arm\'s Arm, ForeArm and '
+                 'Hand are needed; the rest are keyed where mapped). Then pick this file as Bone Map.')
 
 
 def bone_map_json(family_name, roles):
-    """The text of a bone-map file for {role: bone name}."""
-    return json.dumps({"family": family_name, "bones": {r: roles[r] for r in ROLES if r in roles}}, indent=2)
+    """The text of a bone-map file for {role: bone name}: every role, in ROLES order, "" for those `roles`
+    lacks, so the user fills in names rather than typing roles."""
+    return json.dumps({"family": family_name, "note": BONE_MAP_NOTE,
+                       "bones": {r: roles.get(r, "") for r in ROLES}}, indent=2, ensure_ascii=False)
 
 
 #: The largest bone-map file read (Save Bone Map writes about 2 KB).
@@ -247,9 +259,10 @@ def read_bone_map(text, bone_names):
     except (ValueError, KeyError, TypeError, AttributeError, RecursionError):
         raise RLAnimateError('The bone-map file is not valid: it must be JSON like {"family": "...", '
                              '"bones": {"Spine": "my_spine", ...}}; save one from the panel to start.') from None
-    if not isinstance(bones, dict) or not all(isinstance(b, str) and b for b in bones.values()):
+    if not isinstance(bones, dict) or not all(isinstance(b, str) for b in bones.values()):
         raise RLAnimateError('The bone-map file\'s "bones" must map role names to bone names, one name (a '
-                             'string) per role: correct the file, or save a new one from the panel.')
+                             'string, "" for none) per role: correct the file, or save a new one from the panel.')
+    bones = {role: bone for role, bone in bones.items() if bone}  # "": a role left unmapped
     shared = sorted(b for b, uses in Counter(bones.values()).items() if uses > 1)
     if shared:
         roles = [role for role, b in bones.items() if b == shared[0]]

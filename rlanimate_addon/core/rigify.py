@@ -14,7 +14,7 @@ close to both, and the aimed middle of the gesture plays on FK alone.
 """
 import numpy as np
 
-from .gesture import RigState, blend_weights
+from .gesture import blend_weights
 from .rig import inverse
 
 #: The arm's FK controls, shoulder to hand, without their side (".L", ".R").
@@ -79,4 +79,4 @@ def snap_fk(rig, controls, played):
         if above and name not in controls:
             control = rig.skeleton.names[above[-1]]
             new_pose[:, i] = new_pose[:, above[-1]] @ inverse(played[control]) @ pose[:, i]
-    return RigState(rig.name, rig.skeleton, rig.roles, rig.family, new_basis, rig.animated, under_pose=new_pose)
+    return rig.with_pose(new_basis, new_pose)

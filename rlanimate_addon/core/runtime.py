@@ -101,7 +101,7 @@ def _gru_sequence(inputs, gru):
     h, hidden_gates = np.zeros(H), np.empty(3 * H)
     step = _gru_stepper(h, hidden_gates)
     states = np.empty((len(inputs), H))
-    for input_rz, input_n, state in zip(input_gates[:, :2 * H], input_gates[:, 2 * H:], states):
+    for input_rz, input_n, state in zip(input_gates[:, :2 * H], input_gates[:, 2 * H:], states, strict=True):
         np.dot(h, hidden_weight, out=hidden_gates)
         hidden_gates += hidden_bias
         step(input_rz, input_n)
@@ -139,7 +139,7 @@ class GestureAgent:
         config = metadata["agent_config"]
         w = {name: np.asarray(array, dtype=np.float64) for name, array in weights.items()}
         layers = int(config["hidden_layers"])
-        E, Z, A = int(config["behaviour_size"]), int(config["stochastic_size"]), spaces.ACTION_SIZE
+        E, Z = int(config["behaviour_size"]), int(config["stochastic_size"])
         self._sizes = (E, Z)
         self._min_std = float(config["min_std"])
         self._floor = float(config["concentration_floor"])
@@ -252,9 +252,16 @@ class GestureAgent:
         alpha, beta = out[:A], out[A:]
         belief_layers, animation_layers = self._belief, self._animation
         from_e_weights, from_z_weights, from_a_weights = self._from_e, self._from_z, self._from_a
-        hidden_bias, floor, scale, min_std = self._cell_hidden_bias, self._floor, self._concentration_scale, self._min_std
+        hidden_bias, floor, scale, min_std = (
+            self._cell_hidden_bias,
+            self._floor,
+            self._concentration_scale,
+            self._min_std,
+        )
         actions = np.empty((count, A))
-        for cell_row, belief_row, animation_row, a in zip(cell_inputs, belief_inputs, animation_inputs, actions):
+        for cell_row, belief_row, animation_row, a in zip(
+            cell_inputs, belief_inputs, animation_inputs, actions, strict=True
+        ):
             np.add(cell_row, recurrent_gates, out=input_gates)
             cell_step(input_rz, input_n)
             np.dot(e, from_e_weights, out=from_e)

@@ -7,15 +7,26 @@ axis runs from head to tail, and its local Z axis is `z_hint` made orthogonal to
 `EditBone.align_roll(z_hint)` does). Local rotations (pose-bone rotations) are relative to this
 rest frame, so the same numbers mean the same motion on any rig that shares the rest frames.
 """
-from collections import namedtuple
+from typing import NamedTuple
 
 import numpy as np
+import numpy.typing as npt
 
 PREFIX = "mixamorig:"
 
-Bone = namedtuple("Bone", "name parent head tail z_hint")
+Vector3 = tuple[float, float, float]
 
-_UP, _FORWARD = (0.0, 0.0, 1.0), (0.0, -1.0, 0.0)
+
+class Bone(NamedTuple):
+    name: str
+    parent: str | None
+    head: Vector3
+    tail: Vector3
+    z_hint: Vector3
+
+
+_UP: Vector3 = (0.0, 0.0, 1.0)
+_FORWARD: Vector3 = (0.0, -1.0, 0.0)
 
 _CENTRE_BONES = [
     Bone("Hips", None, (0.0, 0.01, 1.00), (0.0, 0.01, 1.09), _FORWARD),
@@ -28,7 +39,8 @@ _CENTRE_BONES = [
 ]
 
 # Left side only; the right side mirrors it in X (see _mirror).
-_FINGER_BASES = {  # name: (base position, direction, phalanx lengths 1-4)
+_FINGER_BASES: dict[str, tuple[Vector3, Vector3, tuple[float, float, float, float]]] = {
+    # name: (base position, direction, phalanx lengths 1-4)
     "Thumb": ((0.725, -0.030, 1.425), (0.55, -0.75, -0.35), (0.040, 0.034, 0.030, 0.024)),
     "Index": ((0.795, -0.026, 1.450), (1.0, -0.03, 0.0), (0.045, 0.028, 0.022, 0.020)),
     "Middle": ((0.800, -0.006, 1.450), (1.0, 0.0, 0.0), (0.048, 0.031, 0.024, 0.020)),
@@ -37,7 +49,7 @@ _FINGER_BASES = {  # name: (base position, direction, phalanx lengths 1-4)
 }
 
 
-def _left_side_bones():
+def _left_side_bones() -> list[Bone]:
     bones = [
         Bone("LeftEye", "Head", (0.032, -0.085, 1.665), (0.032, -0.110, 1.665), _UP),
         # The collar starts 2 cm in front of the shoulder joint, as a clavicle runs back from the
@@ -68,14 +80,15 @@ def _left_side_bones():
     return bones
 
 
-def _mirror(bone):
-    def flip(p):
-        return None if p is None else (-p[0], p[1], p[2])
+def _mirror(bone: Bone) -> Bone:
+    def flip(p: Vector3) -> Vector3:
+        return (-p[0], p[1], p[2])
 
-    def rename(name):
-        return None if name is None else name.replace("Left", "Right") if name.startswith("Left") else name
+    def rename(name: str) -> str:
+        return name.replace("Left", "Right") if name.startswith("Left") else name
 
-    return Bone(rename(bone.name), rename(bone.parent), flip(bone.head), flip(bone.tail), bone.z_hint)
+    parent = None if bone.parent is None else rename(bone.parent)
+    return Bone(rename(bone.name), parent, flip(bone.head), flip(bone.tail), bone.z_hint)
 
 
 _LEFT = _left_side_bones()
@@ -115,7 +128,7 @@ ARMS = ("LEFT", "RIGHT")
 ARM_PREFIX = {"LEFT": "Left", "RIGHT": "Right"}
 
 
-def rest_frame(bone: Bone) -> np.ndarray:
+def rest_frame(bone: Bone) -> npt.NDArray[np.float64]:
     """(3, 3) rest rotation of a bone in armature space; columns are its local X, Y, Z axes."""
     y = np.subtract(bone.tail, bone.head)
     y = y / np.linalg.norm(y)
@@ -126,7 +139,7 @@ def rest_frame(bone: Bone) -> np.ndarray:
     return np.stack([x, y, z], axis=1)
 
 
-def rest_matrices() -> np.ndarray:
+def rest_matrices() -> npt.NDArray[np.float64]:
     """(B, 4, 4) armature-space rest matrices of BONES, in BONES order."""
     mats = np.tile(np.eye(4), (len(BONES), 1, 1))
     for i, bone in enumerate(BONES):
@@ -135,7 +148,7 @@ def rest_matrices() -> np.ndarray:
     return mats
 
 
-def shoulder_rest_position(arm: str) -> np.ndarray:
+def shoulder_rest_position(arm: str) -> npt.NDArray[np.float64]:
     """Rest position (3,) of the pointing arm's shoulder joint: where pointing vectors start."""
     return np.asarray(BONE_BY_NAME[ARM_PREFIX[arm] + "Arm"].head)
 

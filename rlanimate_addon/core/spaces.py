@@ -23,10 +23,11 @@ The character frame is the armature's object space with its scale removed: +X th
 from collections.abc import Mapping
 
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from . import behaviours, rhythm, skeleton
-from .behaviours import INTENSITY, TARGET, WAVE, Behaviour
+from .behaviours import TARGET, WAVE, Behaviour
 from .errors import RLAnimateError
 
 DESCRIPTION_SIZE = 42
@@ -50,7 +51,7 @@ _JOINT_BOUNDS = {
 }
 
 
-def _joint_bound(joint):
+def _joint_bound(joint: str) -> float:
     for side in ("Left", "Right"):
         if joint.startswith(side):
             return _JOINT_BOUNDS[joint[len(side):]]
@@ -58,7 +59,7 @@ def _joint_bound(joint):
 
 
 #: (45, 2) default [low, high] per action channel, in action order.
-DEFAULT_ACTION_BOUNDS = np.array(
+DEFAULT_ACTION_BOUNDS: npt.NDArray[np.float64] = np.array(
     [[-_joint_bound(j), _joint_bound(j)] for j in skeleton.ACTION_JOINTS for _ in range(3)])
 
 
@@ -74,7 +75,7 @@ class ObjectiveSpace:
     """The objective layout of an agent's behaviours (a tuple of core.behaviours.Behaviour, in objective
     order): its size, each behaviour's label, and the objectives of a request."""
 
-    def __init__(self, declared: tuple[Behaviour, ...]):
+    def __init__(self, declared: tuple[Behaviour, ...]) -> None:
         if not declared:
             raise RLAnimateError("An agent needs at least one behaviour.")
         self.behaviours = tuple(declared)
@@ -84,17 +85,17 @@ class ObjectiveSpace:
         self._kinds = {b.name: b.kind for b in self.behaviours}
         count = len(self.behaviours)
         #: (N, L) each behaviour's label: Table 2's type code for at most two behaviours, else one-hot.
-        self.labels = np.arange(1.0, count + 1.0)[:, None] if count <= 2 else np.eye(count)
+        self.labels: npt.NDArray[np.float64] = np.arange(1.0, count + 1.0)[:, None] if count <= 2 else np.eye(count)
         self.label_size = self.labels.shape[1]
         self.size = self.label_size + _FIELDS_AFTER_LABEL
 
-    def __eq__(self, other):
+    def __eq__(self, other: object) -> bool:
         return isinstance(other, ObjectiveSpace) and self.behaviours == other.behaviours
 
-    def __hash__(self):
+    def __hash__(self) -> int:
         return hash(self.behaviours)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"ObjectiveSpace({', '.join(f'{b.name} {b.kind}' for b in self.behaviours)})"
 
     def kind(self, behaviour: str) -> str:
@@ -116,22 +117,24 @@ class ObjectiveSpace:
         self.check_behaviour(behaviour)
         check_arm_and_length(arm, frame_count)
 
-    def label_mask(self, objectives: ArrayLike, behaviour: str) -> np.ndarray:
+    def label_mask(self, objectives: ArrayLike, behaviour: str) -> npt.NDArray[np.bool_]:
         """(...,) bool: which objectives (..., L + 6) carry the label of `behaviour`."""
         label = self.labels[self.names.index(behaviour)]
-        return np.all(np.asarray(objectives)[..., :self.label_size] == label, axis=-1)
+        mask: npt.NDArray[np.bool_] = np.all(np.asarray(objectives)[..., :self.label_size] == label, axis=-1)
+        return mask
 
-    def kind_mask(self, objectives: ArrayLike, kind: str) -> np.ndarray:
+    def kind_mask(self, objectives: ArrayLike, kind: str) -> npt.NDArray[np.bool_]:
         """(...,) bool: which objectives (..., L + 6) belong to a behaviour of `kind`."""
         masks = [self.label_mask(objectives, name) for name in self.of_kind(kind)]
         return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
 
-    def phase_features(self, objectives: ArrayLike) -> np.ndarray:
+    def phase_features(self, objectives: ArrayLike) -> npt.NDArray[np.float64]:
         """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): a wave's rhythm signals and their second
         harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
         objectives = np.asarray(objectives, dtype=np.float64)
         wave = self.label_mask(objectives, WAVE) if WAVE in self.names else np.zeros(objectives.shape[:-1], bool)
-        return rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:]) * wave[..., None]
+        features: npt.NDArray[np.float64] = rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:])
+        return features * wave[..., None]
 
     def behaviours_in(self, objectives: ArrayLike) -> set[str]:
         """The ids whose labels the objectives (..., L + 6) carry; RLAnimateError for a label of none."""
@@ -142,7 +145,7 @@ class ObjectiveSpace:
         return {name for name, mask in masks.items() if mask.any()}
 
     def make_objective(self, behaviour: str, arm: str, attributes: ArrayLike, frame_count: int,
-                       rhythm: ArrayLike | None = None) -> np.ndarray:
+                       rhythm: ArrayLike | None = None) -> npt.NDArray[np.float64]:
         """(N, L + 6) objectives for a gesture of `frame_count` frames.
 
         `attributes` is, for a target behaviour, a unit vector (3,) or one per frame (N, 3), so a moving
@@ -185,7 +188,7 @@ class ObjectiveSpace:
 PAPER_SPACE = ObjectiveSpace(behaviours.PAPER)
 
 
-def pointing_direction(arm: str, target: ArrayLike) -> np.ndarray:
+def pointing_direction(arm: str, target: ArrayLike) -> npt.NDArray[np.float64]:
     """Unit vector (3,) from the arm's rest shoulder joint to `target` (3,), both in the character frame."""
     offset = np.asarray(target, dtype=np.float64) - skeleton.shoulder_rest_position(arm)
     norm = np.linalg.norm(offset)
@@ -194,14 +197,16 @@ def pointing_direction(arm: str, target: ArrayLike) -> np.ndarray:
     return offset / norm
 
 
-def encode_action(rotvecs: ArrayLike, bounds: np.ndarray = DEFAULT_ACTION_BOUNDS) -> np.ndarray:
+def encode_action(rotvecs: ArrayLike,
+                  bounds: npt.NDArray[np.float64] = DEFAULT_ACTION_BOUNDS) -> npt.NDArray[np.float64]:
     """(..., 15, 3) rotation vectors -> (..., 45) actions in [0, 1] (clipped to the bounds)."""
     flat = np.asarray(rotvecs, dtype=np.float64).reshape(np.shape(rotvecs)[:-2] + (ACTION_SIZE,))
     low, high = bounds[:, 0], bounds[:, 1]
     return np.clip((flat - low) / (high - low), 0.0, 1.0)
 
 
-def decode_action(action: ArrayLike, bounds: np.ndarray = DEFAULT_ACTION_BOUNDS) -> np.ndarray:
+def decode_action(action: ArrayLike,
+                  bounds: npt.NDArray[np.float64] = DEFAULT_ACTION_BOUNDS) -> npt.NDArray[np.float64]:
     """(..., 45) actions in [0, 1] -> (..., 15, 3) rotation vectors in radians."""
     a = np.asarray(action, dtype=np.float64)
     low, high = bounds[:, 0], bounds[:, 1]
@@ -209,7 +214,7 @@ def decode_action(action: ArrayLike, bounds: np.ndarray = DEFAULT_ACTION_BOUNDS)
     return rot.reshape(a.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
 
 
-def describe(positions: Mapping[str, ArrayLike], eye_axes: Mapping[str, ArrayLike]) -> np.ndarray:
+def describe(positions: Mapping[str, ArrayLike], eye_axes: Mapping[str, ArrayLike]) -> npt.NDArray[np.float64]:
     """Description (..., 42) from world data in the character frame.
 
     positions: mapping bone name -> (..., 3) head position in metres (DESCRIPTION_JOINTS, fingertips).
@@ -224,7 +229,7 @@ def describe(positions: Mapping[str, ArrayLike], eye_axes: Mapping[str, ArrayLik
     return np.concatenate(vectors + joints, axis=-1)
 
 
-def description_joint_positions(description: ArrayLike) -> np.ndarray:
+def description_joint_positions(description: ArrayLike) -> npt.NDArray[np.float64]:
     """(..., 42) descriptions -> (..., 10, 3) joint positions, the joints the paper's score compares."""
     d = np.asarray(description)
     return d[..., DESCRIPTION_POSITIONS].reshape(d.shape[:-1] + (len(skeleton.DESCRIPTION_JOINTS), 3))

@@ -3,10 +3,10 @@
 Rigs come from the committed sample character, or are built from the canonical skeleton with other
 units, another armature-space orientation and other bone rolls, as a Mixamo FBX import has them.
 """
-from pathlib import Path
+from pathlib import Path  # noqa: I001  (bpy before addon_utils, Blender's own module, importable once bpy is)
 
 import bpy
-import addon_utils  # noqa: I001  (Blender's own module, importable once bpy is)
+import addon_utils
 import numpy as np
 
 from rlanimate_addon.core import skeleton
@@ -58,7 +58,10 @@ def load_sample_rig():
     return activate(bpy.data.objects[SAMPLE_RIG])
 
 
-def build_rig(name, *, units=1.0, axes=np.eye(3), roll_to_x=False, prefix=skeleton.PREFIX, skip=()):
+IDENTITY_AXES = np.eye(3)
+
+
+def build_rig(name, *, units=1.0, axes=IDENTITY_AXES, roll_to_x=False, prefix=skeleton.PREFIX, skip=()):
     """A Mixamo-named armature from the canonical skeleton, standing where the canonical one stands.
 
     Its armature space is `units` times the canonical and rotated by `axes` (3, 3), and its object

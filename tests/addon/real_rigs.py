@@ -9,16 +9,16 @@ import shutil
 import struct
 from pathlib import Path
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
+
+import addon_helpers as helpers
 import rig_variants
 import test_generate
-from test_rig_variants import _strokes
-
 from rlanimate_addon.blender import armature_io, bake_check
 from rlanimate_addon.core import behaviour_metrics, gesture, skeleton
+from test_rig_variants import _strokes
 
 SHARED_RIGS = helpers.ROOT.parent / "shared" / "rigs"
 
@@ -75,7 +75,9 @@ def require(name):
     """Path of a ../shared/rigs file; skips the test, with a message, when it is absent."""
     path = shared_file(name)
     if path is None:
-        pytest.skip(f"{SHARED_RIGS / FILES[name]} is absent: the real-rig tests read ../shared/rigs (see its README.md)")
+        pytest.skip(
+            f"{SHARED_RIGS / FILES[name]} is absent: the real-rig tests read ../shared/rigs (see its README.md)"
+        )
     return path
 
 
@@ -188,12 +190,13 @@ _EXPORT_NAMES = {"DEF-spine": "pelvis", "DEF-spine.001": "spine_01", "DEF-spine.
                     for f in ("thumb", "index", "middle", "ring", "pinky") for k in (1, 2, 3)}}
 
 
-def rigify_rig(arm_mode="FK", export=False):
-    """A Rigify rig generated from Blender's human metarig (fingers, no face: the face takes most of the
-    generation and adds no bone a gesture keys), both arms in FK (IK_FK 1.0) or left as generated, in IK
-    (0.0), the IK hand controls moved so the arms stand posed; a mesh skinned to its DEF- bones, or with
-    `export` to a game export skeleton in the same armature copying them (Copy Transforms). Returns it."""
-    metarig, rig = rig_variants.generate_rigify()
+def rigify_rig(arm_mode="FK", export=False, fingers=True):
+    """A Rigify rig generated from Blender's human metarig (fingers, or none without `fingers`; no face: the
+    face takes most of the generation and adds no bone a gesture keys), both arms in FK (IK_FK 1.0) or left
+    as generated, in IK (0.0), the IK hand controls moved so the arms stand posed; a mesh skinned to its DEF-
+    bones, or with `export` to a game export skeleton in the same armature copying them (Copy Transforms).
+    Returns it."""
+    metarig, rig = rig_variants.generate_rigify(fingers)
     bpy.data.objects.remove(metarig)
     for side in ("L", "R"):
         rig.pose.bones["upper_arm_parent." + side]["IK_FK"] = 1.0 if arm_mode == "FK" else 0.0
@@ -252,28 +255,51 @@ def _skin(rig, bones):
     return body
 
 
+#: Godot's humanoid profile (SkeletonProfileHumanoid) names of the canonical roles a gesture keys.
+GODOT_NAMES = {"Hips": "Hips", "Spine": "Spine", "Spine1": "Chest", "Spine2": "UpperChest", "Neck": "Neck",
+               "Head": "Head", **{f"{side}{role}": f"{side}{godot}" for side in ("Left", "Right") for role, godot in
+                                  (("Eye", "Eye"), ("Shoulder", "Shoulder"), ("Arm", "UpperArm"),
+                                   ("ForeArm", "LowerArm"), ("Hand", "Hand"))}}
+
+
+def godot_without_fingers():
+    """The sample character with Godot's humanoid bone names (GODOT_NAMES), its fingers removed; returns it."""
+    rig = helpers.activate(helpers.load_sample_rig())
+    bpy.ops.object.mode_set(mode="EDIT")
+    for bone in [b for b in rig.data.edit_bones if skeleton.strip_prefix(b.name).partition("Hand")[2]]:
+        rig.data.edit_bones.remove(bone)  # LeftHandIndex1, RightHandThumb2, ...: not LeftHand
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for bone in rig.data.bones:
+        name = skeleton.strip_prefix(bone.name)
+        bone.name = GODOT_NAMES.get(name, name)
+    return rig
+
+
 # Measurements on the deformed bones.
 
 def deformed_joints(rig, settings, arm):
     """A function frame -> (4, 3) world positions of the wrist, the index finger's base and tip joints
     and the shoulder, as the mesh's bones play them; and the arm's rest length (shoulder to elbow to
     wrist, world units). The index tip is the head of the bone after the last index bone (its end
-    bone), else that bone's own head: joint positions, not imported bone tails."""
+    bone), else that bone's own head: joint positions, not imported bone tails. Without an index finger,
+    the hand's own line: the wrist and the hand's tail."""
     found = roles(rig, settings)
     prefix = skeleton.ARM_PREFIX[arm]
     index = [found[prefix + f"HandIndex{k}"] for k in (1, 2, 3) if prefix + f"HandIndex{k}" in found]
     hand = found[prefix + "Hand"]
+    tip_at = "head_local"
     if index:
         last = rig.data.bones[index[-1]]
         base_bone, tip_bone = index[0], last.children[0].name if last.children else index[-1]
-    else:  # no index finger: the forearm's head through the hand's head (gesture.finger_line_bones)
-        base_bone, tip_bone = found[prefix + "ForeArm"], hand
-    joints = [hand, base_bone, tip_bone, found[prefix + "Arm"]]  # their heads
+    else:  # no index finger: the hand's own line, its head to its tail (gesture.finger_line_bones)
+        base_bone, tip_bone, tip_at = hand, hand, "tail_local"
+    joints = [hand, base_bone, tip_bone, found[prefix + "Arm"]]  # their heads (the tip: a hand's tail)
     deformed = bake_check.deformed_bones(rig)
     carriers = [bake_check.stand_in(rig, bone, deformed) for bone in joints]
     rests = [np.array(rig.data.bones[c].matrix_local) for c in carriers]
-    points = [np.append(np.array(rig.data.bones[b].head_local), 1.0) for b in joints]
-    local = [np.linalg.inv(r) @ p for r, p in zip(rests, points)]
+    points = [np.append(np.array(getattr(rig.data.bones[b], tip_at if k == 2 else "head_local")), 1.0)
+              for k, b in enumerate(joints)]
+    local = [np.linalg.inv(r) @ p for r, p in zip(rests, points, strict=True)]
     world = np.array(rig.matrix_world)
     heads = {r: world @ np.append(np.array(rig.data.bones[found[prefix + r]].head_local), 1.0)
              for r in ("Arm", "ForeArm", "Hand")}
@@ -284,7 +310,7 @@ def deformed_joints(rig, settings, arm):
         bpy.context.scene.frame_set(int(frame))
         evaluated = rig.evaluated_get(bpy.context.evaluated_depsgraph_get())
         poses = [np.array(evaluated.pose.bones[c].matrix) for c in carriers]
-        return np.array([(world @ pose @ p)[:3] for pose, p in zip(poses, local)])
+        return np.array([(world @ pose @ p)[:3] for pose, p in zip(poses, local, strict=True)])
     return at, arm_length
 
 
@@ -303,7 +329,7 @@ def measured_bones_deform(rig, settings, arm):
     """The wrist and the finger base the measures read are bones the mesh deforms with (no stand-in)."""
     found = roles(rig, settings)
     prefix = skeleton.ARM_PREFIX[arm]
-    base = found.get(prefix + "HandIndex1", found[prefix + "ForeArm"])
+    base = found.get(prefix + "HandIndex1", found[prefix + "Hand"])
     return {found[prefix + "Hand"], base} <= bake_check.deformed_bones(rig)
 
 
@@ -338,21 +364,36 @@ def _generate(rig, settings, mute, **values):
 
 def point(rig, settings, arm, target, start, frames=120, exact=True, mute=False):
     """Generate a Point; returns (operator result, miss in degrees of the deformed finger at its hold
-    (median over behaviour_metrics.hold_frames of the finger base, else at the apex), the deformed wrist's
-    greatest travel from its start in arm lengths)."""
+    (`point_miss`), the deformed wrist's greatest travel from its start in arm lengths)."""
     empty = helpers.add_empty(f"Target{start}", tuple(target))
     result = _generate(rig, settings, mute, behaviour="POINT", arm=arm, target=empty, start_frame=start,
                        frame_count=frames, exact_aim=exact)
     if result != {"FINISHED"}:
         return result, np.nan, np.nan
+    miss, travel = point_miss(rig, settings, arm, target, start, frames)
+    return result, miss, travel
+
+
+def point_miss(rig, settings, arm, target, start, frames):
+    """(miss in degrees of the deformed finger (median over its hold, `finger_angles`), the deformed wrist's
+    greatest travel from its start in arm lengths) of a Point as it plays on frames start to start + frames - 1."""
+    angles, (first, last), travel = finger_angles(rig, settings, arm, target, start, frames)
+    return float(np.median(angles[first:last + 1])), travel
+
+
+def finger_angles(rig, settings, arm, target, start, frames):
+    """((F,) degrees between the deformed finger and the target at each frame, (first, last) index of the
+    point's hold (behaviour_metrics.hold_frames of the finger base; the apex alone without a hold), the
+    deformed wrist's greatest travel from its start in arm lengths) of a Point as it plays on frames start to
+    start + frames - 1."""
     joints, arm_length = played_joints(rig, settings, arm, start, frames)
     base, finger = joints[:, 1], joints[:, 2] - joints[:, 1]
     angles = behaviour_metrics.pointing_angles(base, finger, np.asarray(target))
     render = bpy.context.scene.render
     hold = behaviour_metrics.hold_frames(base, _shoulder_width(rig, settings), render.fps / render.fps_base)
-    miss = (np.median(angles[hold[0]:hold[1] + 1]) if hold is not None
-            else angles[int(np.argmax(np.linalg.norm(base - base[0], axis=1)))])
-    return result, float(miss), wrist_travel(joints, arm_length)
+    if hold is None:
+        hold = (int(np.argmax(np.linalg.norm(base - base[0], axis=1))),) * 2
+    return angles, hold, wrist_travel(joints, arm_length)
 
 
 def point_misses(rig, settings, count, exact, seed):
@@ -366,7 +407,7 @@ def point_misses(rig, settings, count, exact, seed):
                                      exact=exact)
         assert result == {"FINISHED"}, result
         measured.append((miss, travel))
-    return tuple(np.array(m) for m in zip(*measured))
+    return tuple(np.array(m) for m in zip(*measured, strict=True))
 
 
 def _shoulder_width(rig, settings):
@@ -379,16 +420,23 @@ def _shoulder_width(rig, settings):
 
 def wave(rig, settings, arm, start, frames=150, exaggeration=0.8, mute=False):
     """Generate a Wave; returns (operator result, strokes of the deformed wrist's side-to-side motion
-    (test_rig_variants._strokes), its greatest travel from its start in arm lengths)."""
+    (`wave_strokes`), its greatest travel from its start in arm lengths)."""
     result = _generate(rig, settings, mute, behaviour="WAVE", arm=arm, exaggeration=exaggeration,
                        start_frame=start, frame_count=frames)
     if result != {"FINISHED"}:
         return result, 0, np.nan
+    strokes, travel = wave_strokes(rig, settings, arm, start, frames)
+    return result, strokes, travel
+
+
+def wave_strokes(rig, settings, arm, start, frames):
+    """(strokes of the deformed wrist's side-to-side motion (test_rig_variants._strokes), its greatest travel
+    from its start in arm lengths) of a Wave as it plays on frames start to start + frames - 1."""
     joints, arm_length = played_joints(rig, settings, arm, start, frames)
     frame, _ = _character_frame(rig, settings)
     to_character = frame @ np.linalg.inv(np.array(rig.matrix_world)[:3, :3])
     lateral = (joints[:, 0] - joints[:, 3]) @ to_character.T[:, 0] / arm_length
-    return result, _strokes(lateral), wrist_travel(joints, arm_length)
+    return _strokes(lateral), wrist_travel(joints, arm_length)
 
 
 def arm_drop(rig, settings, arm, frame):

@@ -7,10 +7,10 @@ to save; `tmp` is a folder for the files an export and re-import go through.
 """
 import math
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 
+import addon_helpers as helpers
 from rlanimate_addon.core import gesture, rig_roles, skeleton
 
 
@@ -189,12 +189,14 @@ def blender_human_metarig(rig, tmp):
     return _blender_metarig()
 
 
-def generate_rigify():
-    """(metarig, generated rig): Rigify's generation of Blender's human metarig without its face."""
+def generate_rigify(fingers=True):
+    """(metarig, generated rig): Rigify's generation of Blender's human metarig without its face, and
+    without its hands' palms and fingers unless `fingers`."""
     metarig = _blender_metarig()
     bpy.ops.object.mode_set(mode="EDIT")
     edit_bones = metarig.data.edit_bones
-    for bone in [edit_bones["face"], *edit_bones["face"].children_recursive]:
+    cut = [edit_bones["face"]] + ([] if fingers else [b for b in edit_bones if b.name.startswith("palm.")])
+    for bone in {b for top in cut for b in (top, *top.children_recursive)}:
         edit_bones.remove(bone)
     bpy.ops.object.mode_set(mode="OBJECT")
     bpy.ops.pose.rigify_generate()

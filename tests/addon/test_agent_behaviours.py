@@ -2,14 +2,14 @@
 ids), a stored choice survives a change of agent, the panel shows Target or Exaggeration by the behaviour's
 kind, and Generate bakes a behaviour the agent declares beyond the shipped agent's (tests/addon/declared_agents.py
 widens the shipped agent by two behaviours with numpy alone, so this runs on Blender 4.2 and 5.0)."""
-import addon_helpers
 import bpy
-import declared_agents
 import numpy as np
 import pytest
-from test_registration import RecordingLayout, _draw
 
+import addon_helpers
+import declared_agents
 from rlanimate_addon.blender import gestures, preferences, properties
+from test_registration import RecordingLayout, _draw
 
 ADDED = [("BECKON", "target"), ("SHRUG", "intensity")]
 
@@ -115,6 +115,6 @@ def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviour
     assert travel > 0.1, f"the hand moves ({travel:.3f} m)"
     assert addon_helpers.generate(rig, settings, behaviour="SHRUG", arm="LEFT", exaggeration=0.9,
                                   start_frame=200, frame_count=80) == {"FINISHED"}
-    raised = gestures.placed_gestures(rig)[0]
+    raised = gestures.placed_gestures(rig)[-1]  # the topmost
     assert (raised.record["behaviour"], raised.record["kind"]) == ("SHRUG", "intensity")
     assert gestures.last_targeted(rig).action == beckon.action, "Follow Target follows the target behaviour"

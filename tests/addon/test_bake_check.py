@@ -2,13 +2,13 @@
 undone, exactly, and refused with the bone and what drives it. The audit's silent misses on the sample
 character (Exact Aim over a muted IK or Copy Rotation, a driver on a keyed channel, a target the gesture
 itself moves) now point on target or are refused."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-from test_generate import _assert_refused, _key_existing_animation, finger_angles
 
+import addon_helpers as helpers
 from rlanimate_addon.core import gesture
+from test_generate import _assert_refused, _key_existing_animation, finger_angles
 
 START, COUNT = 1, 120
 #: The sample's right hand and index finger, as the vertex groups of its mesh name them.

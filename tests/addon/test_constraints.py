@@ -1,9 +1,9 @@
 """Constraints that would override the gesture: refused by name, or muted over the gesture's frames only."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.core import gesture
 from test_generate import _assert_refused, _fcurves, _key_existing_animation, _state
 
@@ -22,8 +22,11 @@ def _ik_rig():
 def test_a_constraint_overriding_the_arm_is_refused_by_name_and_changes_nothing(settings):
     rig, forearm, _ = _ik_rig()
     settings.behaviour, settings.start_frame, settings.frame_count = "WAVE", START, COUNT
-    _assert_refused(rig, rf"Constraint 'IK' \(Inverse Kinematics, target IK Target\) on {forearm.name} overrides the rotations the "
-                         rf"gesture keys, so the bake would not play\. Click 'Generate, Muting Constraints'")
+    _assert_refused(
+        rig,
+        rf"Constraint 'IK' \(Inverse Kinematics, target IK Target\) on {forearm.name} overrides the rotations the "
+        rf"gesture keys, so the bake would not play\. Click 'Generate, Muting Constraints'",
+    )
 
 
 def test_muting_keeps_the_constraint_outside_the_gesture_and_lets_the_gesture_play_inside(settings):
@@ -108,9 +111,12 @@ def test_generate_again_over_a_muted_constraint_fades_it_once_as_the_first_click
     for frame in ramp[:3]:
         bpy.context.scene.frame_set(int(frame))
         assert ik.influence == pytest.approx(expected[frame - START], abs=1e-6)
-    # A replacing gesture at other frames gives back the old frames' influence and fades its own.
+    # The gesture selected in the panel's list, baked again at other frames, gives back the old frames' influence
+    # and fades its own.
+    assert bpy.ops.rlanimate.select_gesture(gesture="RLAnimate Wave Right") == {"FINISHED"}
     settings.start_frame = START + 10
     assert bpy.ops.rlanimate.generate_gesture(mute_constraints=True) == {"FINISHED"}
+    assert len([a for a in bpy.data.actions if a.name.startswith("RLAnimate Wave Right")]) == 2, "main and torso"
     for frame, value in ((START + 2, 0.7), (START + 10 + COUNT // 2, 0.0), (START + 10 + COUNT - 1, 0.7)):
         bpy.context.scene.frame_set(frame)
         assert ik.influence == pytest.approx(value, abs=1e-6)

@@ -1,11 +1,11 @@
 """Export FBX: Blender's exporter writes the rig, its mesh and the baked gesture, and they read back."""
 import os
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import export
 from rlanimate_addon.core import skeleton
 
@@ -57,17 +57,29 @@ def test_fbx_round_trip_reproduces_every_joint_within_a_millimetre(settings, tmp
     assert error.max() < 1e-3, f"{error.max() * 1e3:.2f} mm on frame {frames[error.max(axis=1).argmax()]}"
 
 
-def test_a_take_that_starts_after_frame_1_says_where_the_importer_puts_it(settings, tmp_path):
+@pytest.mark.parametrize("scene_start, gesture_start", [(1, -20), (50, 60)], ids=["gesture_from_-20", "scene_from_50"])
+def test_every_keyed_frame_plays_at_its_own_time_whatever_the_scenes_start(settings, tmp_path, scene_start,
+                                                                          gesture_start):
+    """A gesture from frame -20 (frames -20..0 were lost and the rest played a frame late) and a scene starting
+    at frame 50 (its take played 49 frames early) come back on their own frames with the importer's defaults."""
     rig = helpers.load_sample_rig()
-    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=30, frame_count=50) == \
-        {"FINISHED"}
+    assert helpers.generate(rig, settings, behaviour="WAVE", arm="LEFT", start_frame=gesture_start,
+                            frame_count=50) == {"FINISHED"}
     scene = bpy.context.scene
-    scene.frame_start, scene.frame_end = 30, 79
-    summary = export.export_rig(bpy.context, str(tmp_path / "late.fbx"))
-    assert summary.endswith("; its take starts at time 0 on frame 30, which Blender's FBX importer places on frame 1 "
-                            "(Animation Offset 1; give 30 to keep the frames)")
-    copy = next(o for o in _imported(tmp_path / "late.fbx") if o.type == "ARMATURE")
-    assert tuple(copy.animation_data.action.frame_range) == (1.0, 50.0)
+    scene.frame_start, scene.frame_end = scene_start, scene_start + 60
+    scene.frame_set(7)
+    summary = export.export_rig(bpy.context, str(tmp_path / "take.fbx"))
+    first = min(scene_start, gesture_start)
+    assert f"frames {first}-{scene_start + 60} each at its own time" in summary
+    assert (scene.frame_start, scene.frame_current) == (scene_start, 7), "the scene's range and frame are kept"
+    copy = next(o for o in _imported(tmp_path / "take.fbx") if o.type == "ARMATURE")
+    assert tuple(copy.animation_data.action.frame_range) == (first, scene_start + 60)
+    frames = np.arange(gesture_start, gesture_start + 50)
+    names = [skeleton.PREFIX + b.name for b in skeleton.BONES]
+    baked, read_back = helpers.bone_heads(rig, names, frames), helpers.bone_heads(copy, names, frames)
+    assert np.ptp(baked[:, :, 2], axis=0).max() > 0.1, "the wave should move the hand"
+    error = np.linalg.norm(read_back - baked, axis=2)
+    assert error.max() < 1e-3, f"{error.max() * 1e3:.2f} mm on frame {frames[error.max(axis=1).argmax()]}"
 
 
 def test_export_refuses_without_an_armature(settings, tmp_path):

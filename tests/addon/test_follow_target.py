@@ -55,7 +55,7 @@ def test_moving_the_target_re_bakes_the_point_at_the_new_position(settings):
 
 def test_a_gesture_edited_by_hand_is_never_re_baked(settings):
     rig, target = _point(settings)
-    assert not gestures.edited_by_hand(gestures.last_targeted(rig)), "the keys as written hash as read back"
+    assert not gestures.edited(gestures.last_targeted(rig)), "the keys as written read back as written"
     action = rig.animation_data.action
     fcurve = action_adapter.all_fcurves(action)[0]
     fcurve.keyframe_points[10].co.y += 0.1  # the animator's own edit
@@ -65,7 +65,12 @@ def test_a_gesture_edited_by_hand_is_never_re_baked(settings):
     assert "edited by hand" in follow_target.note(rig)
     to_old, _ = _apex_angles(rig)
     assert to_old <= MAX_APEX_ANGLE_DEG, "the edited gesture still points where it did"
-    assert helpers.generate(rig, settings) == {"FINISHED"}
+    bone = fcurve.data_path.split('"')[1]
+    with pytest.raises(RuntimeError, match=rf"The keys of 'RLAnimate Point Right' were edited by hand on {bone} "
+                                           r"\(frame 11\).*'Replace Edited Keys'"):
+        helpers.generate(rig, settings)
+    assert fcurve.keyframe_points[10].co.y == edited, "Generate refuses to overwrite the edit"
+    assert helpers.generate(rig, settings, replace_edited_keys=True) == {"FINISHED"}
     assert follow_target.note(rig) == "", "Generate again follows again"
 
 
@@ -84,11 +89,11 @@ def test_moving_a_handle_of_editable_keys_is_an_edit(settings):
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, editable_keys=True) \
         == {"FINISHED"}
     gesture = gestures.last_targeted(rig)
-    assert not gestures.edited_by_hand(gesture)
+    assert not gestures.edited(gesture)
     point = next(p for f in action_adapter.all_fcurves(gesture.action) for p in f.keyframe_points
                  if p.interpolation == "BEZIER")
     point.handle_right.y += 0.05
-    assert gestures.edited_by_hand(gesture)
+    assert gestures.edited(gesture)
 
 
 def test_a_re_bake_records_its_settings_and_follows_again(settings):
@@ -96,7 +101,9 @@ def test_a_re_bake_records_its_settings_and_follows_again(settings):
     _move(target, NEW)
     record = gestures.last_targeted(rig).record
     assert record["note"] == "" and record["settings"]["target"] == target
-    assert np.allclose(np.reshape(record["aimed_at"], (-1, 3))[0], np.array(rig.matrix_world.inverted() @ target.location))
+    assert np.allclose(
+        np.reshape(record["aimed_at"], (-1, 3))[0], np.array(rig.matrix_world.inverted() @ target.location)
+    )
     _move(target, OLD)
     to_old, to_new = _apex_angles(rig)
     assert to_old <= MAX_APEX_ANGLE_DEG < to_new, "a second move is followed too"

@@ -2,16 +2,15 @@
 a bone of another armature as target, and a bone-map file saved, edited and loaded."""
 import json
 
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-from test_generate import finger_angles, random_target
-from test_rig_variants import _pose_snapshot
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import generate
 from rlanimate_addon.core import key_reduction, rig_roles, skeleton
-from rlanimate_addon.core.rotations import quat_to_matrix
+from test_generate import finger_angles, random_target
+from test_rig_variants import _pose_snapshot
 
 
 def _rotations(rig, bones, frames):
@@ -59,8 +58,9 @@ def test_replace_and_combine_layers_point_on_target_over_the_animation(settings,
     target = helpers.add_empty("Target", location)
     assert helpers.generate(rig, settings, behaviour="POINT", arm="RIGHT", target=target, start_frame=40,
                             frame_count=120, blend_type=blend_type) == {"FINISHED"}
-    strip = rig.animation_data.nla_tracks[-1].strips[0]
+    strip = rig.animation_data.nla_tracks["RLAnimate Point Right"].strips[0]
     assert strip.blend_type == blend_type
+    assert rig.animation_data.nla_tracks["RLAnimate Point Right (torso)"].strips[0].blend_type == "COMBINE"
     angles, bases = finger_angles(rig, "RIGHT", location, np.arange(40, 160))
     apex = int(np.argmax(np.linalg.norm(bases - bases[0], axis=1)))
     print(f"{blend_type}: apex miss {angles[apex]:.3f} deg")

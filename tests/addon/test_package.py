@@ -76,6 +76,7 @@ def test_built_zip_installs_and_enables_in_a_fresh_session(tmp_path):
     report = json.loads(result.stdout.strip().splitlines()[-1])
     assert report["result"] == ["FINISHED"]
     assert report["enabled"] and report["preferences"] and report["scene_settings"]
-    assert report["operators"] == ["bone_map_from_vrm", "export_fbx", "generate_gesture", "save_bone_map"]
+    assert report["operators"] == ["bone_map_from_vrm", "delete_gesture", "export_fbx", "extend_scene_end",
+                                   "generate_gesture", "save_bone_map", "select_gesture"]
     assert Path(report["module_file"]).is_relative_to(user), "the add-on must run from the installed copy"
     assert list((user / "extensions").rglob("site-packages/threadpoolctl.py")), "the bundled wheel must be installed"

@@ -3,7 +3,6 @@ import math
 
 import bpy
 import numpy as np
-import pytest
 
 import addon_helpers as helpers
 from rlanimate_addon.blender import pose_underneath

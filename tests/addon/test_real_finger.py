@@ -3,13 +3,13 @@ an imported bone's tail. Measured from joint positions on the bones the mesh def
 made by others (../shared/rigs: a UE4-named glTF, a Mixamo-like Kenney glTF), on the sample character,
 and on the sample with its finger bones' tails turned 90 degrees off the finger, as many importers
 leave them."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import real_rigs
 from mathutils import Vector
 
+import addon_helpers as helpers
+import real_rigs
 
 EXACT_MEDIAN, EXACT_WORST, OWN_MEDIAN, OWN_WORST = 1.0, 3.0, 5.0, 12.0
 
@@ -45,7 +45,9 @@ def _load(kind, tmp_path):
 @pytest.mark.parametrize("kind", ["UE4 glTF", "Kenney glTF", "sample", "sample, tails turned"])
 def test_exact_aim_hits_through_the_finger_joints(settings, tmp_path, kind):
     rig = _load(kind, tmp_path)
-    assert real_rigs.measured_bones_deform(rig, settings, "RIGHT") and real_rigs.measured_bones_deform(rig, settings, "LEFT")
+    assert real_rigs.measured_bones_deform(rig, settings, "RIGHT") and real_rigs.measured_bones_deform(
+        rig, settings, "LEFT"
+    )
     own, _ = real_rigs.point_misses(rig, settings, 4, False, 7)
     exact, travel = real_rigs.point_misses(rig, settings, 4, True, 7)
     print(f"{kind}: exact {np.round(exact, 2)}, own {np.round(own, 1)} deg, travel {np.round(travel, 2)}")

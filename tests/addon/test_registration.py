@@ -5,11 +5,11 @@ import types
 import zipfile
 from unittest import mock
 
-import addon_helpers
 import bpy
 import numpy as np
 import pytest
 
+import addon_helpers
 import rlanimate_addon
 from rlanimate_addon.blender import panel, registration
 from rlanimate_addon.blender import properties as blender_properties

@@ -1,14 +1,14 @@
 """Generate Gesture on rig variants built from the sample character (tests/addon/rig_variants.py): accepted,
 pointing on target with exact aim, waves with their strokes, and nothing it does not own changed."""
-import addon_helpers as helpers
 import bpy
 import numpy as np
 import pytest
-import rig_variants
-from test_generate import random_target
 
-from rlanimate_addon.blender import action_adapter
+import addon_helpers as helpers
+import rig_variants
+from rlanimate_addon.blender import action_adapter, gestures
 from rlanimate_addon.core import behaviour_metrics, gesture, rig_roles
+from test_generate import random_target
 
 RNG = np.random.default_rng(11)
 POINT_STARTS = (20, 220, 420)
@@ -30,14 +30,14 @@ def _world(rig, point):
 
 
 def finger_angle(rig, arm, target, frames):
-    """(F,) degrees between the rig's finger line (gesture.finger_line_bones: joint heads) and its base-to-target line,
-    and (F, 3) world positions of the finger base."""
-    start, end = gesture.finger_line_bones(_roles(rig), arm)
+    """(F,) degrees between the rig's finger line (gesture.finger_line_bones: joint heads, or a hand's tail) and
+    its base-to-target line, and (F, 3) world positions of the finger base."""
+    line = gesture.finger_line_bones(_roles(rig), arm)
     angles, bases = [], []
     for frame in frames:
         bpy.context.scene.frame_set(int(frame))
-        base = _world(rig, rig.pose.bones[start].head)[:3]
-        tip = _world(rig, rig.pose.bones[end].head)[:3]
+        base = _world(rig, rig.pose.bones[line.start].head)[:3]
+        tip = _world(rig, getattr(rig.pose.bones[line.end], "tail" if line.to_tail else "head"))[:3]
         finger, to_target = tip - base, np.asarray(target) - base
         cos = finger @ to_target / np.linalg.norm(finger) / np.linalg.norm(to_target)
         angles.append(np.degrees(np.arccos(np.clip(cos, -1.0, 1.0))))
@@ -102,9 +102,13 @@ def _pose_snapshot(rig, frames):
     return {k: np.array(v) for k, v in out.items()}
 
 
-def _gesture_bones(action, rig):
-    target = action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None)
-    return {f.data_path.split('"')[1] for f in target.fcurves()}
+def _gesture_bones(actions, rig):
+    """The bones an action, or a list of actions, keys."""
+    bones = set()
+    for action in actions if isinstance(actions, list) else [actions]:
+        target = action_adapter.ActionTarget(action, action.slots[0] if action_adapter.LAYERED else None)
+        bones |= {f.data_path.split('"')[1] for f in target.fcurves()}
+    return bones
 
 
 def _all_keys():
@@ -141,7 +145,9 @@ def test_point_with_exact_aim_hits_and_changes_nothing_it_does_not_own(settings,
 
 
 def _newest_gesture():
-    return max((a for a in bpy.data.actions if a.name.startswith("RLAnimate")), key=lambda a: a.session_uid)
+    """The actions of the gesture made last: its main action and its torso action."""
+    main = max((a for a in bpy.data.actions if gestures.RECORD in a), key=lambda a: a.session_uid)
+    return [main] + [a for a in bpy.data.actions if a.get(gestures.TORSO_OF) == main[gestures.RECORD]["id"]]
 
 
 def _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=120):
@@ -154,7 +160,9 @@ def _assert_unowned_unchanged(rig, before, keys_before, frames, owned, length=12
         for owner, start in owned:
             if owner == bone:
                 inside |= still | ((frames >= start) & (frames < start + length))
-        assert np.allclose(after[bone][~inside], matrices[~inside], atol=1e-5), f"{bone} changed where the gesture does not drive it"
+        assert np.allclose(after[bone][~inside], matrices[~inside], atol=1e-5), (
+            f"{bone} changed where the gesture does not drive it"
+        )
     keys_after = _all_keys()
     assert {k: v for k, v in keys_after.items() if k in keys_before} == keys_before, "existing keys changed"
 
@@ -165,7 +173,9 @@ def _lateral_wrist(rig, frames):
     roles = _roles(rig)
     heads = {r: np.array(rig.data.bones[b].head_local) for r, b in roles.items()}
     frame = gesture.character_frame(heads)
-    size = np.linalg.norm(heads["RightForeArm"] - heads["RightArm"]) + np.linalg.norm(heads["RightHand"] - heads["RightForeArm"])
+    size = np.linalg.norm(heads["RightForeArm"] - heads["RightArm"]) + np.linalg.norm(
+        heads["RightHand"] - heads["RightForeArm"]
+    )
     out = []
     for f in frames:
         bpy.context.scene.frame_set(int(f))

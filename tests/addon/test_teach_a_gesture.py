@@ -9,16 +9,16 @@ import shutil
 
 import pytest
 
-pytest.importorskip("torch", reason="trains an agent: needs the trainer's torch (Blender 4.2's environment has none)")
+pytest.importorskip("torch", reason="trains an agent: needs the trainer's torch (the LTS environments have none)")
 
-import addon_helpers  # noqa: E402
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
-import real_rigs  # noqa: E402
-from test_registration import _draw  # noqa: E402
 
+import addon_helpers  # noqa: E402
+import real_rigs  # noqa: E402
 from rlanimate_addon.blender import gestures, properties  # noqa: E402
 from rlanimate_addon.core import agent_file, skeleton  # noqa: E402
+from test_registration import _draw  # noqa: E402
 from trainer.blender_io import rig_session  # noqa: E402
 from trainer.blender_io.clip_bake import bake_clip, export_fbx  # noqa: E402
 from trainer.motion.synthesis import FPS, GestureSpec, synthesise  # noqa: E402
@@ -87,8 +87,25 @@ def test_a_new_gesture_from_fbx_clips_trains_and_bakes_from_the_panel(tmp_path, 
     clips, run = tmp_path / "clips", tmp_path / "run"
     clips.mkdir()
     write_gesture_library(clips)
-    assert train.main(["trainer/train.py", "--clips", str(clips), "--output", str(run), "--preset", "debug",
-                       "--epochs", "2", "--eval-every", "0", "--quiet"]) == 0
+    assert (
+        train.main(
+            [
+                "trainer/train.py",
+                "--clips",
+                str(clips),
+                "--output",
+                str(run),
+                "--preset",
+                "debug",
+                "--epochs",
+                "2",
+                "--eval-every",
+                "0",
+                "--quiet",
+            ]
+        )
+        == 0
+    )
     weights, metadata = agent_file.load_agent_file(run / "agent.npz")
     assert metadata["behaviours"] == [{"name": "POINT", "kind": "target"}, {"name": "WAVE", "kind": "intensity"},
                                       {"name": "HELLO", "kind": "intensity"}]

@@ -1,10 +1,11 @@
 """Rigs and settings Generate cannot serve well: a zero-scale armature or bone is refused naming it and the fix,
-a bone-map file that is not one is refused before it is read whole, and a gesture far below the agent's
-supported length is baked with a warning. A refusal changes nothing."""
-import addon_helpers as helpers
+a bone-map file that is not one is refused before it is read whole, an armature in Edit mode is refused naming
+the fix, and a gesture far below the agent's supported length is baked with a warning. A refusal changes
+nothing."""
 import bpy
 import pytest
 
+import addon_helpers as helpers
 from rlanimate_addon.blender import generate, preferences
 from rlanimate_addon.core import gesture
 
@@ -51,6 +52,10 @@ def test_a_bone_map_file_far_larger_than_a_bone_map_is_refused_unread(settings, 
         source.write_text('{"family": "x", "bones": {}}' + " " * (2 << 20))
     settings.behaviour, settings.bone_map_file = "WAVE", str(source)  # /dev/zero: a MemoryError after 4.9 GB
     helpers.activate(rig)
+    if source == "/dev/zero":  # not a regular file: refused before a byte is read
+        _assert_refused(rig, r"Cannot read the bone-map file '/dev/zero' \(it is a character device, not a regular "
+                             r"file\): pick a bone-map JSON file saved from the panel, or clear the Bone Map field")
+        return
     _assert_refused(rig, rf"The bone-map file '{source}' is larger than 1024 KB, so it is not a bone map: pick a "
                          "bone-map JSON file saved from the panel, or clear the Bone Map field")
 
@@ -66,3 +71,18 @@ def test_a_gesture_far_below_the_supported_length_is_baked_with_a_warning(settin
             f"Frames to {shortest} or more)") in summary
     settings.frame_count, settings.start_frame = shortest, 10
     assert "warning" not in generate.generate(bpy.context, settings)
+
+
+def test_an_armature_in_edit_mode_is_refused_naming_the_fix_and_stays_in_edit_mode(settings):
+    """Generate in Edit mode failed the bake check with bone-map advice (the pose does not play there): it is
+    refused before anything is written, naming the fix."""
+    rig = helpers.activate(helpers.load_sample_rig())
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj is rig)
+    settings.behaviour, settings.arm = "WAVE", "LEFT"
+    bpy.ops.object.mode_set(mode="EDIT")
+    _assert_refused(rig, r"^Error: Armature 'RLAnimate_Character' is in Edit mode, where its pose does not play: leave "
+                         r"Edit mode \(Tab, or choose Pose Mode\) and generate again.")
+    assert rig.mode == "EDIT" and bpy.context.mode == "EDIT_ARMATURE"
+    bpy.ops.object.mode_set(mode="POSE")
+    assert bpy.ops.rlanimate.generate_gesture() == {"FINISHED"} and rig.animation_data.action is not None

@@ -13,7 +13,9 @@ Kinds:
     npy_header                        an npy header rewritten (shapes of 2**40 and more, other dtypes,
                                       characters changed, added or removed) in a valid zip
     metadata_value                    one metadata value the add-on reads replaced (1e300, inf, NaN,
-                                      1e12, strings, lists, huge integers...) or removed, in a valid zip
+                                      1e12, strings, lists, huge integers, arms...) or removed, in a valid
+                                      zip: the config, bounds, lengths, behaviours and every wave_rhythm
+                                      field (its arms, phases and flags added where the file has none)
     metadata_text                     characters of the metadata JSON changed, in a valid zip
     deflate_bomb                      an entry replaced by megabytes of deflated zeros behind a valid header
     compressed_raw                    bytes of an entry's deflated data changed (the archive deflated first)
@@ -32,10 +34,10 @@ import io
 import json
 import struct
 import zipfile
-import zlib
 
 import numpy as np
 
+import fuzz_json
 from rlanimate_addon.core import agent_file, gesture, runtime
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -47,14 +49,19 @@ KINDS = ("zip_local", "zip_central", "zip_end", "npy_raw", "metadata_raw", "npy_
 ACCEPTED = ("refused", "identical", "valid other file")
 _EDGE_FIELDS = (0, 1, 0x7FFF, 0xFFFF, 0x7FFFFFFF, 0x80000000, 0xFFFFFFFF)
 _EDGE_VALUES = (1e300, -1e300, float("inf"), float("-inf"), float("nan"), 1e12, 1e8, 0, -3, 1, 2.5, True, None,
-                "abc", "", [], {}, [1.0, 2.0], {"POINT": 1e300}, 10 ** 400, [[0.0, 1.0]] * 45, [[[[[]]]]])
+                "abc", "", [], {}, [1.0, 2.0], {"POINT": 1e300}, 10 ** 400, [[0.0, 1.0]] * 45, [[[[[]]]]],
+                ["LEFT", "RIGHT"], [["LEFT"]], "LEFT", {"name": "point", "kind": "target"})
 _METADATA_PATHS = (("action_bounds", 0, 0), ("action_bounds", 44, 1), ("action_bounds", 7), ("action_bounds",),
                    ("average_frames", "POINT"), ("average_frames", "WAVE"), ("average_frames",),
                    ("agent_config", "hidden_layers"), ("agent_config", "hidden_size"),
                    ("agent_config", "task_size"), ("agent_config", "stochastic_size"), ("agent_config", "min_std"),
                    ("agent_config", "concentration_scale"), ("agent_config",), ("variant",), ("format_version",),
                    ("format",), ("wave_rhythm", "examples", 0, 1), ("wave_rhythm", "examples", 1, 0),
-                   ("wave_rhythm", "phase"), ("wave_rhythm", "ramp"), ("wave_rhythm", "bandwidth"), ("wave_rhythm",))
+                   ("wave_rhythm", "phase"), ("wave_rhythm", "ramp"), ("wave_rhythm", "bandwidth"), ("wave_rhythm",),
+                   ("wave_rhythm", "examples", 0), ("wave_rhythm", "examples"), ("wave_rhythm", "phases"),
+                   ("wave_rhythm", "arms"), ("wave_rhythm", "typical_tempo"), ("wave_rhythm", "by_arm"),
+                   ("wave_rhythm", "tempo_bandwidth"), ("behaviours",), ("behaviours", 0), ("behaviours", 1, "kind"),
+                   ("behaviours", 0, "name"))
 _SHAPES = ("(1099511627776,)", "(1048576, 1048576)", "(-1, 64)", "(10000000000000000000000000000,)", "(0,)",
            "()", "(64,)", "(192, 64)", "(8796093022208, 8)")
 _DESCRS = ("'<f8'", "'|O'", "'<U2000000000000'", "'>f4'", "'|V0'", "'<i4'", "[('a', '<f4')]", "'garbage'",
@@ -274,15 +281,8 @@ def _metadata_entry(text):
 
 
 def _metadata_value(layout, rng):
-    metadata = json.loads(_metadata_text(layout))
-    path = _pick(_METADATA_PATHS, rng)
-    parent = metadata
-    for key in path[:-1]:
-        parent = parent[key]
-    if rng.random() < 0.15:
-        del parent[path[-1]]
-    else:
-        parent[path[-1]] = _pick(_EDGE_VALUES, rng)
+    metadata = fuzz_json.set_or_remove(json.loads(_metadata_text(layout)), _pick(_METADATA_PATHS, rng), rng,
+                                       _EDGE_VALUES)
     text = json.dumps(metadata)  # inf and NaN as JSON's Infinity and NaN, as Python writes them
     return _rezip(layout, {agent_file.METADATA_KEY + ".npy": _metadata_entry(text)}, rng)
 

@@ -116,8 +116,15 @@ def test_a_version_2_file_with_a_line_for_its_wave_rhythm_is_refused_with_the_fi
 
 def test_a_broken_wave_rhythm_is_refused(tmp_path, exported):
     weights, metadata = load_agent_file(exported)
-    with pytest.raises(RLAnimateError, match="wave_rhythm metadata is invalid"):
-        load_agent_file(rewrite(tmp_path / "rhythm.npz", weights, {**metadata, "wave_rhythm": {"examples": []}}))
+    path = tmp_path / "rhythm.npz"
+    with pytest.raises(RLAnimateError, match=f"{path} has an invalid wave_rhythm .wave_rhythm lacks phase, ramp"):
+        load_agent_file(rewrite(path, weights, {**metadata, "wave_rhythm": {"examples": []}}))
+    for broken, field in (("fast", "wave_rhythm is a string"), ([1.0], "wave_rhythm is a list"),
+                          (2.5, "wave_rhythm is a number"),
+                          ({"examples": [[0.5, 0.03, 0.1, 0.9]] * 2, "phase": 0.0, "ramp": 9.0, "bandwidth": 0.1,
+                            "arms": [["LEFT"]] * 2}, r"wave_rhythm\.arms must be")):
+        with pytest.raises(RLAnimateError, match=f"{path} has an invalid wave_rhythm .{field}"):
+            load_agent_file(rewrite(path, weights, {**metadata, "wave_rhythm": broken}))
 
 
 def test_wrong_array_shape(tmp_path, exported):
@@ -216,7 +223,7 @@ def test_damaged_metadata_text(tmp_path, exported):
     ("average_frames", {}, "average_frames"),
     ("average_frames", {"POINT": 90, "JUMP": 50}, "average_frames"),
     ("average_frames", {"POINT": 1}, "average_frames"),
-    ("variant", "bigger", "Unknown agent variant"),
+    ("variant", "bigger", "unknown agent variant .bigger."),
     ("still_free_arm", "WAVE", "still_free_arm"),
     ("still_free_arm", ["JUMP"], "still_free_arm"),
     ("still_free_arm", [["WAVE"]], "still_free_arm"),

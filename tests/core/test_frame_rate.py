@@ -8,7 +8,9 @@ from rlanimate_addon.core import frame_rate
 def test_agent_frames_span_the_same_seconds_and_come_back(fps):
     for count in (3, 46, 93, 116, 120, 174):
         span = frame_rate.agent_frames(count, fps)
-        assert abs((span - 1) / frame_rate.AGENT_FPS - frame_rate.seconds(count, fps)) <= 0.5 / frame_rate.AGENT_FPS + 1e-9
+        assert (
+            abs((span - 1) / frame_rate.AGENT_FPS - frame_rate.seconds(count, fps)) <= 0.5 / frame_rate.AGENT_FPS + 1e-9
+        )
         assert abs(frame_rate.scene_frames(span, fps) - count) <= max(1, round(fps / frame_rate.AGENT_FPS))
 
 

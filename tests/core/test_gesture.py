@@ -4,8 +4,13 @@ import pytest
 
 from rlanimate_addon.core import aim, gesture, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
-from rlanimate_addon.core.rotations import (matrix_to_quat, quat_to_matrix, rotvec_to_matrix,
-                                            rotvec_to_quat)
+from rlanimate_addon.core.rotations import (
+    matrix_to_quat,
+    quat_multiply,
+    quat_to_matrix,
+    rotvec_to_matrix,
+    rotvec_to_quat,
+)
 
 RNG = np.random.default_rng(11)
 
@@ -166,9 +171,10 @@ def test_pointing_adds_the_hand_shape_and_the_gesture_blends_from_and_to_the_pos
     rig = _animated(gesture.canonical_rig(), 50)
     targets = np.tile([-1.0, -2.0, 1.6], (50, 1))
     names, quats, under = gesture.gesture_rotations(agent, _request("POINT", frames=50, targets=targets), rig)
-    assert names[:15] == skeleton.ACTION_JOINTS
-    assert {"RightHandMiddle2", "RightHandPinky1", "RightHandThumb1"} <= set(names[15:])
-    assert not any(n.startswith("Left") for n in names[15:-2]) and names[-2:] == ("LeftEye", "RightEye")
+    owned = gesture.owned_joints("RIGHT", still=False)
+    assert names[:len(owned)] == owned and not any(n.startswith("Left") for n in owned), "the other arm is not keyed"
+    assert {"RightHandMiddle2", "RightHandPinky1", "RightHandThumb1"} <= set(names[len(owned):])
+    assert not any(n.startswith("Left") for n in names[len(owned):-2]) and names[-2:] == ("LeftEye", "RightEye")
     columns = [skeleton.BONE_NAMES.index(n) for n in names]
     expected = matrix_to_quat(rig.under[:, columns, :3, :3])
     assert np.allclose(np.abs(np.sum(under * expected, axis=-1)), 1.0)
@@ -228,14 +234,15 @@ def test_exact_aim_puts_the_target_on_the_rig_finger_line_over_animation_underne
     agent = ReplayAgent(RNG.uniform(0.3, 0.7, size=(frames, spaces.ACTION_SIZE)))
     rig = _animated(gesture.canonical_rig(), frames, scale=0.1)
     target = np.array([-1.0 if arm == "RIGHT" else 1.0, -2.5, 1.7])
-    names, quats, _ = gesture.gesture_rotations(agent, _request("POINT", arm, frames, targets=np.tile(target, (frames, 1))), rig)
+    names, quats, _ = gesture.gesture_rotations(
+        agent, _request("POINT", arm, frames, targets=np.tile(target, (frames, 1))), rig
+    )
     basis = rig.under.copy()
     columns = [rig.skeleton.index[n] for n in names]
     basis[:, columns, :3, :3] = quat_to_matrix(quats)
-    start, end = gesture.finger_line_bones(rig.roles, arm)
-    pose = rig.skeleton.pose_matrices(basis, only=(end,))
-    base = pose[:, rig.skeleton.index[start], :3, 3]
-    finger, to_target = pose[:, rig.skeleton.index[end], :3, 3] - base, target - base
+    line = gesture.finger_line_bones(rig.roles, arm)
+    base, tip = line.points(rig.skeleton, rig.skeleton.pose_matrices(basis, only=(line.end,)))
+    finger, to_target = tip - base, target - base
     cos = np.sum(finger * to_target, axis=1) / np.linalg.norm(finger, axis=1) / np.linalg.norm(to_target, axis=1)
     angles = np.degrees(np.arccos(np.clip(cos, -1, 1)))
     phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), arm))
@@ -253,7 +260,9 @@ def test_the_eyes_look_at_the_target_while_pointing(animated):
     basis = rig.under_at(frames).copy()
     basis[:, [rig.skeleton.index[n] for n in names], :3, :3] = quat_to_matrix(quats)
     pose = rig.skeleton.pose_matrices(basis, only=("LeftEye", "RightEye"))
-    phase = aim.pointing_phase(gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT"))
+    phase = aim.pointing_phase(
+        gesture.played_finger_base(gesture.run_agent(agent, "POINT", agent.calls[-1][0]), "RIGHT")
+    )
     for eye in ("LeftEye", "RightEye"):
         i = rig.skeleton.index[eye]
         looking = pose[:, i, :3, :3] @ (skeleton.rest_frame(skeleton.BONE_BY_NAME[eye]).T @ [0.0, -1.0, 0.0])
@@ -275,8 +284,8 @@ def test_a_missing_spine_or_collar_bone_is_folded_and_the_bone_above_turns_the_s
     assert missing not in kept and len(kept) == len(joints) - 1
     from rlanimate_addon.core import kinematics
 
-    full = kinematics.pose_matrices(dict(zip(joints, np.moveaxis(rotvecs, 1, 0))))
-    merged = kinematics.pose_matrices(dict(zip(kept, np.moveaxis(folded, 1, 0))))
+    full = kinematics.pose_matrices(dict(zip(joints, np.moveaxis(rotvecs, 1, 0), strict=True)))
+    merged = kinematics.pose_matrices(dict(zip(kept, np.moveaxis(folded, 1, 0), strict=True)))
     bone = kinematics.bone_index(above)
     assert np.allclose(full[:, bone, :3, :3], merged[:, bone, :3, :3], atol=1e-9)
 
@@ -286,7 +295,7 @@ def test_pointing_hand_curls_the_other_fingers_towards_the_palm():
 
     for arm in skeleton.ARMS:
         names, rotvecs = gesture.pointing_hand_rotations(arm, 1)
-        pose = kinematics.head_positions(kinematics.pose_matrices(dict(zip(names, rotvecs[0]))))
+        pose = kinematics.head_positions(kinematics.pose_matrices(dict(zip(names, rotvecs[0], strict=True))))
         rest = kinematics.head_positions(kinematics.pose_matrices({}))
         prefix = skeleton.ARM_PREFIX[arm]
         for finger in ("Middle", "Ring", "Pinky"):
@@ -397,48 +406,87 @@ def test_a_nan_start_pose_is_refused_before_anything_is_returned():
 
 def test_the_finger_line_runs_through_joints_index_base_to_its_farthest_joint():
     roles = {f"RightHandIndex{k}": f"i{k}" for k in (1, 2, 3)} | {"RightHand": "hand", "RightForeArm": "forearm"}
-    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3")
-    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip")
-    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1")
-    assert gesture.finger_line_bones({"RightHand": "hand", "RightForeArm": "forearm"}, "RIGHT") == ("forearm", "hand")
+    assert gesture.finger_line_bones(roles, "RIGHT") == ("i1", "i3", False)
+    assert gesture.finger_line_bones(roles | {"RightHandIndex4": "tip"}, "RIGHT") == ("i1", "tip", False)
+    assert gesture.finger_line_bones({"RightHandIndex1": "i1", "RightHand": "hand"}, "RIGHT") == ("hand", "i1", False)
+    # Without an index finger, the hand's own line: its head (the wrist) to its tail (the hand's end).
+    fingerless = {"RightHand": "hand", "RightForeArm": "forearm"}
+    assert gesture.finger_line_bones(fingerless, "RIGHT") == ("hand", "hand", True)
 
 
-def test_a_rig_whose_pose_underneath_stands_still_reads_as_still_and_one_that_moves_does_not():
-    rig = gesture.canonical_rig()
-    count = 5
-    under = np.broadcast_to(rig.under, (count,) + rig.under.shape).copy()
-    values = {"RightArm": np.tile([1.0, 0.0, 0.0, 0.0], (count, 1))}
-    animated = gesture.RigState("Rig", rig.skeleton, rig.roles, rig.family, under, True)
-    still, still_values = animated.standing_still(values)
-    assert not still.animated and still.under.strides[0] == 0 and np.array_equal(still.under_at(count), under)
-    assert still_values["RightArm"].strides[0] == 0 and np.array_equal(still_values["RightArm"], values["RightArm"])
-    under[3, 4, 0, 3] += 1e-3  # one bone moves at one frame
-    moving = gesture.RigState("Rig", rig.skeleton, rig.roles, rig.family, under, True)
-    assert moving.standing_still(values) is None
-    turning = dict(values, RightArm=values["RightArm"] + np.array([[0.0, 0.0, 1e-4, 0.0]]) * np.arange(count)[:, None])
-    assert animated.standing_still(turning) is None
+def test_over_animation_a_gesture_keys_only_its_arm_and_adds_its_spine_and_head_turn_to_what_plays_underneath():
+    """Over the animation alone the spine, neck and head play the gesture's pose at full weight, as on a still
+    rig; another gesture's turn of them underneath (`bare` gives the animation without it) stays, so two
+    gestures at once both turn them. The other arm is left to the animation."""
+    frames = 40
+    agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(frames, spaces.ACTION_SIZE)))
+    still = gesture.canonical_rig()
+    animated = _animated(still, frames, scale=0.2)
+    still_names, still_quats, _ = gesture.gesture_rotations(agent, _request(frames=frames, seed=1), still)
+    names, quats, under = gesture.gesture_rotations(agent, _request(frames=frames, seed=1), animated)
+    assert set(still_names) - set(names) == {"LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1"}
+    torso = [skeleton.BONE_NAMES.index(role) for role in gesture.TORSO]
+    turned = animated.under.copy()  # another gesture's turn on top of the animation's spine, neck and head
+    turned[:, torso, :3, :3] = turned[:, torso, :3, :3] @ rotvec_to_matrix(np.array([0.05, -0.08, 0.03]))
+    other = gesture.RigState("Rig", still.skeleton, still.roles, still.family, turned, True,
+                             bare={skeleton.BONE_NAMES[i]: animated.under[:, i] for i in torso})
+    _, over_other, under_other = gesture.gesture_rotations(agent, _request(frames=frames, seed=1), other)
+    full = gesture.blend_weights(frames) == 1.0
+    conjugate = np.array([1.0, -1.0, -1.0, -1.0])
+    for role in gesture.TORSO:
+        k, alone = names.index(role), still_quats[:, still_names.index(role)]
+        assert np.allclose(np.abs(np.sum(quats[full, k] * alone[full], axis=-1)), 1.0), "the gesture's own pose"
+        kept = quat_multiply(quat_multiply(under_other[:, k], under[:, k] * conjugate), quats[:, k])
+        assert np.allclose(np.abs(np.sum(over_other[:, k] * kept, axis=-1)), 1.0), "the other's turn stays"
 
 
 @pytest.mark.parametrize("animated", [False, True])
-def test_a_behaviour_whose_free_arm_has_no_part_keeps_that_arm_where_it_was(animated):
-    """An agent whose training clips left the free arm still (`still_free_arm`) plays the gesture with that arm's
-    joints held at the pose the gesture starts from (the pose underneath, or the standing pose on a still rig at
-    rest) on every frame, whatever its own output for them; the gesturing arm still moves; other behaviours and
-    agents are played as before."""
+def test_a_behaviour_whose_free_arm_has_no_part_holds_it_on_a_still_rig_and_leaves_it_to_the_animation(animated):
+    """An agent whose training clips left the free arm still (`still_free_arm`): on a still rig the gesture keys
+    that arm's joints on the standing pose it starts from on every frame, whatever the agent's own output for them;
+    over animation the gesture does not key that arm at all, held or not (`owned_joints`: it is the animation's).
+    The gesturing arm, and other behaviours, play as before."""
     frames = 40
     agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(frames, spaces.ACTION_SIZE)))
     rig = _animated(gesture.canonical_rig(), frames) if animated else gesture.canonical_rig()
-    _, played, _ = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    played_names, played, _ = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
     agent.still_free_arm = frozenset({"WAVE"})
-    names, held, under = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    names, held, _ = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    assert names == played_names
     free = gesture.free_arm_columns(names, "RIGHT")
+    if animated:
+        assert free == [], "over animation the free arm is not keyed"
+        np.testing.assert_allclose(held, played)
+        return
     assert [names[k] for k in free] == ["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1"]
-    start = under if animated else np.broadcast_to(
-        [rotvec_to_quat(gesture.STANDING_POSE.get(names[k], np.zeros(3))) for k in free], (frames, len(free), 4))
-    start = start[:, free] if animated else start
+    start = np.broadcast_to([rotvec_to_quat(gesture.STANDING_POSE.get(names[k], np.zeros(3))) for k in free],
+                            (frames, len(free), 4))
     assert np.allclose(np.abs(np.sum(held[:, free] * start, axis=-1)), 1.0)
     assert not np.allclose(np.abs(np.sum(played[:, free] * start, axis=-1)), 1.0), "the agent's own output moves it"
     moving = [k for k in range(len(names)) if k not in free]
     np.testing.assert_allclose(held[:, moving], played[:, moving])
     _, pointed, _ = gesture.gesture_rotations(agent, _request("POINT", frames=frames, targets=[-1.0, -2.0, 1.6]), rig)
     assert not np.allclose(np.abs(np.sum(pointed[:, free] * start, axis=-1)), 1.0), "point is not held"
+
+def test_a_handover_starts_from_the_pose_of_its_first_frame_and_a_resting_bone_from_its_own_basis():
+    frames, held = 30, 6
+    agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(frames, spaces.ACTION_SIZE)))
+    base = _animated(gesture.canonical_rig(), frames)
+    moved = base.under.copy()  # another pose underneath on the held frames but the first
+    moved[1:held, :, :3, :3] = rotvec_to_matrix(RNG.normal(scale=0.3, size=(held - 1, len(skeleton.BONES), 3)))
+    request = _request(frames=frames, seed=2)
+    arm = skeleton.BONE_NAMES.index("RightForeArm")
+    results = []
+    for under in (base.under, moved):
+        rig = gesture.RigState("Rig", base.skeleton, base.roles, base.family, under, True, held=held)
+        names, quats, _ = gesture.gesture_rotations(agent, request, rig)
+        results.append(quats[:held, names.index("RightForeArm")])
+    assert np.allclose(results[0], results[1]), "over the held frames only the first frame's pose counts"
+    resting = np.eye(4)
+    resting[:3, :3] = rotvec_to_matrix(np.array([0.4, 0.0, 0.0]))
+    rig = gesture.RigState("Rig", base.skeleton, base.roles, base.family, base.under, True,
+                           resting={"RightForeArm": resting})
+    names, quats, _ = gesture.gesture_rotations(agent, request, rig)
+    assert np.allclose(np.abs(np.sum(quats[0, names.index("RightForeArm")] * matrix_to_quat(resting[:3, :3]))), 1.0)
+    assert not np.allclose(np.abs(np.sum(quats[0, names.index("RightForeArm")]
+                                         * matrix_to_quat(base.under[0, arm, :3, :3]))), 1.0)

@@ -144,6 +144,24 @@ def test_the_rhythm_settings_round_trip_and_broken_ones_are_refused():
             rhythm.RhythmModel.from_dict(broken)
 
 
+@pytest.mark.parametrize("field, value, named", [
+    (None, "fast", "wave_rhythm is a string"), (None, [1.0, 2.0], "wave_rhythm is a list"),
+    (None, 3, "wave_rhythm is a number"), ("examples", [["0.5", 0.07, 0.2, 0.8]] * 3, "wave_rhythm.examples"),
+    ("examples", {"a": 1}, "wave_rhythm.examples"), ("phase", "1.5", "wave_rhythm.phase"),
+    ("phase", True, "wave_rhythm.phase"), ("phase", 10 ** 400, "wave_rhythm.phase"),
+    ("ramp", [9.0], "wave_rhythm.ramp"), ("bandwidth", -0.1, "wave_rhythm.bandwidth"),
+    ("tempo_bandwidth", "x", "wave_rhythm.tempo_bandwidth"), ("phases", "x", "wave_rhythm.phases"),
+    ("phases", [[0.1]] * 8, "wave_rhythm.phases"), ("arms", [["LEFT"]] * 8, "wave_rhythm.arms"),
+    ("arms", "LEFT", "wave_rhythm.arms"), ("arms", 5, "wave_rhythm.arms"),
+    ("typical_tempo", 1, "wave_rhythm.typical_tempo"), ("by_arm", "yes", "wave_rhythm.by_arm")])
+def test_every_field_of_the_model_is_checked_for_its_type_and_named(field, value, named):
+    e, rhythms = _training_rhythms()
+    values = value if field is None else {**rhythm.RhythmModel.fit(e, rhythms).to_dict(), field: value}
+    assert rhythm.invalid_field(values).startswith(named)
+    with pytest.raises(RLAnimateError, match=named.replace(".", r"\.")):
+        rhythm.RhythmModel.from_dict(values)
+
+
 def test_a_requested_tempo_sets_the_rate_and_the_training_waves_near_it_the_rest():
     e, rhythms = _training_rhythms()
     model = rhythm.RhythmModel.fit(e, rhythms)
@@ -187,5 +205,5 @@ def test_with_by_arm_a_request_weighs_the_waves_of_its_own_arm():
     again = rhythm.RhythmModel.from_dict(model.to_dict())
     assert again.arms == tuple(arms) and again.by_arm and again.draw(0.51, arm="RIGHT") == right
     for broken in (arms[:-1], arms[:-1] + ["MIDDLE"]):
-        with pytest.raises(RLAnimateError, match="LEFT or RIGHT for each wave"):
+        with pytest.raises(RLAnimateError, match="wave_rhythm.arms must be null or a list of 12 arms"):
             rhythm.RhythmModel.from_dict({**model.to_dict(), "arms": broken})

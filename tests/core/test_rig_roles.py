@@ -40,7 +40,9 @@ def test_each_family_is_detected_from_its_own_names_with_every_gesture_role(fami
 def test_a_rigify_game_export_keys_its_deform_bones_and_a_whole_rigify_rig_its_controls():
     deform = _family_names(rig_roles.RIGIFY_DEFORM) + ["DEF-upper_arm.L.001", "DEF-forearm.R.001", "root"]
     family, roles = rig_roles.detect(deform)
-    assert family is rig_roles.RIGIFY_DEFORM and roles["LeftArm"] == "DEF-upper_arm.L" and roles["Head"] == "DEF-spine.006"
+    assert (
+        family is rig_roles.RIGIFY_DEFORM and roles["LeftArm"] == "DEF-upper_arm.L" and roles["Head"] == "DEF-spine.006"
+    )
     family, roles = rig_roles.detect(deform + _family_names(rig_roles.RIGIFY))
     assert family is rig_roles.RIGIFY and roles["LeftArm"] == "upper_arm_fk.L"
 
@@ -61,7 +63,11 @@ def test_biped_and_spaced_mixamo_names_are_detected(prefix):
 
 def test_rigify_keys_the_fk_controls():
     _, roles = rig_roles.detect(_family_names(rig_roles.RIGIFY))
-    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == ("upper_arm_fk.L", "forearm_fk.R", "spine_fk.002")
+    assert (roles["LeftArm"], roles["RightForeArm"], roles["Spine"]) == (
+        "upper_arm_fk.L",
+        "forearm_fk.R",
+        "spine_fk.002",
+    )
 
 
 def test_unreal_5_spine_keys_its_top_spine_bone():
@@ -72,9 +78,35 @@ def test_unreal_5_spine_keys_its_top_spine_bone():
 def test_missing_roles_are_listed_with_how_to_map_them():
     names = [n for n in MIXAMO if n not in ("Neck", "RightHand", "Spine", "Spine1", "Spine2")]
     family, roles = rig_roles.detect(names)
-    with pytest.raises(RLAnimateError, match=r"roles Spine, Neck, RightHand \(closest bone naming: Mixamo\).*Bone Map"):
+    missing = r"roles Spine, Neck, RightHand \(closest bone naming: Mixamo\).*Bone Map"
+    with pytest.raises(RLAnimateError, match=missing) as refused:
         rig_roles.check_roles("Hero", roles, "RIGHT", family.name)
+    message = str(refused.value)  # the VRM fix first, the bone map next, renaming bones last
+    assert message.index("'Bone Map from VRM File'") < message.index("'Save Bone Map'") < message.index("rename")
     rig_roles.check_roles("Hero", {**roles, "Neck": "n", "Spine": "s"}, "LEFT", family.name)  # the left arm is whole
+
+
+def test_a_saved_bone_map_names_every_role_and_leaves_those_not_found_empty():
+    text = rig_roles.bone_map_json("Custom", {"Spine": "a", "Neck": "b", "Head": "c"})
+    saved = json.loads(text)
+    assert list(saved["bones"]) == list(rig_roles.ROLES) and '""' in saved["note"]
+    assert saved["bones"]["Spine"] == "a" and saved["bones"]["LeftArm"] == "" and len(rig_roles.ROLES) == 56
+    filled = {**saved, "bones": {**saved["bones"], "LeftArm": "d"}}  # what the user types
+    assert rig_roles.read_bone_map(json.dumps(filled), ["a", "b", "c", "d"]) == (
+        "Custom", {"Spine": "a", "Neck": "b", "Head": "c", "LeftArm": "d"})
+
+
+def test_ue_names_with_blender_side_suffixes_are_the_ue_family():
+    """'upperarm.l', 'hand.L', 'index_01-l': the UE family's names with another side separator (issue 44:
+    Save Bone Map kept 5 roles of a rig so named)."""
+    unreal = _family_names(rig_roles.UNREAL)
+    names = [name[:-2] + {"_l": ".l", "_r": ".R"}.get(name[-2:], name[-2:]) for name in unreal]
+    assert "upperarm.l" in names and "index_01.R" in names
+    family, roles = rig_roles.detect(names)
+    assert family is rig_roles.UNREAL and len(roles) == len(rig_roles.detect(unreal)[1]) == 44
+    assert roles["LeftArm"] == "upperarm.l" and roles["RightHand"] == "hand.R"
+    for family in rig_roles.FAMILIES:  # every family still finds its own names first
+        assert rig_roles.detect(_family_names(family))[0] is family
 
 
 def test_a_bone_map_file_round_trips_and_bad_files_are_refused():
@@ -87,8 +119,8 @@ def test_a_bone_map_file_round_trips_and_bad_files_are_refused():
         rig_roles.read_bone_map(json.dumps({"bones": {"Elbow": "a"}}), bones)
     with pytest.raises(RLAnimateError, match="lacks: z"):
         rig_roles.read_bone_map(json.dumps({"bones": {"Neck": "z"}}), bones)
-    for value in (["a"], None, "", 3):
-        with pytest.raises(RLAnimateError, match="one name \\(a string\\) per role"):
+    for value in (["a"], None, 3):
+        with pytest.raises(RLAnimateError, match="one name \\(a string, \"\" for none\\) per role"):
             rig_roles.read_bone_map(json.dumps({"bones": {"Neck": value}}), bones)
     with pytest.raises(RLAnimateError, match="gives the bone 'a' to the roles Neck, Head"):
         rig_roles.read_bone_map(json.dumps({"bones": {"Spine": "b", "Neck": "a", "Head": "a"}}), bones)

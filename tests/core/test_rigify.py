@@ -39,4 +39,6 @@ def test_snapped_fk_controls_stand_where_the_arm_plays_and_the_fingers_follow():
         np.testing.assert_allclose(snapped.under_pose[:, i], played_pose[:, i], atol=1e-9)
     check = rig.skeleton.pose_matrices(snapped.under, only=controls)
     for name in controls:
-        np.testing.assert_allclose(check[:, rig.skeleton.index[name]], played_pose[:, rig.skeleton.index[name]], atol=1e-9)
+        np.testing.assert_allclose(
+            check[:, rig.skeleton.index[name]], played_pose[:, rig.skeleton.index[name]], atol=1e-9
+        )

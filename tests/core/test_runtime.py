@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 import torch
 
-from rlanimate_addon.core import runtime as runtime_module
 from rlanimate_addon.core import rhythm, spaces
+from rlanimate_addon.core import runtime as runtime_module
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.runtime import GestureAgent, load_agent
 from trainer.agent.agent_export import export_agent
@@ -24,7 +24,9 @@ RHYTHM = rhythm.RhythmModel.fit([0.0, 0.5, 1.0], [rhythm.Rhythm(0.08, 0.3, 0.7, 
 def objectives_for_tests(frames=150):
     point = spaces.PAPER_SPACE.make_objective("POINT", "LEFT", [0.4, -0.8, 0.3], frames)
     wave = spaces.PAPER_SPACE.make_objective("WAVE", "RIGHT", 0.7, frames // 2)
-    swinging = spaces.PAPER_SPACE.make_objective("WAVE", "LEFT", 0.3, frames, rhythm.signals(RHYTHM.draw(0.3, 4), frames))
+    swinging = spaces.PAPER_SPACE.make_objective(
+        "WAVE", "LEFT", 0.3, frames, rhythm.signals(RHYTHM.draw(0.3, 4), frames)
+    )
     return [point, wave, swinging]
 
 
@@ -156,9 +158,14 @@ def test_the_wave_rhythm_comes_from_the_file_mean_without_a_seed_and_varied_with
 
 
 def test_a_file_with_by_arm_plays_each_arm_from_its_own_arms_waves(tmp_path):
-    by_arm = rhythm.RhythmModel.fit(RHYTHM.examples[:, 0], [rhythm.Rhythm(*row[1:], phase, RHYTHM.ramp)
-                                                           for row, phase in zip(RHYTHM.examples, RHYTHM.phases)],
-                                    ["LEFT", "RIGHT", "LEFT"]).with_settings(by_arm=True)
+    by_arm = rhythm.RhythmModel.fit(
+        RHYTHM.examples[:, 0],
+        [
+            rhythm.Rhythm(*row[1:], phase, RHYTHM.ramp)
+            for row, phase in zip(RHYTHM.examples, RHYTHM.phases, strict=True)
+        ],
+        ["LEFT", "RIGHT", "LEFT"],
+    ).with_settings(by_arm=True)
     torch.manual_seed(0)
     path = tmp_path / "by_arm.npz"
     export_agent(RLAnimateAgent(load_preset("debug")[0]), path, {"wave_rhythm": by_arm.to_dict()})

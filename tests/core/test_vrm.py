@@ -17,8 +17,9 @@ VRM0 = {"bone": "hips", "node": 1}, {"bone": "spine", "node": 2}, {"bone": "ches
 
 
 def glb(gltf, binary=b"\0\0\0\0"):
-    """A binary glTF file's bytes: header, JSON chunk (space-padded) and a BIN chunk."""
-    text = json.dumps(gltf).encode()
+    """A binary glTF file's bytes: header, JSON chunk (space-padded) and a BIN chunk; gltf: a dict, or the
+    JSON text."""
+    text = (gltf if isinstance(gltf, str) else json.dumps(gltf)).encode()  # str: the JSON text itself
     text += b" " * (-len(text) % 4)
     total = 12 + 8 + len(text) + 8 + len(binary)
     return (b"glTF" + struct.pack("<II", 2, total) + struct.pack("<I4s", len(text), b"JSON") + text
@@ -68,7 +69,15 @@ def test_imported_names_follow_the_gltf_importer():
 @pytest.mark.parametrize("case, message", [
     ("not glTF", "is not a VRM file"),
     ("glTF 1", "not glTF 2.0"),
-    ("huge chunk", "declares a JSON chunk of"),
+    ("huge chunk", "declares a JSON chunk of 2,147,483,648 bytes in a"),
+    ("chunk larger than a VRM's", "declares a JSON chunk of 33,554,432 bytes, more than a VRM's .2,097,152"),
+    ("nested 1,000 deep", "nests 1,001 deep, more than a glTF's .64"),
+    ("skins a number", "its skins is a number, not a list"),
+    ("node a string", "node 2 is a string, not an object"),
+    ("name a number", "node 1's name is a number, not a string"),
+    ("joint out of range", "skin 0 lists the joint 13, not one of its 13 nodes"),
+    ("joint null", "skin 0 lists the joint null"),
+    ("one bone in two roles", "gives the bone 'upper_arm.L' to the roles LeftArm, LeftForeArm: each role needs"),
     ("truncated", "ends inside its JSON chunk"),
     ("bad JSON", "is not valid JSON"),
     ("plain glTF", "it is a plain glTF, not a VRM"),
@@ -89,6 +98,24 @@ def test_bad_files_are_refused_with_what_is_wrong(tmp_path, case, message):
         data = data[:4] + struct.pack("<I", 1) + data[8:]
     elif case == "huge chunk":
         data = data[:12] + struct.pack("<I", 2 ** 31) + data[16:]
+    elif case == "chunk larger than a VRM's":
+        data = glb(good) + b" " * 2 ** 25  # a 32 MiB chunk in a file that holds it
+        data = data[:8] + struct.pack("<II", len(data), 2 ** 25) + data[16:]
+    elif case == "nested 1,000 deep":
+        data = glb(json.dumps(good)[:-1] + ', "extras": ' + "[" * 1000 + "]" * 1000 + "}")
+    elif case == "skins a number":
+        data = glb({**good, "skins": 5})
+    elif case == "node a string":
+        data = glb({**good, "nodes": NODES[:2] + ["spine"] + NODES[3:]})
+    elif case == "name a number":
+        data = glb({**good, "nodes": NODES[:1] + [{"name": 7}] + NODES[2:]})
+    elif case == "joint out of range":
+        data = glb({**good, "skins": [{"joints": [0, 1, 13]}]})
+    elif case == "joint null":
+        data = glb({**good, "skins": [{"joints": [0, None]}]})
+    elif case == "one bone in two roles":
+        bones = [dict(entry, node=7) if entry["bone"] == "leftLowerArm" else entry for entry in VRM0]
+        data = glb({"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": bones}}}})
     elif case == "truncated":
         data = data[:40]
         data = data[:8] + struct.pack("<I", len(data) + 10 ** 6) + data[12:]
@@ -99,7 +126,9 @@ def test_bad_files_are_refused_with_what_is_wrong(tmp_path, case, message):
     elif case == "no humanoid":
         data = glb({"nodes": NODES, "extensions": {"VRM": {"meta": {}}}})
     elif case == "node out of range":
-        data = glb({"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": [{"bone": "hips", "node": 99}]}}}})
+        data = glb(
+            {"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": [{"bone": "hips", "node": 99}]}}}}
+        )
     elif case == "too many bones":
         data = glb({"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": [VRM0[0]] * 300}}}})
     elif case == "wrong type":
@@ -116,11 +145,10 @@ def test_only_the_json_chunk_is_read(tmp_path, monkeypatch):
     path = _write(tmp_path, glb({"nodes": NODES, "extensions": {"VRM": {"humanoid": {"humanBones": list(VRM0)}}}},
                                 binary=b"\0" * (8 * 1024 * 1024)))
     read = []
-    real_open = open
 
     class Counting:
-        def __init__(self, *args, **kwargs):
-            self.handle = real_open(*args, **kwargs)
+        def __init__(self, handle):
+            self.handle = handle
 
         def __enter__(self):
             return self
@@ -133,9 +161,10 @@ def test_only_the_json_chunk_is_read(tmp_path, monkeypatch):
             data = self.handle.read(size)
             read.append(len(data))
             return data
-    monkeypatch.setattr("builtins.open", Counting)
+    opened = vrm.open_regular
+    monkeypatch.setattr(vrm, "open_regular", lambda p: Counting(opened(p)))
     assert vrm.read_gltf_json(path)["nodes"] == NODES
-    assert sum(read) < 64 * 1024
+    assert 0 < sum(read) < 64 * 1024
 
 
 def test_vrm_addon_property_names():

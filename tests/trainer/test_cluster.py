@@ -1,10 +1,10 @@
 """Ray tasks (trainer/cluster.py) give what the serial code gives: a training run on a Ray worker is bit for
-bit the run trained in this process (on the sample library and on real capture), and clips imported by two
-Blenders at once are the serial import's, in the same cache."""
+bit the run trained in this process (on the sample library and on real capture); a run refused on a worker
+is one line naming it."""
 import numpy as np
 import pytest
 
-from trainer.blender_io.clip_import import import_clip_directory
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect
 from trainer.experiments import realmocap
@@ -33,6 +33,20 @@ def test_a_run_on_a_ray_worker_equals_the_run_in_this_process(tiny_library, tmp_
     assert _agents_equal(tmp_path / "serial", tmp_path / "ray")
 
 
+def test_a_run_refused_on_a_ray_worker_is_one_line_naming_the_run(tiny_library, tmp_path, local_ray):
+    output = tmp_path / "run"
+    output.mkdir()
+    (output / "checkpoint.pt").write_bytes(b"not a checkpoint")
+    settings = RunSettings(output=str(output), clips=str(tiny_library), epochs=2, preset="debug", resume=True,
+                           progress=False)
+    with pytest.raises(RLAnimateError) as refused:
+        list(train_runs([settings]))
+    message = str(refused.value)
+    assert message.startswith(f"The run in {output}: The checkpoint {output / 'checkpoint.pt'} is damaged (")
+    assert "\n" not in message and "weights_only" not in message and "Traceback" not in message
+    assert (output / "checkpoint.pt").read_bytes() == b"not a checkpoint", "the run's files are kept"
+
+
 def _agents_equal(folder_a, folder_b):
     with np.load(folder_a / "agent.npz") as a, np.load(folder_b / "agent.npz") as b:
         weights = [name for name in a.files if a[name].dtype.kind == "f"]
@@ -40,8 +54,10 @@ def _agents_equal(folder_a, folder_b):
             np.array_equal(a[name], b[name]) for name in weights)
 
 
-@pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
-                    reason=f"real motion capture not found at {REALMOCAP_DIR} (../shared/realmocap/ beside the repository)")
+@pytest.mark.skipif(
+    not (REALMOCAP_DIR / "wave").is_dir(),
+    reason=f"real motion capture not found at {REALMOCAP_DIR} (../shared/realmocap/ beside the repository)",
+)
 def test_a_real_capture_run_on_a_ray_worker_equals_the_run_in_this_process(tmp_path, local_ray):
     wave = REALMOCAP_DIR / "wave"
     train_takes = tuple(str(wave / f"dataset-2_wave-left-hand_{name}.bvh") for name in ("feminine_001", "active_021"))
@@ -61,15 +77,3 @@ def test_a_real_capture_run_on_a_ray_worker_equals_the_run_in_this_process(tmp_p
     assert _agents_equal(tmp_path / "serial", tmp_path / "ray")
     # A finished run is not trained again: its report is read back.
     assert realmocap.train_real_runs([run(tmp_path / "ray")]) == reports
-
-
-def test_clips_imported_by_two_blenders_are_the_serial_import_in_the_same_cache(tiny_library, tmp_path, local_ray):
-    serial, serial_problems = import_clip_directory(tiny_library, cache_dir=tmp_path / "serial")
-    parallel, parallel_problems = import_clip_directory(tiny_library, cache_dir=tmp_path / "parallel", workers=2)
-    assert len(serial) == len(parallel) == 6 and serial_problems == parallel_problems == []
-    for a, b in zip(serial, parallel):
-        assert (a.name, a.behaviour, a.arm, a.fps) == (b.name, b.behaviour, b.arm, b.fps)
-        assert np.array_equal(a.rotvecs, b.rotvecs) and sorted(a.fingers) == sorted(b.fingers)
-        assert all(np.array_equal(a.fingers[name], b.fingers[name]) for name in a.fingers)
-    cached = [sorted(p.name for p in (tmp_path / name).iterdir()) for name in ("serial", "parallel")]
-    assert cached[0] == cached[1] and len(cached[0]) == 6

@@ -84,12 +84,16 @@ def _json_value(value):
 
 
 def _spaces(space):
-    return {"objective_size": space.size, "description_size": spaces.DESCRIPTION_SIZE,
-            "action_size": spaces.ACTION_SIZE, "behaviour_labels": dict(zip(space.names, space.labels.tolist())),
-            "action_joints": list(skeleton.ACTION_JOINTS),
-            "action_encoding": "rotation vector relative to rest, (r - low) / (high - low)",
-            "description_joints": [list(j) for j in skeleton.DESCRIPTION_JOINTS],
-            "effectors": [list(e) for e in skeleton.EFFECTORS]}
+    return {
+        "objective_size": space.size,
+        "description_size": spaces.DESCRIPTION_SIZE,
+        "action_size": spaces.ACTION_SIZE,
+        "behaviour_labels": dict(zip(space.names, space.labels.tolist(), strict=True)),
+        "action_joints": list(skeleton.ACTION_JOINTS),
+        "action_encoding": "rotation vector relative to rest, (r - low) / (high - low)",
+        "description_joints": [list(j) for j in skeleton.DESCRIPTION_JOINTS],
+        "effectors": [list(e) for e in skeleton.EFFECTORS],
+    }
 
 
 def _git_commit():
@@ -104,4 +108,4 @@ def _git_commit():
 
 
 def _now():
-    return datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds")
+    return datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds")

@@ -24,18 +24,18 @@ import torch
 from torch.optim.swa_utils import AveragedModel
 
 from rlanimate_addon.core import behaviours, rhythm, spaces
-from rlanimate_addon.core.errors import RLAnimateError
-
 from trainer.agent import checkpoint, pointing
 from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
+from trainer.motion.clip import trained_behaviours
 from trainer.motion.fk import ClipReferences
+
 
 def clips_for_behaviour(clips, behaviour, space):
     """Clips grouped as Algorithm 1 draws them: one group per behaviour of the training set `behaviour`
-    (behaviours.training_set, among the ObjectiveSpace `space`'s), in objective order ([[point clips],
-    [wave clips]] for 'both')."""
-    wanted = behaviours.training_set(behaviour, space.names)
+    that `clips` have (trained_behaviours, among the ObjectiveSpace `space`'s), in objective order ([[point
+    clips], [wave clips]] for 'both')."""
+    wanted = trained_behaviours(clips, behaviour, space.names)
     return [[clip for clip in clips if clip.behaviour == name] for name in wanted]
 
 
@@ -152,7 +152,7 @@ class Trainer:
         descriptions = np.asarray(self.env.evaluate(rotvecs).descriptions)  # (sum F, 42)
         ends = np.cumsum([len(a) for a in actions])[:-1]
         for clip, objective, imitate, action, description in zip(drawn, objectives, imitated, actions,
-                                                                 np.split(descriptions, ends)):
+                                                                 np.split(descriptions, ends), strict=True):
             motion_description, _ = self.references.get(clip)
             self.buffer.add({
                 "objective": objective,

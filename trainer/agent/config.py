@@ -58,7 +58,9 @@ class TrainConfig:
     epochs_single: int = 50  # iterations of Algorithm 1 for one behaviour (the paper's 50)
     epochs_both: int = 100  # ... and for both behaviours (the paper's 100)
     update_steps: int = 20  # T: model updates per iteration
-    chunk_count: int = 16  # C: chunks per update for one or two behaviours (n > 2: C * n / 2, algorithm.chunks_per_update)
+    chunk_count: int = (
+        16  # C: chunks per update for one or two behaviours (n > 2: C * n / 2, algorithm.chunks_per_update)
+    )
     chunk_length: int = 32  # L: frames per chunk
     learning_rate: float = 1e-3  # Adam
     learning_rate_final: float = None  # cosine decay to this over the run's epochs (None: constant)

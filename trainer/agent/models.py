@@ -35,7 +35,6 @@ from torch.distributions import Beta, Independent, Normal
 from rlanimate_addon.core import agent_file, spaces
 from rlanimate_addon.core.behaviours import WAVE
 from rlanimate_addon.core.errors import RLAnimateError
-
 from trainer.agent import losses as loss_terms
 
 VARIANTS = agent_file.VARIANTS
@@ -54,7 +53,7 @@ class MLP(nn.Module):
     def __init__(self, inputs, hidden, layers, outputs):
         super().__init__()
         widths = [inputs] + [hidden] * layers + [outputs]
-        self.layers = nn.ModuleList(nn.Linear(n_in, n_out) for n_in, n_out in zip(widths[:-1], widths[1:]))
+        self.layers = nn.ModuleList(nn.Linear(n_in, n_out) for n_in, n_out in zip(widths[:-1], widths[1:], strict=True))
 
     def forward(self, x):
         for layer in self.layers[:-1]:
@@ -73,7 +72,7 @@ class RLAnimateAgent(nn.Module):
         c = self.config = agent_config
         self.variant = variant
         self.space = space
-        O, D, A = space.size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE
+        O, D, A = space.size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE  # noqa: E741 (the paper's sizes)
         E, Z, hid, n = c.behaviour_size, c.stochastic_size, c.hidden_size, c.hidden_layers
         self.uses_portrayal = agent_file.uses_portrayal(variant)
         self.uses_task_state = agent_file.uses_task_state(variant)
@@ -201,7 +200,9 @@ class RLAnimateAgent(nn.Module):
         e, z, _ = self.initial_state(objectives.shape[0], objectives)
         es, zs, means, stds = [], [], [], []
         # unbind, not [:, t]: the gradient of T slices is one stack, not T zero-filled (B, T, .) tensors
-        for task_t, a_prev, condition in zip(task.unbind(1), previous_actions.unbind(1), conditions.unbind(1)):
+        for task_t, a_prev, condition in zip(
+            task.unbind(1), previous_actions.unbind(1), conditions.unbind(1), strict=True
+        ):
             e = self.transition(e, z, a_prev, task_t)
             mean, std = self.posterior_parameters(e, condition)
             z = mean + torch.empty_like(mean).normal_() * std  # Normal(mean, std).rsample(), draw for draw

@@ -10,22 +10,27 @@ rest frames (the action space before its [0, 1] mapping); `fingers` holds the ot
 source has them. Bone names go through core.bone_maps (Mixamo with any `prefix:`, Bandai Namco);
 trainer/motion/canonicalise.py turns the source's world bone frames into canonical local rotations.
 Imported clips are cached (trainer/motion/clip_cache.py) in a git-ignored `.import_cache/` beside the
-clips; manifests are read by trainer/motion/manifest.py. With `workers` > 1 the files the cache lacks are
-imported first by Ray tasks (trainer/cluster.py), each worker with its own Blender, into the same cache;
-the clips are then read from it, so they are the serial import's.
+clips; manifests are read by trainer/motion/manifest.py. The clips of a library (import_clip_directory)
+that the cache lacks are imported by worker processes (trainer/blender_io/import_worker.py), `workers` at
+once, each clip under a memory cap and a time limit, into the cache (a temporary one when there is none, or
+it cannot be written), and then read from it: the same clips however many workers import them, and a file
+that would take the machine's memory or hang is skipped with a note.
 """
 import io
 import sys
-from contextlib import contextmanager, redirect_stderr
+import tempfile
+from contextlib import contextmanager, nullcontext, redirect_stderr
+from dataclasses import replace
 from pathlib import Path
+from typing import IO
 
 import numpy as np
 from tqdm import tqdm
 
 from rlanimate_addon.core import bone_maps, rotations, skeleton
 from rlanimate_addon.core.errors import RLAnimateError, operator_error_reason
-from trainer.blender_io import rig_session
-from trainer.cluster import connect, run_tasks
+from trainer.blender_io import import_worker, rig_session
+from trainer.blender_io.import_worker import ImportLimits
 from trainer.motion import canonicalise, clip_cache
 from trainer.motion.clip import ClipSet, MotionClip
 from trainer.motion.hands import with_hand
@@ -140,7 +145,7 @@ def _alignments(canonical, bones, rest):
     """
     index = {name: k for k, name in enumerate(canonical)}
     result = np.tile(np.eye(3), (len(bones), 1, 1))
-    for k, (name, bone) in enumerate(zip(canonical, bones)):
+    for k, (name, bone) in enumerate(zip(canonical, bones, strict=True)):
         frame = rest[k, :3, :3]
         child = _TAIL_CHILD.get(name)
         if child in index:
@@ -273,14 +278,19 @@ def _to_canonical(canonical, frames, calibration_frames, calibration_heads, bone
     return canonicalise.action_rotvecs(bases), fingers
 
 
-def _import_uncached(path, expected_fps, bone_map):
-    bpy = rig_session.import_bpy()
+def _check_file(path: Path) -> None:
+    """RLAnimateError for a clip path that is no file, not FBX or BVH, or empty."""
     if not path.is_file():
         raise RLAnimateError(f"{path}: no such file. Check the path or the manifest entry.")
     if path.suffix.lower() not in CLIP_SUFFIXES:
         raise RLAnimateError(f"{path}: unsupported file type {path.suffix!r}. Export clips as FBX or BVH.")
     if path.stat().st_size == 0:
         raise RLAnimateError(f"{path}: the file is empty. Re-export the clip.")
+
+
+def _import_uncached(path, expected_fps, bone_map):
+    bpy = rig_session.import_bpy()
+    _check_file(path)
     if path.suffix.lower() == ".bvh":
         _check_bvh_numbers(path)
     with _SceneSnapshot(bpy):
@@ -317,11 +327,9 @@ def import_clip(path, expected_fps=EXPECTED_FPS, bone_map=None, cache_dir=None):
     if cache_dir is None or not path.is_file():
         return _import_uncached(path, float(expected_fps), bone_map)
     cache_file = _cache_file(path, expected_fps, bone_map, cache_dir)
-    if cache_file.is_file():
-        try:
-            return clip_cache.load_cached(cache_file, path)
-        except RLAnimateError as error:  # import again and overwrite it
-            tqdm.write(f"clip_import: {error} Importing {path.name} again.", file=sys.stderr)  # above the bar
+    cached = _read_cache(cache_file, path)
+    if cached is not None:
+        return cached
     clip = _import_uncached(path, float(expected_fps), bone_map)
     try:
         clip_cache.save_cached(cache_file, clip)
@@ -335,41 +343,37 @@ def _cache_file(path, expected_fps, bone_map, cache_dir):
     return Path(cache_dir) / f"{clip_cache.file_hash(path)}_{map_tag}_{float(expected_fps):g}.npz"
 
 
-def import_into_cache(files: list[tuple[Path, float]], cache_dir: Path, workers: int) -> int:
-    """Import the clip files (path, fps) that `cache_dir` lacks as `workers` Ray tasks, each a share of the
-    files in a Blender of its own (a local Ray, or the cluster this process joined); returns how many
-    were missing. A file that fails here is imported again, and its problem reported, by the caller's
-    serial pass."""
-    missing = [(str(path), float(fps)) for path, fps in files
-               if Path(path).is_file() and not _cache_file(Path(path), fps, None, cache_dir).is_file()]
-    if missing:
-        connect(workers=workers)
-        shares = [(missing[k::workers], str(cache_dir)) for k in range(min(workers, len(missing)))]
-        for _ in run_tasks(_import_share, shares):
-            pass
-    return len(missing)
+def _read_cache(cache_file: Path, path: Path) -> MotionClip | None:
+    """The clip of `path` cached in `cache_file`, or None when there is none or it is damaged (then said, so
+    that it is imported again and overwritten)."""
+    if cache_file.is_file():
+        try:
+            return clip_cache.load_cached(cache_file, path)
+        except RLAnimateError as error:
+            tqdm.write(f"clip_import: {error} Importing {path.name} again.", file=sys.stderr)  # above the bar
+    return None
 
 
-def _import_share(share):
-    """Import (path, fps) files into the cache folder, quietly, skipping the ones that fail: a Ray task."""
-    files, cache_dir = share
-    with rig_session.blender_output():
-        for path, fps in files:
-            try:
-                import_clip(path, fps, cache_dir=cache_dir)
-            except RLAnimateError:
-                pass
+def import_into_cache_file(path: Path, fps: float, cache_dir: Path) -> None:
+    """Import the clip at `path` afresh (the bone map its bone names pick) into the cache folder `cache_dir`:
+    what an import worker does (trainer/blender_io/import_worker.py)."""
+    clip = _import_uncached(Path(path), float(fps), None)
+    try:
+        clip_cache.save_cached(_cache_file(Path(path), fps, None, cache_dir), clip)
+    except OSError as error:
+        raise RLAnimateError(f"{path}: cannot write its import cache entry in {cache_dir} ({error}).") from error
 
 
-def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, progress=None, workers=1):
+def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, progress=None, workers=1,
+                          limits=None):
     """Import every clip of a directory (its manifest.json when it has one, else every .fbx/.bvh) or
     of a manifest file. Returns (clips, problems): the clips that imported, and one message per file
     that did not. Clips listed in a manifest carry its labels; a clip without finger data gets the relaxed hand
     (motion/hands.py). cache_dir: where imported clips are
     cached (default: `.import_cache/` beside a manifest; no cache for a folder without one, so that
     shared data folders stay untouched); False imports afresh without caching. progress: a stream to
-    show a progress bar on (None: no bar). workers > 1: the files the cache lacks are imported first as
-    that many Ray tasks (import_into_cache); the clips are the same."""
+    show a progress bar on (None: no bar). The files the cache lacks are imported by `workers` import
+    workers at once, each clip within `limits` (an ImportLimits; None: the default 2 GB and 60 s)."""
     path = Path(path_or_manifest)
     manifest_path = path / "manifest.json" if path.is_dir() and (path / "manifest.json").is_file() else path
     if manifest_path.is_file() and manifest_path.suffix.lower() == ".json":
@@ -386,16 +390,17 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
         raise _no_library(path)
     if cache_dir is None:  # cache beside a manifest's clips; never write into a plain folder such as
         cache_dir = folder / clip_cache.CACHE_DIR_NAME if manifest_path is not None else False  # ../shared/realmocap
-    cache = Path(cache_dir) if cache_dir else None
-    if cache is not None and workers > 1:
-        import_into_cache([(folder / entry.file, entry.fps) for entry in entries], cache, workers)
+    imported = _import_files([(folder / entry.file, entry.fps) for entry in entries],
+                             Path(cache_dir) if cache_dir else None, workers, limits or ImportLimits(), progress)
     clips = []
-    for entry in tqdm(entries, desc="clips", unit="clip", file=progress, disable=progress is None, leave=False,
-                      dynamic_ncols=True):
+    for entry in entries:
         try:
-            clip = with_hand(import_clip(folder / entry.file, entry.fps, cache_dir=cache))
-            if manifest_path is not None:
-                clip = labelled(clip, entry, manifest_path)
+            clip = imported[folder / entry.file, entry.fps]
+            if isinstance(clip, RLAnimateError):
+                raise clip
+            clip = with_hand(clip)  # a new clip when it gets the relaxed hand
+            if manifest_path is not None:  # a copy: two entries may name one file
+                clip = labelled(replace(clip), entry, manifest_path)
             clips.append(clip)
         except FrameRateMismatch as error:
             problems.append(str(error) if manifest_path is None else _manifest_fps_problem(error, entry, manifest,
@@ -403,6 +408,45 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
         except RLAnimateError as error:
             problems.append(str(error))
     return clips, problems
+
+
+def _import_files(files: list[tuple[Path, float]], cache: Path | None, workers: int, limits: ImportLimits,
+                  progress: IO | None) -> dict[tuple[Path, float], MotionClip | RLAnimateError]:
+    """{(path, fps): its MotionClip, or the RLAnimateError of its file}, read from the cache folder `cache`
+    (None, or one that cannot be written: a temporary folder), the clips it lacks imported into it by
+    import workers first."""
+    results: dict[tuple[Path, float], MotionClip | RLAnimateError] = {}
+    with nullcontext(str(cache)) if _writable(cache) else tempfile.TemporaryDirectory() as folder:
+        store, missing = Path(folder), []
+        for path, fps in dict.fromkeys((Path(path), float(fps)) for path, fps in files):
+            try:
+                _check_file(path)
+                cached = _read_cache(_cache_file(path, fps, None, store), path)
+            except RLAnimateError as error:
+                results[path, fps] = error
+                continue
+            if cached is None:
+                missing.append((path, fps))
+            else:
+                results[path, fps] = cached
+        failed = import_worker.import_into_cache(missing, store, workers, limits, progress)
+        for path, fps in missing:
+            result = failed.get((path, fps)) or _read_cache(_cache_file(path, fps, None, store), path)
+            results[path, fps] = result or RLAnimateError(f"{path}: its import left no readable cache entry in "
+                                                          f"{store}. Import it again.")
+    return results
+
+
+def _writable(folder: Path | None) -> bool:
+    """Whether the folder `folder` (None: no folder) exists or can be made, and a file can be written in it."""
+    if folder is None:
+        return False
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        tempfile.TemporaryFile(dir=folder).close()
+    except OSError:
+        return False
+    return True
 
 
 def _manifest_fps_problem(error, entry, manifest, manifest_path):
@@ -429,11 +473,12 @@ def _no_library(path):
     return RLAnimateError(f"{path} does not exist: use a clip library's manifest.json or the folder that holds it.")
 
 
-def load_clip_set(manifest_path, progress=None, workers=1):
+def load_clip_set(manifest_path, progress=None, workers=1, limits=None):
     """The labelled clip library of `manifest_path` (or of the directory holding manifest.json), with a
     progress bar on the stream `progress` (None: none). Bad files are listed in ClipSet.problems; raises
-    RLAnimateError when none imports. workers > 1: import what the cache lacks as Ray tasks first."""
-    clips, problems = import_clip_directory(manifest_path, progress=progress, workers=workers)
+    RLAnimateError when none imports. What the cache lacks is imported by `workers` import workers, each
+    clip within `limits` (import_clip_directory)."""
+    clips, problems = import_clip_directory(manifest_path, progress=progress, workers=workers, limits=limits)
     if not clips:
         raise RLAnimateError(f"{manifest_path}: no clip could be imported ({len(problems)} problems: "
                              f"{'; '.join(problems[:3])}). Regenerate the clip library.")

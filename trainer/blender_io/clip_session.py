@@ -16,13 +16,15 @@ class LibrarySession:
     """What a run needs besides the trainer (trainer.experiments.run.train's `session`): env, references,
     train_clips, test_clips, problems."""
 
-    def __init__(self, clips, rig_path=SAMPLE_RIG_BLEND, verbose=False, import_workers=1):
+    def __init__(self, clips, rig_path=SAMPLE_RIG_BLEND, verbose=False, import_workers=1, import_limits=None):
         """Load the library with a progress bar and Blender's own prints held back (shown with `verbose`),
-        then say in one line what was loaded, and name every file that was skipped. import_workers > 1:
-        the clips the import cache lacks are imported by that many Ray tasks first."""
+        then say in one line what was loaded, and name every file that was skipped. The clips the import
+        cache lacks are imported by `import_workers` import workers at once, each clip within
+        `import_limits` (an ImportLimits; None: the default)."""
         self.manifest = manifest_path(clips)
         with blender_output(verbose) as terminal:
-            self.clip_set = load_clip_set(self.manifest, progress=terminal, workers=import_workers)
+            self.clip_set = load_clip_set(self.manifest, progress=terminal, workers=import_workers,
+                                          limits=import_limits)
             self.env = FKEnvironment(rig_path)
         self.references = ClipReferences(self.env)
         problems = self.clip_set.problems

@@ -70,7 +70,7 @@ class FKEnvironment(FKEnvironmentBase):
         eye_slots = {eye: self._bone_index[eye] for eye in eye_axes}
         for start in range(0, count, self.instances):
             batch = self.objects[:min(self.instances, count - start)]
-            for obj, pose_quats in zip(batch, quats[start:start + len(batch)]):
+            for obj, pose_quats in zip(batch, quats[start:start + len(batch)], strict=True):
                 obj.pose.bones.foreach_set("rotation_quaternion", pose_quats.ravel())
                 obj.update_tag(refresh={"DATA"})  # foreach_set does not tag the pose for evaluation
             self._bpy.context.view_layer.update()

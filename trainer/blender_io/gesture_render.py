@@ -2,12 +2,11 @@
 frames rendered with Cycles (CPU), as PNG files for a contact sheet.
 
 Each request is baked on its own frame range of one character (Generate keys only its own frames)
-through the registered operator, exactly as an animator runs it from the panel.
+through the registered operator, exactly as an animator runs it from the panel; a composition
+(`render_compositions`) bakes several gestures on overlapping frames of one character, in order.
 """
 from dataclasses import dataclass, field
 from pathlib import Path
-
-import numpy as np
 
 from trainer.blender_io.rig_session import blender_output, import_bpy, load_rig, new_empty_scene
 from trainer.paths import SAMPLE_RIG_BLEND
@@ -24,7 +23,8 @@ class RenderRequest:
     """One Generate Gesture call: the panel's settings (Scene.rlanimate names) and a row title."""
     title: str
     settings: dict
-    target: tuple = None  # character-frame position of a target sphere for a target behaviour (POINT, GUIDE)
+    #: character-frame position of a target sphere for a target behaviour (POINT, GUIDE)
+    target: tuple[float, ...] | None = None
     frames: list = field(default_factory=list)  # filled by render_requests: (frame, png path)
 
 
@@ -79,10 +79,19 @@ def _target_sphere(bpy, name, location):
     return sphere
 
 
-def render_requests(requests, out_dir, agent_path=None, rig_path=SAMPLE_RIG_BLEND):
-    """Bake each RenderRequest with Generate Gesture and render its KEY_FRACTIONS frames into out_dir;
-    returns the requests with `frames` filled. agent_path: an agent file for the add-on's preferences
-    (default: the bundled agent)."""
+@dataclass
+class Composition:
+    """Gestures baked in order on one character (each its panel settings, with start_frame, and a target
+    position or None), and the frames rendered of them, with a row title."""
+    title: str
+    gestures: list
+    shown: tuple
+    frames: list = field(default_factory=list)  # filled by render_compositions: (frame, png path)
+
+
+def _staged_rig(agent_path, rig_path):
+    """A fresh scene with the add-on enabled (and the agent file chosen), the character and the stage; returns
+    the armature."""
     bpy = import_bpy()
     import addon_utils  # Blender's own module, importable once bpy is
     new_empty_scene()
@@ -91,6 +100,47 @@ def render_requests(requests, out_dir, agent_path=None, rig_path=SAMPLE_RIG_BLEN
         bpy.context.preferences.addons[ADDON].preferences.agent_path = str(agent_path)
     rig = load_rig(rig_path, with_mesh=True)
     _stage(bpy)
+    return rig
+
+
+def _render(bpy, frame, path):
+    scene = bpy.context.scene
+    scene.frame_set(frame)
+    scene.render.filepath = str(path)
+    with blender_output():  # Cycles' progress and 'Saved: ...' lines
+        bpy.ops.render.render(write_still=True)
+
+
+def render_compositions(compositions, out_dir, agent_path=None, rig_path=SAMPLE_RIG_BLEND):
+    """Bake each Composition's gestures in order with Generate Gesture on a character of its own (a fresh
+    scene) and render its `shown` frames into out_dir; returns the compositions with `frames` filled."""
+    bpy = import_bpy()
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for k, composition in enumerate(compositions):
+        rig = _staged_rig(agent_path, rig_path)
+        settings = bpy.context.scene.rlanimate
+        for j, (values, target) in enumerate(composition.gestures):
+            for key, value in values.items():
+                setattr(settings, key, value)
+            settings.target = None if target is None else _target_sphere(bpy, f"Target{j}", target)
+            bpy.context.view_layer.objects.active = rig
+            if bpy.ops.rlanimate.generate_gesture() != {"FINISHED"}:
+                raise RuntimeError(f"Generate Gesture failed for {composition.title!r}")
+        composition.frames = []
+        for frame in composition.shown:
+            path = out_dir / f"composition{k:02d}_frame{frame:05d}.png"
+            _render(bpy, frame, path)
+            composition.frames.append((frame, path))
+    return compositions
+
+
+def render_requests(requests, out_dir, agent_path=None, rig_path=SAMPLE_RIG_BLEND):
+    """Bake each RenderRequest with Generate Gesture and render its KEY_FRACTIONS frames into out_dir;
+    returns the requests with `frames` filled. agent_path: an agent file for the add-on's preferences
+    (default: the bundled agent)."""
+    bpy = import_bpy()
+    rig = _staged_rig(agent_path, rig_path)
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     scene = bpy.context.scene
@@ -110,11 +160,8 @@ def render_requests(requests, out_dir, agent_path=None, rig_path=SAMPLE_RIG_BLEN
         request.frames = []
         for fraction in KEY_FRACTIONS:
             frame = start + int(round(fraction * (settings.frame_count - 1)))
-            scene.frame_set(frame)
             path = out_dir / f"request{k:02d}_frame{frame:05d}.png"
-            scene.render.filepath = str(path)
-            with blender_output():  # Cycles' progress and 'Saved: ...' lines
-                bpy.ops.render.render(write_still=True)
+            _render(bpy, frame, path)
             request.frames.append((frame - start, path))
         if target is not None:
             target.hide_render = True  # only this request's target shows in its own frames

@@ -81,7 +81,7 @@ class ProceduralIK:
         self._constraint = (pose_bone, constraint)
 
     def _set_pose(self, rotvecs):
-        for joint, rotvec in zip(skeleton.ACTION_JOINTS, rotvecs):
+        for joint, rotvec in zip(skeleton.ACTION_JOINTS, rotvecs, strict=True):
             bone = self._pose_bones[joint]
             bone.rotation_mode = "QUATERNION"
             bone.rotation_quaternion = rotations.rotvec_to_quat(rotvec)

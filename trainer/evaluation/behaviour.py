@@ -12,7 +12,6 @@ score against the time-scaled reference and the DTW time-aligned score. POINT is
 method's own aim, or after aim correction (`aim.aim_at`) with exact_aim.
 """
 import numpy as np
-
 from scipy.stats import spearmanr
 
 from rlanimate_addon.core import aim, behaviours, metrics, skeleton, spaces
@@ -192,7 +191,7 @@ def summarise(rows):
     for behaviour in sorted({r["behaviour"] for r in rows}):
         group = [r for r in rows if r["behaviour"] == behaviour]
 
-        def values(key):
+        def values(key, group=group):
             return np.array([r[key] for r in group], dtype=np.float64)
 
         entry = {"requests": len(group)}
@@ -206,7 +205,10 @@ def summarise(rows):
                 entry[f"{key}_median"] = float(np.nanmedian(values(key)))
             entry["swing_ratio_min"], entry["swing_ratio_max"] = (float(values("swing_ratio").min()),
                                                                   float(values("swing_ratio").max()))
-            entry["cycles_min"], entry["cycles_median"] = float(values("cycles").min()), float(np.median(values("cycles")))
+            entry["cycles_min"], entry["cycles_median"] = (
+                float(values("cycles").min()),
+                float(np.median(values("cycles"))),
+            )
             entry["accepted_share"] = float(values("wave_accepted").mean())
         elif "pointing_angle" in group[0]:
             entry["pointing_angle_median"] = float(np.median(values("pointing_angle")))

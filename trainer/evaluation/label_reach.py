@@ -57,8 +57,17 @@ def label_reach(train_read, test_read) -> dict:
             in_reach = [name for hz, name in nearby if RATE_TOLERANCE[0] <= hz / tempo <= RATE_TOLERANCE[1]]
             near[str(width)] = {"waves": len(nearby), "styles": sorted({name for _, name in nearby}),
                                 "in_reach": len(in_reach), "in_reach_styles": sorted(set(in_reach))}
-        medians = np.array([np.median([rule.draw(_label(clip), arm=clip.arm).frequency * fps / hz
-                                       for (clip, _), hz in zip(waves, tempos)]) for rule in rules])  # (rules,)
+        medians = np.array(
+            [
+                np.median(
+                    [
+                        rule.draw(_label(clip), arm=clip.arm).frequency * fps / hz
+                        for (clip, _), hz in zip(waves, tempos, strict=True)
+                    ]
+                )
+                for rule in rules
+            ]
+        )  # (rules,)
         within = (medians >= RATE_TOLERANCE[0]) & (medians <= RATE_TOLERANCE[1])
         in_band &= within
         table[style] = {"takes": len(waves), "labels": (float(labels.min()), float(labels.max())), "tempo_hz": tempo,

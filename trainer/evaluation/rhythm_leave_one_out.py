@@ -21,7 +21,7 @@ def leave_one_out(exaggerations, rhythms, frame_counts, typical_tempo, tempo_ban
     or off, its tempo kernel's sd in log Hz, exaggeration kernel's sd and `by_arm` (None: rhythm's defaults)."""
     exaggerations = np.asarray(exaggerations, dtype=np.float64)
     within, log_errors, correlations = [], [], []
-    for left_out, (own, frames) in enumerate(zip(rhythms, frame_counts)):
+    for left_out, (own, frames) in enumerate(zip(rhythms, frame_counts, strict=True)):
         keep = [k for k in range(len(rhythms)) if k != left_out]
         model = rhythm.RhythmModel.fit(exaggerations[keep], [rhythms[k] for k in keep],
                                        None if arms is None else [arms[k] for k in keep])

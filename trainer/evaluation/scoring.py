@@ -14,7 +14,6 @@ from functools import partial
 import numpy as np
 
 from rlanimate_addon.core import behaviour_metrics, behaviours, metrics, spaces
-
 from trainer.agent.algorithm import clip_objective, rollout_actions
 from trainer.evaluation.behaviour import clip_target, summarise
 
@@ -85,7 +84,9 @@ def score_descriptions(clips, descriptions, references):
     """The one scorer: {'score', 'smoothness', 'by_behaviour': {behaviour: summarise's entry}, 'clips':
     [clip_row]} of generated (F_i, 42) `descriptions` against each clip's own FK (references:
     motion.fk.ClipReferences): means over the clips, per behaviour, per clip."""
-    rows = [clip_row(clip, generated, references.get(clip)[0]) for clip, generated in zip(clips, descriptions)]
+    rows = [
+        clip_row(clip, generated, references.get(clip)[0]) for clip, generated in zip(clips, descriptions, strict=True)
+    ]
     return {"score": float(np.mean([r["score"] for r in rows])),
             "smoothness": float(np.mean([r["smoothness"] for r in rows])),
             "by_behaviour": summarise(rows), "clips": rows}

@@ -6,8 +6,9 @@ command line.
 
 Waves: the rhythm in the objective with the waving-wrist term (the default), without the wrist term,
 the paper's objective (exaggeration only), and the stochastic behaviour state carrying the wave
-(single_state, its posterior on the clip's description during updates, its prior at play). Points: the pointing term with random targets (the default),
-without the random targets, and with neither. Runs that already finished are not trained again.
+(single_state, its posterior on the clip's description during updates, its prior at play). Points: the pointing
+term with random targets (the default), without the random targets, and with neither. Runs that already
+finished are not trained again.
 """
 import json
 from dataclasses import dataclass
@@ -17,6 +18,7 @@ import numpy as np
 import torch
 
 from rlanimate_addon.core import behaviours, kinematics, spaces
+from trainer.agent import checkpoint
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
@@ -82,23 +84,40 @@ def measure(path, behaviour_name, session, target_count):
 
 
 def markdown(results, command):
-    lines = ["# Issue 10's agent choices against their alternatives", "",
-             "One-behaviour agents (preset `default` or the named ablation preset, seed 0, 50 epochs), measured with "
-             "`core.behaviour_metrics` (docs/METRICS.md) on the sample library's held-out requests at each clip's "
-             "own length, deterministic rollouts of the numpy runtime; T: the run's updates per epoch; seeded = variation seeds "
-             f"{', '.join(map(str, SEEDS))}. Regenerate: `{command}`.", "", "## Wave (4 held-out requests)", ""]
+    lines = [
+        "# Issue 10's agent choices against their alternatives",
+        "",
+        "One-behaviour agents (preset `default` or the named ablation preset, seed 0, 50 epochs), measured with "
+        "`core.behaviour_metrics` (docs/METRICS.md) on the sample library's held-out requests at each clip's "
+        "own length, deterministic rollouts of the numpy runtime; T: the run's updates per epoch; "
+        "seeded = variation seeds "
+        f"{', '.join(map(str, SEEDS))}. Regenerate: `{command}`.",
+        "",
+        "## Wave (4 held-out requests)",
+        "",
+    ]
     rows = []
     for name, result in results.items():
         if ABLATIONS[name][0] != "wave":
             continue
         held, seeded = result["held_out"], result["seeded"]
-        rows.append([ABLATIONS[name][3], result["update_steps"], f"{held['accepted_share'] * 4:.0f} / 4",
-                     f"{seeded['accepted_share'] * 4 * len(SEEDS):.0f} / {4 * len(SEEDS)}",
-                     f"{held['swing_ratio_min']:.2f} / {held['swing_ratio_median']:.2f} / {held['swing_ratio_max']:.2f}",
-                     f"{held['frequency_ratio_median']:.2f}", f"{held['cycles_min']:.0f} / {held['cycles_median']:.1f}",
-                     "yes" if all(s["swing_rising"] for s in result["sweep"].values()) else "no",
-                     f"{100 * result['variation']:.1f}", f"{held['elevation_first_error_max']:.1f}",
-                     f"{held['elevation_last_error_max']:.1f}", f"{held['score']:.2f}", f"{held['smoothness']:.2f}"])
+        rows.append(
+            [
+                ABLATIONS[name][3],
+                result["update_steps"],
+                f"{held['accepted_share'] * 4:.0f} / 4",
+                f"{seeded['accepted_share'] * 4 * len(SEEDS):.0f} / {4 * len(SEEDS)}",
+                f"{held['swing_ratio_min']:.2f} / {held['swing_ratio_median']:.2f} / {held['swing_ratio_max']:.2f}",
+                f"{held['frequency_ratio_median']:.2f}",
+                f"{held['cycles_min']:.0f} / {held['cycles_median']:.1f}",
+                "yes" if all(s["swing_rising"] for s in result["sweep"].values()) else "no",
+                f"{100 * result['variation']:.1f}",
+                f"{held['elevation_first_error_max']:.1f}",
+                f"{held['elevation_last_error_max']:.1f}",
+                f"{held['score']:.2f}",
+                f"{held['smoothness']:.2f}",
+            ]
+        )
     lines += markdown_table(["method", "T", "accepted", "accepted, seeded", "swing ratio min / median / max",
                              "frequency ratio", "cycles min / median", "swing rises with exaggeration",
                              "seed variation (cm)", "first-frame elevation error (deg, max)",
@@ -126,9 +145,11 @@ def run_ablation(settings: AblationSettings) -> str:
     agent_ablation.json and .md into `settings.results`; returns the markdown."""
     torch.set_num_threads(1)
     names = settings.only or tuple(ABLATIONS)
-    untrained = [RunSettings(str(Path(settings.runs) / name), behaviour=ABLATIONS[name][0], preset=ABLATIONS[name][1],
-                             variant=ABLATIONS[name][2], eval_every=0, progress=False)
-                 for name in names if not (Path(settings.runs) / name / "report.json").is_file()]
+    folders = {name: Path(settings.runs) / name for name in names}
+    untrained = [RunSettings(str(folders[name]), behaviour=ABLATIONS[name][0], preset=ABLATIONS[name][1],
+                             variant=ABLATIONS[name][2], eval_every=0, progress=False,
+                             resume=(folders[name] / checkpoint.FILENAME).is_file())  # a stopped run continues
+                 for name in names if not (folders[name] / "report.json").is_file()]
     for run, _ in train_runs(untrained, settings.address, settings.workers):
         print(f"trained {Path(run.output).name}", flush=True)
     session = LibrarySession(DEFAULT_MANIFEST)

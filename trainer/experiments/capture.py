@@ -34,7 +34,7 @@ from trainer.reporting.plots import gesture_hand_paths, wave_hand_paths
 
 #: What a capture-folder run trains by default where the command line says nothing: the recipe chosen on real
 #: capture's validation takes (docs/REALMOCAP.md).
-CAPTURE_DEFAULTS = {"preset": "end_chunks", "epochs": 100}
+CAPTURE_DEFAULTS: dict[str, Any] = {"preset": "end_chunks", "epochs": 100}
 MANIFEST = "manifest.json"
 REPORT = "capture_report"
 PATHS_FIGURE = "capture_hand_paths.png"
@@ -126,8 +126,9 @@ def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
     label: the take, the agent and retrieval (a wave asked its tempo) into `path`, the waves' side to side where there
     are waves, else the other gestures' held reach; the takes drawn."""
     agent = baselines.AgentMethod(agent_path)
-    methods = {"RLAnimate": agent, "retrieval": baselines.NearestClip(session.train_clips)}
-    waves, held = [], []
+    methods: dict[str, Any] = {"RLAnimate": agent, "retrieval": baselines.NearestClip(session.train_clips)}
+    waves: list[Any] = []
+    held: list[Any] = []
     for behaviour in agent.agent.behaviours:
         takes = sorted((c for c in session.test_clips if c.behaviour == behaviour),
                        key=lambda c: float(np.ravel(c.attributes)[0]))

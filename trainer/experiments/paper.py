@@ -107,7 +107,7 @@ def evaluate_runs(settings, runs, session):
         for column in settings.columns:
             wanted = [c for c in clips if c.behaviour in behaviours.training_set(column, spaces.PAPER_SPACE.names)]
             entry = results.setdefault(split, {}).setdefault(column, {})
-            for (seed, variant, run_column), folder in sorted(runs.items()):
+            for (_seed, variant, run_column), folder in sorted(runs.items()):
                 if run_column == column:
                     entry.setdefault(variant, []).append(summary(AgentMethod(folder / "agent.npz"), wanted))
             for name, method in baselines.items():
@@ -121,7 +121,7 @@ def random_target_aim(settings, runs, session):
     class-average pointing length."""
     frames = behaviour.class_lengths(session.train_clips)[behaviours.POINT]
     results = {}
-    for (seed, variant, column), folder in sorted(runs.items()):
+    for (_seed, variant, column), folder in sorted(runs.items()):
         if behaviours.POINT in behaviours.training_set(column, spaces.PAPER_SPACE.names):
             sweeps = behaviour.random_target_sweeps(AgentMethod(folder / "agent.npz"), frames, session.describe,
                                                      RANDOM_TARGETS)
@@ -133,7 +133,7 @@ def random_target_aim(settings, runs, session):
 def aggregate(per_seed: list[dict]) -> dict:
     """[summary per seed] -> {behaviour: {metric: {mean, sd, n}}}; sd 0 for one value, NaN values (a ratio
     to a zero reference) left out."""
-    out = {}
+    out: dict[str, dict[str, dict[str, float | int | None]]] = {}
     for key in per_seed[0]:
         out[key] = {}
         for metric in per_seed[0][key]:

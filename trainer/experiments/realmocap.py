@@ -39,9 +39,10 @@ import torch
 from rlanimate_addon.core import behaviour_metrics, behaviours, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
-from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip, import_into_cache
+from trainer.blender_io.clip_import import EXPECTED_FPS, import_clip
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.fk_env import FKEnvironment
+from trainer.blender_io.import_worker import import_into_cache
 from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.cluster import connect, run_tasks
@@ -51,11 +52,27 @@ from trainer.experiments.run import RunSettings, is_finished, train_logged, trai
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
 from trainer.motion.hands import relaxed_hand
-from trainer.motion.realmocap_takes import (GUIDE_TARGET_DISTANCE, HOLDOUT_STYLES, PAPER_LABELS, TAKE_GROUPS,
-                                            parse_name, require_realmocap, style_holdout_split,
-                                            take_group, take_paths, wave_split)
-from trainer.paths import (DEFAULT_MANIFEST, INSTALLED_AGENT, REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR, seed_folder,
-                           shown)
+from trainer.motion.realmocap_takes import (
+    GUIDE_TARGET_DISTANCE,
+    HOLDOUT_STYLES,
+    PAPER_LABELS,
+    TAKE_GROUPS,
+    parse_name,
+    require_realmocap,
+    style_holdout_split,
+    take_group,
+    take_paths,
+    wave_split,
+)
+from trainer.paths import (
+    DEFAULT_MANIFEST,
+    INSTALLED_AGENT,
+    REALMOCAP_DIR,
+    REALMOCAP_RUNS,
+    RESULTS_DIR,
+    seed_folder,
+    shown,
+)
 from trainer.reporting.realmocap_report import frames_figure, seed_summary
 
 
@@ -83,7 +100,7 @@ def load_folder(folder, root=REALMOCAP_DIR, cache_dir=REALMOCAP_RUNS / "import_c
                 labels=PAPER_LABELS):
     """Every clip of root/folder ('wave', 'bye' or 'guide') but the withheld takes, sorted by name, labelled
     as `labels` says (import_real_clip); import_workers > 1: the takes the cache lacks are imported by that
-    many Ray tasks first (clip_import.import_into_cache)."""
+    many import workers first (import_worker.import_into_cache)."""
     paths = take_paths(require_realmocap(root) / folder)
     if import_workers > 1:
         import_into_cache([(p, EXPECTED_FPS) for p in paths], Path(cache_dir), import_workers)
@@ -103,8 +120,8 @@ def waves_and_env(realmocap=REALMOCAP_DIR, runs=REALMOCAP_RUNS):
 
 
 class RealSession:
-    """What trainer.experiments.run.train needs (env, references, train_clips, test_clips, problems), over real clips (every one
-    imported: a take that does not import stops the experiment)."""
+    """What trainer.experiments.run.train needs (env, references, train_clips, test_clips, problems), over real clips
+    (every one imported: a take that does not import stops the experiment)."""
 
     def __init__(self, env, references, train_clips, test_clips):
         self.env, self.references, self.problems = env, references, []
@@ -131,7 +148,7 @@ def guide_angles(method, clips, env):
     """Per guide clip: the angle (deg) between generated and real forearm directions at their holds."""
     rows = []
     motions = baselines.generate_for(method, clips)
-    for clip, motion in zip(clips, motions):
+    for clip, motion in zip(clips, motions, strict=True):
         real = env.evaluate(clip.rotvecs)
         generated = env.evaluate(motion)
         hold = autolabel.label_point(motion, clip.arm).hold_frame
@@ -192,7 +209,7 @@ def train_real_runs(runs, address=None, workers=None):
     pending = [run for run in runs if not is_finished(Path(run.settings.output), run.settings.epochs)]
     if pending:
         connect(address, workers)
-        for run, _ in run_tasks(train_real, pending):
+        for run, _ in run_tasks(train_real, pending, name=lambda run: f"The run in {run.settings.output}"):
             print(f"realmocap: trained {shown(run.settings.output)}", flush=True)
     return {run.settings.output: json.loads((Path(run.settings.output) / "report.json").read_text()) for run in runs}
 
@@ -214,7 +231,7 @@ def compare(methods, clips, env, references, with_tempo=False):
         result = scoring.score_motions(env, motions, clips, references)
         if all(c.behaviour == behaviours.WAVE for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
-                                                   for m, c in zip(motions, clips)]))
+                                                   for m, c in zip(motions, clips, strict=True)]))
         if fallbacks:
             result["tempo_fallbacks"] = fallbacks
         results[name] = result
@@ -230,10 +247,17 @@ def label_table(clips):
         entry["elevation"].append(clip.label.elevation)
         entry["stroke"].append(clip.label.stroke)
         entry["arm_correct"].append(clip.named_arm is None or clip.named_arm == clip.arm)
-    return {style: {"clips": len(v["exaggeration"]), "exaggeration": float(np.mean(v["exaggeration"])),
-                    "exaggeration_sd": float(np.std(v["exaggeration"])), "elevation_deg": float(np.mean(v["elevation"])),
-                    "stroke_arm_lengths": float(np.mean(v["stroke"])), "arm_correct": int(np.sum(v["arm_correct"]))}
-            for style, v in sorted(table.items(), key=lambda item: np.mean(item[1]["exaggeration"]))}
+    return {
+        style: {
+            "clips": len(v["exaggeration"]),
+            "exaggeration": float(np.mean(v["exaggeration"])),
+            "exaggeration_sd": float(np.std(v["exaggeration"])),
+            "elevation_deg": float(np.mean(v["elevation"])),
+            "stroke_arm_lengths": float(np.mean(v["stroke"])),
+            "arm_correct": int(np.sum(v["arm_correct"])),
+        }
+        for style, v in sorted(table.items(), key=lambda item: np.mean(item[1]["exaggeration"]))
+    }
 
 
 def tempo_table(clips, references):
@@ -372,8 +396,14 @@ def run_experiments(settings: RealMocapSettings) -> dict:
         if name == "wave":
             chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
             generated = baselines.generate_for(methods["rlanimate"], chosen)
-            frames_figure(env, [(f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
-                                for c, g in zip(chosen, generated)], Path(settings.results) / "realmocap_frames.png")
+            frames_figure(
+                env,
+                [
+                    (f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
+                    for c, g in zip(chosen, generated, strict=True)
+                ],
+                Path(settings.results) / "realmocap_frames.png",
+            )
     results["evaluation_cpu_seconds"] = time.process_time() - evaluation_started
 
     try:

@@ -75,7 +75,8 @@ SEEDS = (1, 2, 3)
 EARLIER_KERNELS = {"bandwidth": 0.05, "tempo_bandwidth": EARLIER_TEMPO_BANDWIDTH}
 VARIANTS = (Variant("typical tempo (as exported)", typical_tempo=True),
             Variant("mean rhythm, all waves' phase", typical_tempo=False, bandwidth=EARLIER_KERNELS["bandwidth"]),
-            Variant("typical tempo, the kernels before (sd 0.05, log 1.25)", typical_tempo=True, **EARLIER_KERNELS),
+            Variant("typical tempo, the kernels before (sd 0.05, log 1.25)", typical_tempo=True,
+                    bandwidth=EARLIER_KERNELS["bandwidth"], tempo_bandwidth=EARLIER_KERNELS["tempo_bandwidth"]),
             Variant("typical tempo, the request's arm's waves", typical_tempo=True, by_arm=True),
             *(Variant(f"sampled states {seed}: typical tempo", typical_tempo=True, state_seed=seed) for seed in SEEDS),
             *(Variant(f"seed {seed}: a nearby wave's rhythm, random phase, sampled states", typical_tempo=True,
@@ -215,7 +216,7 @@ def run_ablation(settings: AblationSettings) -> dict:
     waves, env = waves_and_env(settings.realmocap, settings.runs)
     references = ClipReferences(env)
     splits = {name: EXPERIMENTS[name][0](waves) for name in settings.experiments}
-    presets = {None: settings.preset, **{preset: preset for preset in settings.compare_presets}}
+    presets: dict[str | None, str] = {None: settings.preset, **{preset: preset for preset in settings.compare_presets}}
     runs = {(name, key): real_run(name, train, test, settings.seed, replace(settings, preset=preset))
             for name, (train, test) in splits.items() for key, preset in presets.items()}
     reports = train_real_runs(runs.values(), workers=settings.workers)

@@ -11,11 +11,11 @@ does (takes 001-008 and 021-036 train, 009-010 test; 011-020 never read).
 
 One agent per seed (epochs from the settings) trains on every training take as a Ray task
 (realmocap.train_real) into runs/realmocap/gestures/ (seed 0) or runs/realmocap_seed<N>/gestures/. The first
-seed's agent gives the full tables and the figure; every seed's is scored on the held-out sets ("seeds"). Retrieval answers the same requests from the same
-training clips. Each test set is scored as realmocap.md scores the waves (score, DTW score), with the
-behaviour's metrics: a guide take with the guide metrics towards a target along its held direction
-(realmocap_takes.GUIDE_TARGET_DISTANCE), a goodbye wave with the wave metrics (generated as BYE, measured
-as a wave).
+seed's agent gives the full tables and the figure; every seed's is scored on the held-out sets ("seeds").
+Retrieval answers the same requests from the same training clips. Each test set is scored as realmocap.md
+scores the waves (score, DTW score), with the behaviour's metrics: a guide take with the guide metrics
+towards a target along its held direction (realmocap_takes.GUIDE_TARGET_DISTANCE), a goodbye wave with the wave
+metrics (generated as BYE, measured as a wave).
 """
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -28,8 +28,13 @@ from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines, scoring
 from trainer.experiments.realmocap import load_folder, real_run, train_real_runs
 from trainer.motion.fk import ClipReferences
-from trainer.motion.realmocap_takes import (GESTURE_LABELS, gesture_split, gesture_test_styles, require_realmocap,
-                                            wave_split)
+from trainer.motion.realmocap_takes import (
+    GESTURE_LABELS,
+    gesture_split,
+    gesture_test_styles,
+    require_realmocap,
+    wave_split,
+)
 from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.realmocap_gestures_report import held_out_summary
 
@@ -117,9 +122,9 @@ def run_experiment(settings: GestureSettings) -> tuple[dict, dict]:
     for name in HELD_OUT_SETS:
         per_seed = {str(seeds[0]): held_out_summary(results["sets"][name]["rlanimate"])}
         per_seed.update({str(seed): held_out_summary(score(agent, sets[name], env))
-                         for seed, agent in zip(seeds[1:], agents[1:])})
+                         for seed, agent in zip(seeds[1:], agents[1:], strict=True)})
         results["seed_sets"][name] = {"rlanimate": per_seed,
                                       "nearest_clip": held_out_summary(results["sets"][name]["nearest_clip"])}
     results["train_seconds_per_seed"] = {str(seed): reports[run.settings.output]["train_seconds"]
-                                         for seed, run in zip(seeds, runs)}
+                                         for seed, run in zip(seeds, runs, strict=True)}
     return results, {"env": env, "methods": methods, "sets": sets}

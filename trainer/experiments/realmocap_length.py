@@ -21,6 +21,7 @@ requests with each exaggeration kernel of `exaggeration_kernels` (core/rhythm.py
 import math
 import time
 from dataclasses import dataclass
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -29,8 +30,7 @@ from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import swinging_check
-from trainer.experiments.realmocap import (REQUESTS, RealMocapSettings, compare, real_run, train_real_runs,
-                                           waves_and_env)
+from trainer.experiments.realmocap import REQUESTS, RealMocapSettings, compare, real_run, train_real_runs, waves_and_env
 from trainer.experiments.realmocap_ablation import VariantMethod
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
@@ -61,7 +61,11 @@ class LengthSettings:
     workers: int | None = None
 
     def __post_init__(self):
-        if not self.lengths or any(b <= a for a, b in zip(self.lengths, self.lengths[1:])) or self.lengths[0] < 1:
+        if (
+            not self.lengths
+            or any(b <= a for a, b in pairwise(self.lengths))
+            or self.lengths[0] < 1
+        ):
             raise RLAnimateError(f"--lengths {' '.join(map(str, self.lengths))}: give rising epoch counts of at "
                                  f"least 1, such as 50 100 200.")
         if not self.exaggeration_kernels or min(self.exaggeration_kernels) <= 0:

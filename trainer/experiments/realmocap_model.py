@@ -12,6 +12,7 @@ last-frame elevation error of each style (the issue's bars).
 import time
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -66,11 +67,12 @@ def run_models(settings: ModelSettings) -> dict:
                                            RealMocapSettings(epochs=settings.epochs, preset=preset, runs=settings.runs))
             for preset in settings.presets for seed in settings.seeds for name, (train, validation) in splits.items()}
     reports = train_real_runs(runs.values(), workers=settings.workers)
+    experiments: dict[str, Any] = {}
     results = {"command": command_line(settings), "epochs": settings.epochs, "presets": list(settings.presets),
-               "seeds": list(settings.seeds), "experiments": {}}
+               "seeds": list(settings.seeds), "experiments": experiments}
     for name, (train, validation) in splits.items():
         retrieval = baselines.NearestClip(train)
-        entry = results["experiments"][name] = {
+        entry = experiments[name] = {
             "validates": EXPERIMENTS[name][1], "train_clips": len(train), "validation_clips": len(validation),
             "retrieval": {suffix or "paper": validation_summary(compare({"r": retrieval}, validation, env, references,
                                                                         with_tempo)["r"])

@@ -10,6 +10,7 @@ own LibrarySession and pinned to one torch thread, so each is bit for bit the ru
 import json
 import os
 import random
+import shutil
 import sys
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
@@ -33,7 +34,8 @@ from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
 from trainer.motion.autolabel import still_free_arm
-from trainer.motion.clip import training_space
+from trainer.motion.clip import trained_behaviours, training_space
+from trainer.motion.library_checks import check_new_behaviours, left_out
 from trainer.motion.manifest import manifest_path
 from trainer.paths import DEFAULT_MANIFEST
 from trainer.reporting import plots
@@ -57,6 +59,8 @@ class RunSettings:
     variant: str = None  # ablation variant (Table 4)
     eval_every: int = None  # evaluate on seen and unseen clips every N epochs (0: only at the end)
     resume: bool = False  # continue the run in `output` from its checkpoint
+    overwrite: bool = False  # replace the run in `output` (without it, a new run there is refused)
+    allow_new_behaviour: bool = False  # "all" trains a new behaviour that fewer than 3 clips name
     checkpoint_every: int = 1
     progress: bool = True  # show a progress bar
 
@@ -93,7 +97,7 @@ def check_settings(settings: RunSettings) -> None:
         problems.append(f"--seed {settings.seed}: use a seed from 0 to {2 ** 32 - 1}")
     if settings.preset is not None and settings.preset not in PRESETS:
         problems.append(f"--preset {settings.preset}: unknown config preset; use one of {', '.join(PRESETS)}")
-    problems += _output_problems(settings.output)
+    problems += _output_problems(settings.output) or _existing_run_problems(settings)
     if problems:
         raise RLAnimateError("; ".join(problems) + ". Nothing was trained.")
 
@@ -110,6 +114,30 @@ def _output_problems(output):
         tempfile.TemporaryFile(dir=existing).close()
     except OSError as error:
         return [f"--output {output}: cannot write in {existing} ({error.strerror}); choose a folder you can write to"]
+    return []
+
+
+#: What a run writes in its folder: --overwrite removes them (and nothing else) before the new run writes.
+RUN_OUTPUTS = ("agent.npz", checkpoint.FILENAME, "metrics.jsonl", "report.json", "report.md", "training_curves.png",
+               "tensorboard")
+
+
+def _existing_run_problems(settings: RunSettings) -> list[str]:
+    """[] when a run may start in `settings.output`, else the one problem: --resume with --overwrite, or a
+    new run into the folder of another run (finished: its agent.npz; stopped: its checkpoint) without
+    --overwrite."""
+    output = Path(settings.output)
+    if settings.resume and settings.overwrite:
+        return [f"--resume and --overwrite: give one (--resume continues the run in {output}, --overwrite "
+                "replaces it with a new one)"]
+    if settings.resume or settings.overwrite:
+        return []
+    if (output / "agent.npz").is_file():
+        return [f"--output {output} holds a finished run (its agent.npz): choose another --output, or add "
+                "--overwrite to replace that run"]
+    if (output / checkpoint.FILENAME).is_file():
+        return [f"--output {output} holds a run that has not finished (its {checkpoint.FILENAME}): continue it "
+                "with --resume, or add --overwrite to replace it"]
     return []
 
 
@@ -178,25 +206,10 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     one); returns (report dict, Trainer). report.json lists the clips the session skipped."""
     torch.set_num_threads(1)
     output = Path(settings.output)
-    output.mkdir(parents=True, exist_ok=True)
     saved = checkpoint.load(output / checkpoint.FILENAME) if settings.resume else None
     settings = _resolved(settings, saved)
-    agent_config, train_config = load_preset(settings.preset)
-    space = training_space(session.train_clips, settings.behaviour)
-    trained = space.names
-    epochs = settings.epochs or (train_config.epochs_both if len(trained) > 1 else train_config.epochs_single)
-
-    seed_everything(settings.seed)
-    agent = RLAnimateAgent(agent_config, settings.variant, space)
-    trainer = Trainer(agent, session.env, session.train_clips, train_config, settings.behaviour, settings.seed,
-                      references=session.references, epochs=epochs)
-    if not select_clips(session.test_clips, trainer.trained):
-        held_out = " or ".join(behaviours.key(b) for b in trainer.trained)
-        print(f"note: the library has no held-out {held_out} clips (split \"test\"): the run is scored on "
-              "training clips only. Mark some clips \"split\": \"test\" in the manifest to measure unseen requests.",
-              file=sys.stderr)
-    if saved is not None:
-        trainer.load_state_dict(saved["trainer"])
+    trainer, epochs = _trainer(settings, session, saved)
+    _prepare_output(settings)
     arguments = {**{name: getattr(settings, name) for name in RESUMED_SETTINGS}, "epochs": epochs}
     log = MetricsLog(output, trainer.history)
     bar = tqdm(range(trainer.epoch, epochs), initial=trainer.epoch, total=epochs, disable=not settings.progress,
@@ -221,6 +234,46 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     plots.training_curves(trainer.history, output / "training_curves.png",
                           title=f"{settings.variant}, {settings.behaviour}")
     return report, trainer
+
+
+def _trainer(settings: RunSettings, session: Any, saved: dict | None) -> tuple[Trainer, int]:
+    """(Trainer, planned epochs) of the resolved `settings` on `session`, from the checkpoint `saved` when
+    resuming; a new run with "all" first says which of the library's behaviours it leaves out, and refuses
+    a new behaviour that fewer than 3 clips name (library_checks)."""
+    agent_config, train_config = load_preset(settings.preset)
+    trained = trained_behaviours(session.train_clips, settings.behaviour)
+    if settings.behaviour == behaviours.ALL:
+        if saved is None and not settings.allow_new_behaviour:
+            check_new_behaviours([*session.train_clips, *session.test_clips], trained)
+        note = left_out(session.train_clips, session.test_clips, trained)
+        if note:
+            print(note, file=sys.stderr)
+    epochs = settings.epochs or (train_config.epochs_both if len(trained) > 1 else train_config.epochs_single)
+    seed_everything(settings.seed)
+    agent = RLAnimateAgent(agent_config, settings.variant, training_space(session.train_clips, settings.behaviour))
+    trainer = Trainer(agent, session.env, session.train_clips, train_config, settings.behaviour, settings.seed,
+                      references=session.references, epochs=epochs)
+    if not select_clips(session.test_clips, trainer.trained):
+        held_out = " or ".join(behaviours.key(b) for b in trainer.trained)
+        print(f"note: the library has no held-out {held_out} clips (split \"test\"): the run is scored on "
+              "training clips only. Mark some clips \"split\": \"test\" in the manifest to measure unseen requests.",
+              file=sys.stderr)
+    if saved is not None:
+        trainer.load_state_dict(saved["trainer"])
+    return trainer, epochs
+
+
+def _prepare_output(settings: RunSettings) -> None:
+    """Make the run's folder, once every check has passed (so a refused run leaves none); with --overwrite,
+    first remove the files of the run it replaces (RUN_OUTPUTS)."""
+    output = Path(settings.output)
+    if settings.overwrite:
+        for path in (output / name for name in RUN_OUTPUTS):
+            if path.is_dir():
+                shutil.rmtree(path)
+            elif path.exists():
+                path.unlink()
+    output.mkdir(parents=True, exist_ok=True)
 
 
 def _flatten(evaluation):
@@ -293,7 +346,7 @@ def train_runs(runs: Iterable[RunSettings], address: str | None = None,
     runs = list(runs)
     if runs:
         connect(address, workers)
-        yield from run_tasks(train_logged, runs)
+        yield from run_tasks(train_logged, runs, name=lambda run: f"The run in {run.output}")
 
 
 @contextmanager
@@ -310,6 +363,6 @@ def _output_to(path):
         finally:
             sys.stdout.flush()
             sys.stderr.flush()
-            for descriptor, copy in zip((1, 2), saved):
+            for descriptor, copy in zip((1, 2), saved, strict=True):
                 os.dup2(copy, descriptor)
                 os.close(copy)

@@ -213,7 +213,7 @@ def free_arm_shift(rotvecs, arm) -> float:
 def still_free_arm(clips) -> list[str]:
     """The ids of the behaviours among `clips` (MotionClips with behaviour and arm) whose free arm has no part in
     them: the median free_arm_shift of their clips is at most FREE_ARM_STILL."""
-    shifts = {}
+    shifts: dict[str, list[float]] = {}
     for clip in clips:
         shifts.setdefault(clip.behaviour, []).append(free_arm_shift(clip.rotvecs, clip.arm))
     return sorted(b for b, values in shifts.items() if float(np.median(values)) <= FREE_ARM_STILL)

@@ -57,6 +57,7 @@ class TakeLabel:
         """The label the hold-out spreads over: the exaggeration, or the direction's azimuth (radians)."""
         if self.exaggeration is not None:
             return self.exaggeration
+        assert self.direction is not None, "a take is labelled with an exaggeration or a direction"
         return float(np.arctan2(self.direction[0], -self.direction[1]))
 
 
@@ -82,7 +83,8 @@ def label_take(path, clip: MotionClip) -> TakeLabel:
                            "goes); make it \"kind\": \"target\" in the manifest if it aims at something")
     if kind == behaviours.TARGET:
         read = autolabel.label_point(clip.rotvecs)
-        label.arm, label.direction = read.arm, tuple(float(v) for v in read.direction)
+        x, y, z = (float(v) for v in read.direction)
+        label.arm, label.direction = read.arm, (x, y, z)
     elif behaviour == behaviours.WAVE:
         read = autolabel.label_wave(clip.rotvecs, clip.fps)
         label.arm, label.exaggeration = read.arm, read.exaggeration
@@ -105,10 +107,11 @@ def place_elevations(labels: list[TakeLabel]) -> None:
     """Give each intensity take labelled by its elevation its exaggeration: where its elevation lies between
     the lowest (0) and highest (1) of its behaviour's takes (0.5 when they are all alike)."""
     for behaviour in {label.behaviour for label in labels if label.elevation is not None}:
-        group = [label for label in labels if label.behaviour == behaviour and label.elevation is not None]
-        low, high = min(lb.elevation for lb in group), max(lb.elevation for lb in group)
-        for label in group:
-            label.exaggeration = 0.5 if high - low < 1e-6 else (label.elevation - low) / (high - low)
+        group = [(label, label.elevation) for label in labels
+                 if label.behaviour == behaviour and label.elevation is not None]
+        low, high = min(e for _, e in group), max(e for _, e in group)
+        for label, elevation in group:
+            label.exaggeration = 0.5 if high - low < 1e-6 else (elevation - low) / (high - low)
 
 
 def hold_out(labels: list[TakeLabel], share: float = HOLD_OUT_SHARE) -> None:
@@ -134,7 +137,7 @@ def manifest(labels: list[TakeLabel], folder) -> dict:
             entry["direction"] = [round(v, 5) for v in label.direction]
             target = skeleton.shoulder_rest_position(label.arm) + TARGET_DISTANCE * np.asarray(label.direction)
             entry["target"] = [round(float(v), 4) for v in target]
-        else:
+        elif label.exaggeration is not None:
             entry["exaggeration"] = round(label.exaggeration, 4)
         if label.tempo is not None:
             entry["tempo_hz"] = round(label.tempo, 3)

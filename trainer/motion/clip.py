@@ -1,4 +1,5 @@
 """The motion-clip type: one clip on the canonical rig with its declared labels, and a labelled clip set."""
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -14,18 +15,18 @@ class MotionClip:
     fps: float
     rotvecs: np.ndarray  # (F, 15, 3) local rotation vectors of skeleton.ACTION_JOINTS
     fingers: dict = field(default_factory=dict)  # {canonical finger bone: (F, 3)}; empty without fingers
-    behaviour: str = None  # the behaviour's id: "POINT", "WAVE", or a user's own ("BECKON")
-    kind: str = None  # behaviours.TARGET or INTENSITY; None for POINT and WAVE is their known kind
-    arm: str = None  # "LEFT" or "RIGHT"
+    behaviour: str | None = None  # the behaviour's id: "POINT", "WAVE", or a user's own ("BECKON")
+    kind: str | None = None  # behaviours.TARGET or INTENSITY; None for POINT and WAVE is their known kind
+    arm: str | None = None  # "LEFT" or "RIGHT"
     attributes: object = None  # target kind: unit vector (3,) from the arm's shoulder; intensity: exaggeration
-    target: tuple = None
-    exaggeration: float = None
-    split: str = None  # "train" or "test"
+    target: tuple[float, ...] | None = None
+    exaggeration: float | None = None
+    split: str | None = None  # "train" or "test"
     label: object = None  # autolabel's WaveLabel or PointLabel, when labelled from the motion
-    content: str = None  # real mocap: what the take shows ("wave", "bye", "guide")
-    style: str = None  # real mocap: the actor's style ("normal", "elderly", ...)
-    take: str = None  # real mocap: the take number ("001")
-    named_arm: str = None  # real mocap: the arm the file name gives ("LEFT", "RIGHT" or None)
+    content: str | None = None  # real mocap: what the take shows ("wave", "bye", "guide")
+    style: str | None = None  # real mocap: the actor's style ("normal", "elderly", ...)
+    take: str | None = None  # real mocap: the take number ("001")
+    named_arm: str | None = None  # real mocap: the arm the file name gives ("LEFT", "RIGHT" or None)
 
     @property
     def frames(self):
@@ -45,11 +46,21 @@ def library_space(clips):
     return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 
+def trained_behaviours(clips: Sequence[MotionClip], training_set: str,
+                       order: Sequence[str] | None = None) -> tuple[str, ...]:
+    """The ids of the behaviours a run with the training set `training_set` ("all", "both", keys:
+    behaviours.training_set) trains on the training clips `clips`, in the objective order `order` (default
+    library_space(clips)'s): "all" is the behaviours the clips have, so a library of points alone, or one
+    whose waves are all held out, trains point although the paper's space it declares has wave too."""
+    names = library_space(clips).names if order is None else order
+    return behaviours.training_set(training_set, [name for name in names if any(c.behaviour == name for c in clips)])
+
+
 def training_space(clips, training_set):
-    """The ObjectiveSpace an agent trained on `clips` with the training set `training_set` ("all", "both", keys:
-    behaviours.training_set) declares: its own behaviours only, so point and wave taken from a library with
-    more behaviours keep the paper's objective, as the shipped agent has it."""
-    trained = behaviours.training_set(training_set, library_space(clips).names)
+    """The ObjectiveSpace an agent trained on `clips` with the training set `training_set` declares: its own
+    behaviours only, so point and wave taken from a library with more behaviours keep the paper's
+    objective, as the shipped agent has it."""
+    trained = trained_behaviours(clips, training_set)
     return library_space([clip for clip in clips if clip.behaviour in trained])
 
 

@@ -28,7 +28,7 @@ def pose_matrices(action_rotvecs: ArrayLike, extra_rotvecs: Mapping[str, ArrayLi
     """(..., B, 4, 4) canonical pose matrices (skeleton.BONE_NAMES order) of action rotations (..., 15, 3)
     and optional {bone name: (..., 3)} rotations of other bones; every other bone stays at rest."""
     rotvecs = np.asarray(action_rotvecs, dtype=np.float64)
-    local = {joint: rotvecs[..., k, :] for k, joint in enumerate(skeleton.ACTION_JOINTS)}
+    local: dict[str, ArrayLike] = {joint: rotvecs[..., k, :] for k, joint in enumerate(skeleton.ACTION_JOINTS)}
     local.update(extra_rotvecs or {})
     return kinematics.pose_matrices(local)
 
@@ -43,8 +43,8 @@ class FKEnvironmentBase:
     bone heads and eye axes a subclass's `_pose(rotvecs)` returns. Subclasses set `bone_names` (the order of
     bone_heads) and `_pose_names` (the order of the rotations `_pose` takes)."""
 
-    bone_names = ()
-    _pose_names = ()
+    bone_names: tuple[str, ...] = ()
+    _pose_names: tuple[str, ...] = ()
 
     def evaluate(self, action_rotvecs: ArrayLike, extra_rotvecs: Mapping[str, ArrayLike] | None = None) -> FKResult:
         """FKResult for P poses.
@@ -88,6 +88,10 @@ class FKEnvironmentBase:
             rotvecs[:, slots[bone]] = values
         return rotvecs
 
+    def _pose(self, rotvecs: np.ndarray) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+        """(bone heads (P, len(bone_names), 3), {eye: (P, 3) its Y axis}) of (P, len(_pose_names), 3) rotations."""
+        raise NotImplementedError
+
 
 class NumpyFKEnvironment(FKEnvironmentBase):
     """The FK environment of the canonical skeleton in numpy (core.kinematics), without Blender."""
@@ -106,7 +110,7 @@ class ClipReferences:
 
     def __init__(self, env: FKEnvironmentBase):
         self.env = env
-        self._cache = {}
+        self._cache: dict[int, tuple[MotionClip, np.ndarray, np.ndarray]] = {}
 
     def get(self, clip: MotionClip) -> tuple[np.ndarray, np.ndarray]:
         key = id(clip)

@@ -53,8 +53,12 @@ def _point_targets(arm, rng, azimuths=AZIMUTH_RANGE, elevations=ELEVATION_RANGE,
     targets = []
     for i in range(5):
         for j in range(5):
-            az = rng.uniform(az_edges[i] + 0.15 * (az_edges[1] - az_edges[0]), az_edges[i + 1] - 0.15 * (az_edges[1] - az_edges[0]))
-            el = rng.uniform(el_edges[j] + 0.15 * (el_edges[1] - el_edges[0]), el_edges[j + 1] - 0.15 * (el_edges[1] - el_edges[0]))
+            az = rng.uniform(
+                az_edges[i] + 0.15 * (az_edges[1] - az_edges[0]), az_edges[i + 1] - 0.15 * (az_edges[1] - az_edges[0])
+            )
+            el = rng.uniform(
+                el_edges[j] + 0.15 * (el_edges[1] - el_edges[0]), el_edges[j + 1] - 0.15 * (el_edges[1] - el_edges[0])
+            )
             direction = np.array([sign * np.sin(az) * np.cos(el), -np.cos(az) * np.cos(el), np.sin(el)])
             distance = float(np.clip(distances[5 * i + j], *distance_range))
             if direction[2] < 0:  # keep low targets above the floor

@@ -36,7 +36,7 @@ def swing_signal(rotvecs, arm):
     """(F,) outward offset (metres) of the waving wrist from its shoulder, from the clip's action
     rotations (F, 15, 3)."""
     side = skeleton.ARM_PREFIX[arm]
-    pose = kinematics.pose_matrices(dict(zip(skeleton.ACTION_JOINTS, np.moveaxis(rotvecs, 1, 0))),
+    pose = kinematics.pose_matrices(dict(zip(skeleton.ACTION_JOINTS, np.moveaxis(rotvecs, 1, 0), strict=True)),
                                     only=[side + "Hand"])
     heads = kinematics.head_positions(pose)  # (F, B, 3)
     wrist, shoulder = kinematics.bone_index(side + "Hand"), kinematics.bone_index(side + "Arm")

@@ -35,7 +35,9 @@ def _scores(entry):
 
 def behaviour_words(behaviour, entry):
     """One line of a clip set's behaviour measures (an evaluation.behaviour.summarise entry)."""
-    elevation = f"elevation error <= {_f(max(entry['elevation_first_error_max'], entry['elevation_last_error_max']), 1)} deg"
+    elevation = (
+        f"elevation error <= {_f(max(entry['elevation_first_error_max'], entry['elevation_last_error_max']), 1)} deg"
+    )
     if behaviour == "wave":
         return (f"swing {_f(entry['swing_ratio_median'])}x, frequency {_f(entry['frequency_ratio_median'])}x, "
                 f"at least {entry['cycles_min']:.0f} cycles, {entry['accepted_share'] * entry['requests']:.0f} of "
@@ -99,9 +101,12 @@ def raise_row(entry):
 def wave_row(entry):
     return _scores(entry) + [
         f"{_f(entry['swing_ratio_median'])} ({_f(entry['swing_ratio_min'])}-{_f(entry['swing_ratio_max'])})",
-        _f(entry["frequency_ratio_median"]), f"{entry['cycles_min']:.0f} / {entry['cycles_median']:.1f}",
-        _f(entry["hand_height_ratio_median"]), f"{entry['accepted_share'] * entry['requests']:.0f} of {entry['requests']}",
-        _elevation(entry)]
+        _f(entry["frequency_ratio_median"]),
+        f"{entry['cycles_min']:.0f} / {entry['cycles_median']:.1f}",
+        _f(entry["hand_height_ratio_median"]),
+        f"{entry['accepted_share'] * entry['requests']:.0f} of {entry['requests']}",
+        _elevation(entry),
+    ]
 
 
 def point_row(entry):
@@ -140,14 +145,26 @@ def behaviour_markdown(report):
         if key in report["sets"]:
             methods = report["sets"][key]
             count = next(iter(methods.values()))["requests"]
-            lines += [f"## {title}, held-out clips ({count})", "", f"docs/METRICS.md (\"Guide and raise hand\"); {bounds}.",
-                      ""]
-            lines += markdown_table(("method",) + columns, [[METHOD_LABELS.get(m, m)] + row(e) for m, e in methods.items()])
+            lines += [
+                f"## {title}, held-out clips ({count})",
+                "",
+                f'docs/METRICS.md ("Guide and raise hand"); {bounds}.',
+                "",
+            ]
+            lines += markdown_table(
+                ("method",) + columns, [[METHOD_LABELS.get(m, m)] + row(e) for m, e in methods.items()]
+            )
             lines.append("")
     agent = report["agent"]
-    lines += ["## RLAnimate on its own", "", f"### Pointing at {agent['targets_per_arm']} random unseen targets per arm",
-              "", "Targets drawn uniformly over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, "
-              "1.5-4 m from the shoulder), at the class-average length.", ""]
+    lines += [
+        "## RLAnimate on its own",
+        "",
+        f"### Pointing at {agent['targets_per_arm']} random unseen targets per arm",
+        "",
+        "Targets drawn uniformly over the library's ranges (azimuth -60 to 95 degrees, elevation -40 to 55, "
+        "1.5-4 m from the shoulder), at the class-average length.",
+        "",
+    ]
     lines += markdown_table(("arm", "own aim: median / max (deg)", "exact aim: median / max (deg)", "hold (s, median)"),
                             [[arm, f"{_f(s['own']['median_angle'], 1)} / {_f(s['own']['max_angle'], 1)}",
                               f"{_f(s['exact']['median_angle'], 2)} / {_f(s['exact']['max_angle'], 2)}",
@@ -163,20 +180,40 @@ def behaviour_markdown(report):
         lines += ["", f"### \"This way\" to {agent['targets_per_arm']} random unseen targets per arm", "",
                   "Targets drawn uniformly over the library's guiding ranges (azimuth -30 to 95 degrees, elevation -35 "
                   "to 12, 1.5-5 m from the shoulder), at the class-average length.", ""]
-        lines += markdown_table(("arm", "accepted", "heading error: median / max (deg)", "palm from up: median / max (deg)",
-                                 "reach (arm lengths)", "hold (s, median)"),
-                                [[arm, f"{100 * s['accepted_share']:.0f}%",
-                                  f"{_f(s['heading_error_median'], 1)} / {_f(s['heading_error_max'], 1)}",
-                                  f"{_f(s['palm_up_median'], 0)} / {_f(s['palm_up_max'], 0)}", _f(s["reach_median"]),
-                                  _f(s["hold_s_median"])] for arm, s in agent["guide_targets"].items()])
+        lines += markdown_table(
+            (
+                "arm",
+                "accepted",
+                "heading error: median / max (deg)",
+                "palm from up: median / max (deg)",
+                "reach (arm lengths)",
+                "hold (s, median)",
+            ),
+            [
+                [
+                    arm,
+                    f"{100 * s['accepted_share']:.0f}%",
+                    f"{_f(s['heading_error_median'], 1)} / {_f(s['heading_error_max'], 1)}",
+                    f"{_f(s['palm_up_median'], 0)} / {_f(s['palm_up_max'], 0)}",
+                    _f(s["reach_median"]),
+                    _f(s["hold_s_median"]),
+                ]
+                for arm, s in agent["guide_targets"].items()
+            ],
+        )
     if "raise_sweep" in agent:
         sweeps = agent["raise_sweep"]
         exaggerations = next(iter(sweeps.values()))["exaggerations"]
         lines += ["", "### Raise-hand exaggeration sweep (class-average length)", ""]
-        lines += markdown_table(("arm",) + tuple(f"wrist above shoulder at {e:g} (cm)" for e in exaggerations)
-                                + ("Spearman", "rising"),
-                                [[arm] + [_f(100 * v, 1) for v in s["height"]]
-                                 + [_f(s["spearman"]), "yes" if s["height_rising"] else "no"] for arm, s in sweeps.items()])
+        lines += markdown_table(
+            ("arm",) + tuple(f"wrist above shoulder at {e:g} (cm)" for e in exaggerations) + ("Spearman", "rising"),
+            [
+                [arm]
+                + [_f(100 * v, 1) for v in s["height"]]
+                + [_f(s["spearman"]), "yes" if s["height_rising"] else "no"]
+                for arm, s in sweeps.items()
+            ],
+        )
     variation = agent["variation"]
     lines += ["", "### Seeds", "",
               "Each variation seed's answers to the held-out requests (the panel's Seed; seed 0 is the "

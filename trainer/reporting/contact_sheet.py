@@ -85,7 +85,9 @@ def _draw(ax, heads, frame, view, trail, target):
         x, y = xy(pose[[parent, child]])
         left = "Left" in name
         color = "#2b5d9b" if left else "#b5482f" if "Right" in name else "#444444"
-        ax.plot(x, y, color=color, lw=_width(name), solid_capstyle="round", alpha=0.95 if left or view == "front" else 0.8)
+        ax.plot(
+            x, y, color=color, lw=_width(name), solid_capstyle="round", alpha=0.95 if left or view == "front" else 0.8
+        )
     hx, hy = xy(0.5 * (pose[_INDEX["Head"]] + pose[_INDEX["HeadTop_End"]]))
     ax.add_patch(plt.Circle((hx[0], hy[0]), 0.1, color="#444444", fill=False, lw=2))
     eye = pose[_INDEX["LeftEye"]]
@@ -129,14 +131,15 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
                       "green dots = finger line)", 0.98, out)
 
 
-def generated_sheet(rows, out, title, fps=30):
-    """One PNG of rendered frames: rows [(row title, [(frame offset, png path)])], a column per key frame."""
+def generated_sheet(rows, out, title, fps=30, frame_labels=False):
+    """One PNG of rendered frames: rows [(row title, [(frame offset, png path)])], a column per key frame, each
+    titled with its time (or, with frame_labels, its frame number)."""
     columns = max(len(frames) for _, frames in rows)
     fig, axes = plt.subplots(len(rows), columns, figsize=(columns * 1.9, len(rows) * 2.0), dpi=110, squeeze=False)
-    for (row_title, frames), row_axes in zip(rows, axes):
-        for ax, (offset, path) in zip(row_axes, frames):
+    for (row_title, frames), row_axes in zip(rows, axes, strict=True):
+        for ax, (offset, path) in zip(row_axes, frames, strict=False):  # a shorter row leaves axes empty
             ax.imshow(plt.imread(str(path)))
-            ax.set_title(f"{offset / fps:.2f}s", fontsize=7, pad=2)
+            ax.set_title(f"frame {offset}" if frame_labels else f"{offset / fps:.2f}s", fontsize=7, pad=2)
         for ax in row_axes:
             ax.set_xticks([])
             ax.set_yticks([])

@@ -44,7 +44,7 @@ def figure3(histories, path, split):
     """The paper's Figure 3 row for `split` ('seen' or 'unseen'): score over epochs, one panel per
     column (wave, point, both), one line per variant. `histories[variant][column]` is a run's history."""
     figure, axes = plt.subplots(1, 3, figsize=(15, 4.2))
-    for axis, column in zip(axes, COLUMN_LABELS):
+    for axis, column in zip(axes, COLUMN_LABELS, strict=True):
         for variant, label in VARIANT_LABELS.items():
             history = histories.get(variant, {}).get(column)
             if history:
@@ -87,13 +87,15 @@ def wave_hand_paths(panels, path):
     from rlanimate_addon.core import behaviour_metrics as bm
 
     figure, axes = plt.subplots(len(panels), 2, figsize=(11, 2.6 * len(panels)), squeeze=False)
-    for (title, arm, clips), (over_time, frontal) in zip(panels, axes):
+    for (title, arm, clips), (over_time, frontal) in zip(panels, axes, strict=True):
         for k, (label, positions) in enumerate(clips.items()):
             wrist = bm.joint(positions, f"{arm.lower()}_wrist")
             shoulder = bm.joint(positions, f"{arm.lower()}_shoulder")
             style = {"color": "black", "linewidth": 2.0} if k == 0 else {"linewidth": 1.2}
             over_time.plot(100 * (wrist[:, 0] - shoulder[:, 0]), label=label, **style)
-            frontal.plot(100 * (wrist[:, 0] - shoulder[:, 0]), 100 * (wrist[:, 2] - shoulder[:, 2]), label=label, **style)
+            frontal.plot(
+                100 * (wrist[:, 0] - shoulder[:, 0]), 100 * (wrist[:, 2] - shoulder[:, 2]), label=label, **style
+            )
             run = bm.hand_up_run(positions, arm)
             if k == 0 and run is not None:
                 over_time.axvspan(run[0], run[1], color="0.9", zorder=0)
@@ -125,9 +127,11 @@ def gesture_hand_paths(panels, path):
     from rlanimate_addon.core import behaviour_metrics as bm
 
     figure, axes = plt.subplots(len(panels), 3, figsize=(14, 3.0 * len(panels)), squeeze=False)
-    for (title, arm, clips, target), (over_time, above, frontal) in zip(panels, axes):
+    for (title, arm, clips, target), (over_time, above, frontal) in zip(panels, axes, strict=True):
         for k, (label, positions) in enumerate(clips.items()):
-            relative = 100 * (bm.joint(positions, f"{arm.lower()}_wrist") - bm.joint(positions, f"{arm.lower()}_shoulder"))
+            relative = 100 * (
+                bm.joint(positions, f"{arm.lower()}_wrist") - bm.joint(positions, f"{arm.lower()}_shoulder")
+            )
             style = {"color": "black", "linewidth": 2.0} if k == 0 else {"linewidth": 1.2}
             over_time.plot(relative[:, 2], label=label, **style)
             above.plot(relative[:, 0], -relative[:, 1], label=label, **style)

@@ -90,8 +90,14 @@ def gap_rows(results):
     rows = []
     for key, _, label in SETS[:3]:
         ours, theirs = (held_out_summary(results["sets"][key][m]) for m in ("rlanimate", "nearest_clip"))
-        rows.append([label, f"{ours['score'] - theirs['score']:+.2f}",
-                     f"{ours['aligned_score'] - theirs['aligned_score']:+.2f}", f"{ours['accepted'] - theirs['accepted']:+d}"])
+        rows.append(
+            [
+                label,
+                f"{ours['score'] - theirs['score']:+.2f}",
+                f"{ours['aligned_score'] - theirs['aligned_score']:+.2f}",
+                f"{ours['accepted'] - theirs['accepted']:+d}",
+            ]
+        )
     return rows
 
 
@@ -99,7 +105,11 @@ def seed_rows(results):
     """Per held-out set: each seed's agent, their mean ± sd when there are several, and retrieval: score, DTW
     score, accepted takes."""
     def cells(summary):
-        return [f"{summary['score']:.2f}", f"{summary['aligned_score']:.2f}", f"{summary['accepted']} / {summary['clips']}"]
+        return [
+            f"{summary['score']:.2f}",
+            f"{summary['aligned_score']:.2f}",
+            f"{summary['accepted']} / {summary['clips']}",
+        ]
 
     rows = []
     for key, _, label in SETS[:3]:
@@ -153,7 +163,7 @@ def style_rows(results):
     """Per held-out take (one per style): score, DTW score and accepted, RLAnimate against retrieval."""
     rows = []
     for key, _, label in SETS[1:3]:
-        pairs = zip(*(results["sets"][key][m]["clips"] for m in ("rlanimate", "nearest_clip")))
+        pairs = zip(*(results["sets"][key][m]["clips"] for m in ("rlanimate", "nearest_clip")), strict=True)
         for ours, theirs in pairs:
             rows.append([label.split(",")[0], parse_name(ours["name"])["style"],
                          *(f"{ours[k]:.1f} / {theirs[k]:.1f}" for k in ("score", "aligned_score")),
@@ -276,7 +286,7 @@ def gestures_markdown(results, wave_only=None):
         "",
         *markdown_table(["style", "score", "DTW score", "accepted"], wave_style_rows(results, wave_only)),
         "",
-        f"![hand paths of a held-out guide and bye take](realmocap_guide_bye_paths.png)",
+        "![hand paths of a held-out guide and bye take](realmocap_guide_bye_paths.png)",
         "",
     ]
     return "\n".join(lines)

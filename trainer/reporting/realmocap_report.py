@@ -62,7 +62,7 @@ def style_summaries(result):
         by_style[parse_name(clip["name"])["style"]].append(clip)
     summaries = {}
     for style, clips in sorted(by_style.items()):
-        def values(key):
+        def values(key, clips=clips):
             return np.array([clip[key] for clip in clips], dtype=np.float64)
         summaries[style] = {"takes": len(clips), "score": float(values("score").mean()),
                             "aligned_score": float(values("aligned_score").mean()),
@@ -161,7 +161,13 @@ def seed_rows(results):
             spread = [f"**{mean_and_sd([summary[key] for summary in per_seed.values()], digits)}**"
                       for key, digits in SEED_METRICS]
             rows.append([label, f"RLAnimate, mean ± sd of {len(per_seed)}", *spread])
-        rows.append([label, METHOD_LABELS["nearest_clip"], *metric_cells(seed_summary(results[name][set_name]["nearest_clip"]), SEED_METRICS)])
+        rows.append(
+            [
+                label,
+                METHOD_LABELS["nearest_clip"],
+                *metric_cells(seed_summary(results[name][set_name]["nearest_clip"]), SEED_METRICS),
+            ]
+        )
     return rows
 
 
@@ -293,13 +299,29 @@ def realmocap_markdown(results):
         entry = results[name]
         for set_name, set_label in SET_LABELS.items():
             for method, result in entry.get(set_name, {}).items():
-                score_rows.append([label, f"{set_label} ({len(result['clips'])})", METHOD_LABELS[method],
-                                   f"{result['score']:.2f}", f"{result['smoothness']:.2f}", f"{result['label_error']:.3f}"])
+                score_rows.append(
+                    [
+                        label,
+                        f"{set_label} ({len(result['clips'])})",
+                        METHOD_LABELS[method],
+                        f"{result['score']:.2f}",
+                        f"{result['smoothness']:.2f}",
+                        f"{result['label_error']:.3f}",
+                    ]
+                )
                 wave = result["by_behaviour"]["wave"]
-                behaviour_rows.append([label, f"{set_label} ({len(result['clips'])})", METHOD_LABELS[method],
-                                       f"{wave['aligned_score']:.2f}", f"{wave['swing_ratio_median']:.2f}",
-                                       f"{wave['frequency_ratio_median']:.2f}", f"{wave['cycles_median']:.0f}",
-                                       f"{round(wave['accepted_share'] * len(result['clips']))}/{len(result['clips'])}"])
+                behaviour_rows.append(
+                    [
+                        label,
+                        f"{set_label} ({len(result['clips'])})",
+                        METHOD_LABELS[method],
+                        f"{wave['aligned_score']:.2f}",
+                        f"{wave['swing_ratio_median']:.2f}",
+                        f"{wave['frequency_ratio_median']:.2f}",
+                        f"{wave['cycles_median']:.0f}",
+                        f"{round(wave['accepted_share'] * len(result['clips']))}/{len(result['clips'])}",
+                    ]
+                )
         for set_name in ("test", "test_tempo"):
             style_rows += per_style_rows(next(shown for experiment, key, shown in SEED_SETS
                                               if (experiment, key) == (name, set_name)),

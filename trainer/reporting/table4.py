@@ -52,14 +52,30 @@ def table4_markdown(report):
                   f"the hold, the median and the worst of the {count} per arm; issue 10 asks at most 3 and 8.", ""]
         for column, variants in report["random_targets"].items():
             lines += [f"### {COLUMN_LABELS[column]} agents", ""]
-            lines += markdown_table(("method", "n", "left: median", "left: max", "right: median", "right: max"),
-                                    [[LABELS.get(v, v), str(entry["left"]["median"]["n"])]
-                                     + [cell(entry[arm][key], 1) for arm in ("left", "right") for key in ("median", "max")]
-                                     for v, entry in variants.items()])
+            lines += markdown_table(
+                ("method", "n", "left: median", "left: max", "right: median", "right: max"),
+                [
+                    [LABELS.get(v, v), str(entry["left"]["median"]["n"])]
+                    + [cell(entry[arm][key], 1) for arm in ("left", "right") for key in ("median", "max")]
+                    for v, entry in variants.items()
+                ],
+            )
             lines.append("")
     lines += ["## Training runs", ""]
-    lines += markdown_table(("variant", "column", "seed", "episodes", "wall s", "CPU s", "held-out score", "seen score"),
-                            [[LABELS.get(r["variant"], r["variant"]), r["column"], r["seed"], r["episodes"],
-                              f"{r['train_seconds']:.0f}", f"{r['train_cpu_seconds']:.0f}", f"{r['held_out_score']:.2f}",
-                              f"{r['seen_score']:.2f}"] for r in report["training"].values()])
+    lines += markdown_table(
+        ("variant", "column", "seed", "episodes", "wall s", "CPU s", "held-out score", "seen score"),
+        [
+            [
+                LABELS.get(r["variant"], r["variant"]),
+                r["column"],
+                r["seed"],
+                r["episodes"],
+                f"{r['train_seconds']:.0f}",
+                f"{r['train_cpu_seconds']:.0f}",
+                f"{r['held_out_score']:.2f}",
+                f"{r['seen_score']:.2f}",
+            ]
+            for r in report["training"].values()
+        ],
+    )
     return "\n".join(lines) + "\n"

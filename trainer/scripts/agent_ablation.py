@@ -8,7 +8,7 @@ Runs that already finished are not trained again.
 import argparse
 
 from trainer.experiments.agent_ablation import ABLATIONS, AblationSettings, run_ablation
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts.cli import RUNS_INTERRUPTED, run_main, script_args
 
 DEFAULTS = AblationSettings()
 
@@ -37,4 +37,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=RUNS_INTERRUPTED))

@@ -42,7 +42,7 @@ def sample_library_comparison(agent_path, manifest):
             if behaviour == "wave":
                 rows[name]["label_error"] = float(np.mean([
                     abs(autolabel.label_wave(m).exaggeration - autolabel.label_wave(c.rotvecs).exaggeration)
-                    for m, c in zip(motions, clips)]))
+                    for m, c in zip(motions, clips, strict=True)]))
         sets[f"{behaviour}, held-out clips ({len(clips)})"] = rows
     return sets, methods["rlanimate"].agent.metadata.get("training", {})
 

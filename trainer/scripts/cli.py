@@ -13,13 +13,22 @@ def script_args(argv=None):
     return argv[argv.index("--") + 1:] if "--" in argv else argv[1:]
 
 
-def run_main(main, *args):
-    """Call main(*args); an RLAnimateError becomes one `error: ...` line on stderr and exit status 2."""
+#: What an experiment that trains its runs as Ray tasks says when it is interrupted.
+RUNS_INTERRUPTED = ("interrupted: the finished runs are kept, and the others continue from their checkpoints when "
+                    "the command runs again")
+
+
+def run_main(main, *args, interrupted="interrupted"):
+    """Call main(*args); an RLAnimateError becomes one `error: ...` line on stderr and exit status 2, a
+    Ctrl-C (KeyboardInterrupt) the line `interrupted` and exit status 130."""
     try:
         return main(*args)
     except RLAnimateError as error:
         print(f"error: {error}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(interrupted, file=sys.stderr)
+        return 130
 
 
 def add_real_capture_arguments(parser, defaults):

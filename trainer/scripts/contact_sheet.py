@@ -1,10 +1,12 @@
 """Contact sheets: the clip library's key frames (docs/contact_sheet.png), or, with --generated, the add-on's
 Generate Gesture on the sample character rendered by Blender (Cycles, CPU) into
 docs/results/generated_frames.png (point and wave), or, with --generated --further, the guide and
-raise-hand gestures into docs/results/generated_guide_raise_frames.png.
+raise-hand gestures into docs/results/generated_guide_raise_frames.png, or, with --composing, gestures
+composed on one character (both arms at once, a handover) into docs/results/composing_frames.png.
 
     python -m trainer.scripts.contact_sheet [--out docs/contact_sheet.png] [--seed S]
     nice -n 10 python -m trainer.scripts.contact_sheet --generated [--further] [--agent PATH] [--out PNG]
+    nice -n 10 python -m trainer.scripts.contact_sheet --composing [--agent PATH] [--out PNG]
 """
 import argparse
 import tempfile
@@ -17,6 +19,7 @@ from trainer.scripts.cli import run_main, script_args
 
 GENERATED_SHEET = RESULTS_DIR / "generated_frames.png"
 FURTHER_SHEET = RESULTS_DIR / "generated_guide_raise_frames.png"
+COMPOSING_SHEET = RESULTS_DIR / "composing_frames.png"
 TARGET_HIGH = (-0.9, -2.0, 1.7)  # ahead, up and to the character's right
 TARGET_ACROSS = (-0.9, -1.8, 0.9)  # low, across the body for the left arm
 TARGET_DOOR = (-2.2, -1.6, 0.9)  # a doorway ahead and out to the character's right, at waist height
@@ -43,22 +46,63 @@ def further_requests():
     """The requests of the guide and raise-hand sheet: "this way" to two targets, raised hands small to big."""
     from trainer.blender_io.gesture_render import RenderRequest
     return [
-        RenderRequest("this way, right, to a door", {"behaviour": "GUIDE", "arm": "RIGHT", "seed": 0}, target=TARGET_DOOR),
-        RenderRequest("this way, left, to the floor", {"behaviour": "GUIDE", "arm": "LEFT", "seed": 0},
-                      target=TARGET_FLOOR),
-        RenderRequest("raise hand right, e 0.1", {"behaviour": "RAISE_HAND", "arm": "RIGHT", "exaggeration": 0.1, "seed": 0}),
-        RenderRequest("raise hand left, e 0.9", {"behaviour": "RAISE_HAND", "arm": "LEFT", "exaggeration": 0.9, "seed": 0}),
+        RenderRequest(
+            "this way, right, to a door", {"behaviour": "GUIDE", "arm": "RIGHT", "seed": 0}, target=TARGET_DOOR
+        ),
+        RenderRequest(
+            "this way, left, to the floor", {"behaviour": "GUIDE", "arm": "LEFT", "seed": 0}, target=TARGET_FLOOR
+        ),
+        RenderRequest(
+            "raise hand right, e 0.1", {"behaviour": "RAISE_HAND", "arm": "RIGHT", "exaggeration": 0.1, "seed": 0}
+        ),
+        RenderRequest(
+            "raise hand left, e 0.9", {"behaviour": "RAISE_HAND", "arm": "LEFT", "exaggeration": 0.9, "seed": 0}
+        ),
     ]
 
 
+def compositions():
+    """The compositions of the composing sheet: a point and a wave on overlapping frames, a point handing over
+    to a wave on the same arm (docs/EXTENSION.md, "Composing gestures")."""
+    from trainer.blender_io.gesture_render import Composition
+    point = {"behaviour": "POINT", "arm": "RIGHT", "start_frame": 1, "frame_count": 93, "seed": 0}
+    return [
+        Composition("point right 1-93,\nwave left 40-132", [
+            (point, TARGET_HIGH),
+            ({"behaviour": "WAVE", "arm": "LEFT", "exaggeration": 0.8, "start_frame": 40, "frame_count": 93,
+              "seed": 0}, None)], (20, 45, 60, 75, 90, 110, 125)),
+        Composition("point right 1-93, wave\nright from 50 takes over", [
+            (point, TARGET_HIGH),
+            ({"behaviour": "WAVE", "arm": "RIGHT", "exaggeration": 0.8, "start_frame": 50, "frame_count": 93,
+              "seed": 0}, None)], (20, 40, 50, 58, 66, 90, 130)),
+    ]
+
+
+def _composing(args):
+    from trainer.blender_io.gesture_render import render_compositions
+    with tempfile.TemporaryDirectory() as frames:
+        rendered = render_compositions(compositions(), frames, agent_path=args.agent)
+        agent = shown(args.agent) if args.agent else "the bundled agent"
+        return generated_sheet([(c.title, c.frames) for c in rendered], args.out or COMPOSING_SHEET,
+                               f"Gestures composed on the sample character, {agent}, rendered by Blender (Cycles): "
+                               "frame numbers above; red: the point's target", frame_labels=True)
+
+
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0]
+    )
     parser.add_argument("--out", type=Path)
     parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="library plan seed (library sheet)")
     parser.add_argument("--generated", action="store_true", help="render Generate Gesture's output with Blender")
     parser.add_argument("--further", action="store_true", help="with --generated: the guide and raise-hand gestures")
+    parser.add_argument("--composing", action="store_true",
+                        help="render gestures composed on one character (both arms, a handover) with Blender")
     parser.add_argument("--agent", type=Path, help="agent file for the add-on (default: the bundled agent)")
     args = parser.parse_args(script_args(argv))
+    if args.composing:
+        print(f"wrote {_composing(args)}")
+        return 0
     if not args.generated:
         print(f"wrote {render(args.out or CONTACT_SHEET, args.seed)}")
         return 0

@@ -26,7 +26,7 @@ from pathlib import Path
 
 from trainer.agent.models import VARIANTS
 from trainer.experiments.paper import COLUMNS, PaperSettings, run_paper
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts.cli import RUNS_INTERRUPTED, run_main, script_args
 
 DEFAULTS = PaperSettings()
 
@@ -72,4 +72,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    sys.exit(run_main(main))
+    sys.exit(run_main(main, interrupted=RUNS_INTERRUPTED))

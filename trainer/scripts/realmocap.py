@@ -13,7 +13,7 @@ from pathlib import Path
 from trainer.experiments.realmocap import RealMocapSettings, baseline_sets, run_experiments
 from trainer.reporting.baselines_report import write_baselines_results
 from trainer.reporting.realmocap_report import realmocap_markdown
-from trainer.scripts.cli import run_main, script_args, write_results
+from trainer.scripts.cli import RUNS_INTERRUPTED, run_main, script_args, write_results
 
 DEFAULTS = RealMocapSettings()
 
@@ -62,4 +62,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=RUNS_INTERRUPTED))

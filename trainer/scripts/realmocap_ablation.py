@@ -12,7 +12,7 @@ import argparse
 
 from trainer.experiments.realmocap_ablation import EXPERIMENTS, AblationSettings, run_ablation
 from trainer.reporting.realmocap_ablation_report import ablation_markdown
-from trainer.scripts.cli import add_real_capture_arguments, run_main, script_args, write_results
+from trainer.scripts.cli import RUNS_INTERRUPTED, add_real_capture_arguments, run_main, script_args, write_results
 
 DEFAULTS = AblationSettings()
 
@@ -48,4 +48,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=RUNS_INTERRUPTED))

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from trainer.experiments.realmocap_gestures import GestureSettings, run_experiment
 from trainer.reporting.realmocap_gestures_report import gestures_markdown, paths_figure
-from trainer.scripts.cli import run_main, script_args, write_results
+from trainer.scripts.cli import RUNS_INTERRUPTED, run_main, script_args, write_results
 
 DEFAULTS = GestureSettings()
 RESULT = "realmocap_guide_bye"
@@ -62,4 +62,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=RUNS_INTERRUPTED))

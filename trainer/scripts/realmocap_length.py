@@ -13,7 +13,7 @@ import argparse
 
 from trainer.experiments.realmocap_length import LengthSettings, run_lengths
 from trainer.reporting.realmocap_length_report import length_markdown
-from trainer.scripts.cli import add_real_capture_arguments, run_main, script_args, write_results
+from trainer.scripts.cli import RUNS_INTERRUPTED, add_real_capture_arguments, run_main, script_args, write_results
 
 DEFAULTS = LengthSettings()
 
@@ -51,4 +51,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=RUNS_INTERRUPTED))

@@ -10,18 +10,24 @@ names and motion (shown as a table and written to <output>/manifest.json), holds
 and compares the agent with retrieval on the held-out takes in <output>/capture_report.md
 (trainer/experiments/capture.py). `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
 report to docs/results/. Outputs: see trainer/experiments/run.py. `--resume` continues the run in --output
-from its checkpoint with the run's own settings; the continuation equals the uninterrupted run.
+from its checkpoint with the run's own settings; the continuation equals the uninterrupted run. A new run
+into the folder of another is refused unless `--overwrite`.
 """
 import argparse
 from pathlib import Path
 
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.models import VARIANTS
 from trainer.blender_io.clip_session import LibrarySession
+from trainer.blender_io.import_worker import ImportLimits
 from trainer.experiments import capture
 from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, check_settings, resolve, train
 from trainer.files import atomic_copy
 from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.scripts.cli import run_main, script_args
+
+#: What an interrupted run says: every epoch it finished is in its checkpoint.
+INTERRUPTED = "interrupted: the run's checkpoint holds every epoch it finished; continue it with --resume"
 
 
 def build_parser():
@@ -47,6 +53,11 @@ def build_parser():
     parser.add_argument("--variant", choices=VARIANTS, help="ablation variant (Table 4; default rlanimate)")
     parser.add_argument("--resume", action="store_true",
                         help="continue the run in --output from its checkpoint, with the run's own settings")
+    parser.add_argument("--overwrite", action="store_true",
+                        help="replace the run in --output (without it, a new run into a run's folder is refused)")
+    parser.add_argument("--allow-new-behaviour", action="store_true",
+                        help="with --behaviour all, also learn a behaviour other than point and wave that fewer "
+                             "than 3 clips name (without it, such a behaviour is refused as a likely typo)")
     parser.add_argument("--install", action="store_true",
                         help="install the agent as the add-on's default and its report into docs/results/")
     parser.add_argument("--eval-every", type=int,
@@ -56,15 +67,33 @@ def build_parser():
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--verbose", action="store_true", help="show what Blender prints while loading the clips")
     parser.add_argument("--import-workers", type=int, default=1,
-                        help="import the clips the cache lacks with N Blenders at once (Ray tasks; default 1)")
+                        help="import the clips the cache lacks with N Blenders at once (worker processes; default 1)")
+    parser.add_argument("--import-memory-limit", type=float, default=ImportLimits.memory_gb, metavar="GB",
+                        help="the memory one clip's import may take; a clip that needs more is skipped with a note "
+                             f"(default {ImportLimits.memory_gb:g})")
+    parser.add_argument("--import-time-limit", type=float, default=ImportLimits.seconds, metavar="SECONDS",
+                        help="the time one clip's import may take; a clip that takes longer is skipped with a note "
+                             f"(default {ImportLimits.seconds:g})")
     return parser
+
+
+def import_limits(args: argparse.Namespace) -> ImportLimits:
+    """The ImportLimits of the arguments; RLAnimateError naming each that is not a positive number."""
+    problems = [f"{option} {value:g}: give a number above 0{example}" for option, value, example in (
+        ("--import-workers", args.import_workers, ", such as 2"),
+        ("--import-memory-limit", args.import_memory_limit, " (GB), such as 2"),
+        ("--import-time-limit", args.import_time_limit, " (seconds), such as 60")) if not value > 0]
+    if problems:
+        raise RLAnimateError("; ".join(problems) + ". Nothing was trained.")
+    return ImportLimits(memory_gb=args.import_memory_limit, seconds=args.import_time_limit)
 
 
 def run_settings(args):
     """RunSettings from parsed arguments."""
     return RunSettings(output=args.output, behaviour=args.behaviour, clips=args.clips, epochs=args.epochs,
                        seed=args.seed, preset=args.preset, variant=args.variant, eval_every=args.eval_every,
-                       resume=args.resume, checkpoint_every=args.checkpoint_every, progress=not args.quiet)
+                       resume=args.resume, overwrite=args.overwrite, allow_new_behaviour=args.allow_new_behaviour,
+                       checkpoint_every=args.checkpoint_every, progress=not args.quiet)
 
 
 def install(output):
@@ -84,7 +113,9 @@ def main(argv=None):
         labelled = capture.label_folder(args.clips, args.output, args.hold_out, args.verbose)
         settings = capture.capture_settings(settings, labelled)
     settings = resolve(settings)
-    session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers)
+    limits = import_limits(args)
+    session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers,
+                             import_limits=limits)
     report, _ = train(settings, session)
     scored, split = ((report["held_out"], "held-out") if report["held_out"] is not None
                      else (report["training"], "no held-out clips; training-clip"))
@@ -101,4 +132,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    raise SystemExit(run_main(main))
+    raise SystemExit(run_main(main, interrupted=INTERRUPTED))

@@ -107,7 +107,7 @@ def test_collect_stores_real_descriptions_and_clip_motion(env, library):
     drawn = trainer.collect()
     assert len(trainer.buffer) == 2 + train_config.random_targets
     assert [c.behaviour for c in drawn] == ["POINT", "WAVE"] + ["POINT"] * train_config.random_targets
-    for k, (clip, episode) in enumerate(zip(drawn, trainer.buffer.episodes)):
+    for k, (clip, episode) in enumerate(zip(drawn, trainer.buffer.episodes, strict=True)):
         imitated = k < 2
         assert np.all(episode["imitate"] == float(imitated))
         if imitated:
@@ -147,7 +147,9 @@ def test_every_behaviour_keeps_the_chunks_and_random_targets_it_has_beside_one_o
     assert trainer.chunk_count == 2 * train_config.chunk_count
     drawn = trainer.collect()
     assert [c.behaviour for c in drawn] == ["POINT", "WAVE", "GUIDE", "RAISE"] + ["POINT"] * 3 + ["GUIDE"] * 3
-    for clip, episode in zip(drawn[4:], trainer.buffer.episodes[4:]):  # each within its own behaviour's range
+    for clip, episode in zip(
+        drawn[4:], trainer.buffer.episodes[4:], strict=True
+    ):  # each within its own behaviour's range
         direction = episode["objective"][0, spaces.OBJECTIVE_ATTRIBUTES]
         side = 1.0 if clip.arm == "LEFT" else -1.0
         if clip.behaviour == "GUIDE":  # the guides' range: straight to the arm's side, widened by the margin

@@ -65,7 +65,8 @@ def test_a_checkpoint_holding_code_is_refused_without_torchs_advice_to_unpickle_
         checkpoint.load(path)
     message = str(refused.value)
     assert message.startswith(f"The checkpoint {path} is damaged (Unsupported global: GLOBAL argparse.Namespace")
-    assert message.endswith("delete it and start again.")
+    assert message.endswith("train.py with --overwrite (which replaces it) or another --output folder; an "
+                            "experiment after moving the run's folder away."), "the advice keeps the run's files"
     assert "weights_only" not in message and "\x1b" not in message
 
 
@@ -84,18 +85,23 @@ def _run(session, output, epochs, resume=False):
 
 
 def test_resumed_run_equals_the_uninterrupted_run(session, tmp_path):
+    """Resumed twice: what a resumed run saves (the dicts `load` returned among them) loads again."""
     _, straight = _run(session, tmp_path / "straight", 4)
     _, first_half = _run(session, tmp_path / "resumed", 2)
+    _, once = _run(session, tmp_path / "resumed", 3, resume=True)
     _, resumed = _run(session, tmp_path / "resumed", 4, resume=True)
-    assert first_half.epoch == 2 and resumed.epoch == 4
+    assert (first_half.epoch, once.epoch, resumed.epoch) == (2, 3, 4)
     a, b = straight.state_dict(), resumed.state_dict()
     assert a["agent"].keys() == b["agent"].keys()
     assert all(torch.equal(a["agent"][k], b["agent"][k]) for k in a["agent"])
-    for state_a, state_b in zip(a["optimizer"]["state"].values(), b["optimizer"]["state"].values()):
+    for state_a, state_b in zip(a["optimizer"]["state"].values(), b["optimizer"]["state"].values(), strict=True):
         assert all(torch.equal(state_a[k], state_b[k]) for k in state_a)
     assert len(straight.buffer) == len(resumed.buffer)
-    assert all(np.array_equal(x[k], y[k]) for x, y in zip(straight.buffer.episodes, resumed.buffer.episodes)
-               for k in x)
+    assert all(
+        np.array_equal(x[k], y[k])
+        for x, y in zip(straight.buffer.episodes, resumed.buffer.episodes, strict=True)
+        for k in x
+    )
     assert [e["loss/total"] for e in a["history"]] == [e["loss/total"] for e in b["history"]]
     lines = (tmp_path / "resumed" / "metrics.jsonl").read_text().splitlines()
     assert len(lines) == 4  # the metrics log is rebuilt from the checkpoint, not duplicated
@@ -155,6 +161,28 @@ def test_a_checkpoint_missing_a_key_is_refused_naming_it_and_the_run_is_kept(ses
     torch.save(payload, path)
     files = {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()}
     with pytest.raises(RLAnimateError, match=rf"^The checkpoint {re.escape(str(path))} lacks {re.escape(missing)}: "
-                                             r"it is incomplete.*delete it and start a new run \(without --resume\)"):
+                                             r"it is incomplete.*train the run again: train.py with --overwrite"):
         _run(session, run, 4, resume=True)
     assert {p.name: p.read_bytes() for p in run.iterdir() if p.is_file()} == files, "the run's files are kept"
+
+
+def test_a_checkpoint_an_earlier_trainer_wrote_after_a_resume_loads_and_the_run_finishes(session, two_epoch_run,
+                                                                                        tmp_path):
+    """Before issue 44 a resumed run saved the dicts `load` had returned as they were (_CheckedDicts, holding
+    the checkpoint's PosixPath), which weights_only refuses: such a file loads, as plain data."""
+    run = tmp_path / "run"
+    shutil.copytree(two_epoch_run, run)
+    path = run / checkpoint.FILENAME
+    payload = checkpoint.load(path)
+    assert type(payload["trainer"]["history"][0]) is checkpoint._CheckedDict
+    torch.save({"format_version": checkpoint.FORMAT_VERSION, "arguments": payload["arguments"],
+                "trainer": payload["trainer"]}, path)  # what the earlier save wrote
+    with pytest.raises(Exception, match="_CheckedDict"):
+        torch.load(path, weights_only=True)
+    loaded = checkpoint.load(path)
+    assert loaded["trainer"]["history"][1]["loss/total"] == payload["trainer"]["history"][1]["loss/total"]
+    _, resumed = _run(session, run, 4, resume=True)
+    _, straight = _run(session, tmp_path / "straight", 4)
+    a, b = straight.agent.state_dict(), resumed.agent.state_dict()
+    assert all(torch.equal(a[k], b[k]) for k in a)
+    torch.load(path, weights_only=True)  # what this trainer writes is plain data

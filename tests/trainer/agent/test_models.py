@@ -36,7 +36,10 @@ def test_parameters_match_the_agent_file_layout(variant):
     config, _ = load_preset("debug")
     agent = RLAnimateAgent(config, variant)
     shapes = {name: tuple(t.shape) for name, t in agent.state_dict().items()}
-    expected = {name: tuple(s) for name, s in agent_file.expected_weight_shapes(config.to_dict(), variant, agent.space.size).items()}
+    expected = {
+        name: tuple(s)
+        for name, s in agent_file.expected_weight_shapes(config.to_dict(), variant, agent.space.size).items()
+    }
     assert shapes == expected
 
 

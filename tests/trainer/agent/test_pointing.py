@@ -53,15 +53,20 @@ def test_the_wrist_term_is_the_squared_wrist_distance_on_each_frames_own_arm():
     rotvecs = np.random.default_rng(1).normal(0.0, 0.4, (8, 15, 3))
     bounds = torch.tensor(spaces.DEFAULT_ACTION_BOUNDS)
     motion = torch.tensor(spaces.encode_action(rotvecs))
-    objective = torch.tensor(np.vstack([spaces.PAPER_SPACE.make_objective("WAVE", arm, 0.5, 4) for arm in skeleton.ARMS]))
+    objective = torch.tensor(
+        np.vstack([spaces.PAPER_SPACE.make_objective("WAVE", arm, 0.5, 4) for arm in skeleton.ARMS])
+    )
     assert wrist_error(motion, motion, objective, bounds).abs().max() < 1e-12
     turned = rotvecs.copy()
     turned[:, skeleton.ACTION_JOINTS.index("LeftForeArm")] += (0.0, 0.0, 0.2)
     error = wrist_error(torch.tensor(spaces.encode_action(turned)), motion, objective, bounds).numpy()
-    wrists = {arm: kinematics.head_positions(kinematics.pose_matrices(
-        dict(zip(skeleton.ACTION_JOINTS, np.moveaxis(r, 1, 0)))))[:, kinematics.bone_index(skeleton.ARM_PREFIX[arm] + "Hand")]
-        for arm, r in (("LEFT", turned[:4]), ("RIGHT", turned[4:]))}
+    wrists = {
+        arm: kinematics.head_positions(
+            kinematics.pose_matrices(dict(zip(skeleton.ACTION_JOINTS, np.moveaxis(r, 1, 0), strict=True)))
+        )[:, kinematics.bone_index(skeleton.ARM_PREFIX[arm] + "Hand")]
+        for arm, r in (("LEFT", turned[:4]), ("RIGHT", turned[4:]))
+    }
     reference = kinematics.head_positions(kinematics.pose_matrices(dict(zip(skeleton.ACTION_JOINTS, np.moveaxis(
-        rotvecs[:4], 1, 0)))))[:, kinematics.bone_index("LeftHand")]
+        rotvecs[:4], 1, 0), strict=True))))[:, kinematics.bone_index("LeftHand")]
     assert np.allclose(error[:4], np.sum((wrists["LEFT"] - reference) ** 2, axis=1), atol=1e-9)
     assert error[:4].min() > 1e-3 and error[4:].max() < 1e-12  # the right arm's frames see only the right wrist

@@ -2,6 +2,7 @@
 import json
 import shutil
 import zipfile
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,7 +11,7 @@ bpy = pytest.importorskip("bpy")
 
 from rlanimate_addon.core import kinematics, rotations, skeleton, spaces  # noqa: E402
 from rlanimate_addon.core.errors import RLAnimateError  # noqa: E402
-from trainer.blender_io import clip_import, rig_session  # noqa: E402
+from trainer.blender_io import clip_import, import_worker, rig_session  # noqa: E402
 from trainer.motion import clip_cache  # noqa: E402
 from trainer.paths import SAMPLE_RIG_BLEND, SAMPLE_RIG_FBX  # noqa: E402
 
@@ -270,15 +271,21 @@ def test_load_clip_set_attaches_the_manifest_labels_and_split(library, tmp_path)
 
 
 def count_imports(monkeypatch):
-    """A list that collects the name of every file clip_import really imports (not from its cache)."""
+    """A list that collects the name of every file clip_import really imports (not from its cache): in this
+    process (import_clip) or in its import workers (a library's clips)."""
     imported = []
-    real_import = clip_import._import_uncached
+    real_import, real_workers = clip_import._import_uncached, import_worker.import_into_cache
 
     def counting_import(path, *args):
         imported.append(path.name)
         return real_import(path, *args)
 
+    def counting_workers(files, *args, **kwargs):
+        imported.extend(Path(path).name for path, _ in files)
+        return real_workers(files, *args, **kwargs)
+
     monkeypatch.setattr(clip_import, "_import_uncached", counting_import)
+    monkeypatch.setattr(import_worker, "import_into_cache", counting_workers)
     return imported
 
 
@@ -292,7 +299,7 @@ def test_imported_clips_are_cached_and_reused_without_reimporting(library, tmp_p
     imported = count_imports(monkeypatch)
     second = clip_import.load_clip_set(manifest)
     assert imported == ["point_right_001.fbx"]  # only the bad file, which has no cache entry
-    for a, b in zip(first.clips, second.clips):
+    for a, b in zip(first.clips, second.clips, strict=True):
         np.testing.assert_array_equal(a.rotvecs, b.rotvecs)
         assert a.fingers.keys() == b.fingers.keys()
         assert (a.behaviour, a.split) == (b.behaviour, b.split)
@@ -386,3 +393,14 @@ def test_a_clip_folder_without_a_manifest_is_named_with_what_training_needs(libr
     with pytest.raises(RLAnimateError, match=rf"{tmp_path / 'elsewhere'} does not exist"):
         clip_import.load_clip_set(tmp_path / "elsewhere")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["point_left_000.fbx"], "nothing was written"
+
+
+def test_two_entries_of_one_file_keep_their_own_labels(library, tmp_path):
+    files, _, _ = library
+    manifest, _ = write_manifest(tmp_path, files)
+    data = json.loads(manifest.read_text())
+    data["clips"].append(dict(data["clips"][0], behaviour="JUMP", split="test"))  # the same file again
+    manifest.write_text(json.dumps(data))
+    clips, _ = clip_import.import_clip_directory(manifest, cache_dir=False)
+    assert [(c.name, c.behaviour, c.split) for c in clips] == [
+        ("point_left_000", "POINT", "train"), ("wave_right_000", "WAVE", "test"), ("point_left_000", "JUMP", "test")]

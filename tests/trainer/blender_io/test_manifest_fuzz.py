@@ -14,7 +14,6 @@ bpy = pytest.importorskip("bpy")
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "motion"))
 import manifest_fuzz  # noqa: E402  (tests/trainer/motion/manifest_fuzz.py)
-
 from trainer.blender_io import clip_import  # noqa: E402
 
 MUTATIONS = 300

@@ -103,7 +103,9 @@ def test_sweeps_and_seed_variation_on_a_seeded_method(library):
     lengths = behaviour.class_lengths(train)
     plain, shifted = (behaviour.request_rows(Seeded(), test[:2], NumpyReferences(), kinematics.describe, lengths,
                                              seed=seed) for seed in (None, 2))
-    assert all(s["score"] < p["score"] for p, s in zip(plain, shifted)), "a seed's answer is the one scored"
+    assert all(s["score"] < p["score"] for p, s in zip(plain, shifted, strict=True)), (
+        "a seed's answer is the one scored"
+    )
     sweep = behaviour.exaggeration_sweep(baselines.NearestClip(train), "RIGHT", 100, kinematics.describe)
     assert sweep["swing_rising"] and len(sweep["swing"]) == len(behaviour.EXAGGERATIONS)
     targets = behaviour.random_targets(np.random.default_rng(1), "RIGHT", 3)

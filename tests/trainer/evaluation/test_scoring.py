@@ -76,7 +76,7 @@ def test_length_flexibility_rolls_out_each_scaled_length(env, library):
     scales = (0.4, 1.0, 1.5)
     result = scoring.length_flexibility(agent, env, library.test, library.train, scales)
     assert set(result) == {"point", "wave"}
-    for behaviour, by_scale in result.items():
+    for by_scale in result.values():
         assert list(by_scale) == ["0.4", "1", "1.5"]
         assert all(0.0 <= value <= 100.0 for value in by_scale.values())
     waves = [c for c in library.test if c.behaviour == "WAVE"]

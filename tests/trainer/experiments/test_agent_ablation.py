@@ -1,4 +1,6 @@
-"""The agent ablation (trainer.scripts.agent_ablation) with --only: trains and measures the named rows, keeps the others as they were."""
+"""The agent ablation (trainer.scripts.agent_ablation) with --only: trains and measures the named rows, keeps the
+others as they were."""
+
 import json
 import shutil
 

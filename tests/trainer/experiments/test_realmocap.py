@@ -26,7 +26,13 @@ needs_data = pytest.mark.skipif(not (REALMOCAP_DIR / "wave").is_dir(),
 def test_imported_clips_are_labelled_from_their_motion(tmp_path):
     wave = realmocap.import_real_clip(REALMOCAP_DIR / "wave" / "dataset-2_wave-right-hand_normal_003.bvh",
                                       tmp_path)
-    assert (wave.behaviour, wave.arm, wave.named_arm, wave.style, wave.take) == ("WAVE", "RIGHT", "RIGHT", "normal", "003")
+    assert (wave.behaviour, wave.arm, wave.named_arm, wave.style, wave.take) == (
+        "WAVE",
+        "RIGHT",
+        "RIGHT",
+        "normal",
+        "003",
+    )
     assert 0.0 <= wave.exaggeration <= 1.0 and wave.attributes == wave.exaggeration
     assert np.allclose(wave.rotvecs[:, skeleton.ACTION_JOINTS.index("RightHandIndex1")],
                        neutral_pose()["RightHandIndex1"])
@@ -62,7 +68,9 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
                               references, with_tempo=True)
     tempo = wave_rhythm.clip_tempo(test[0])
     assert 0.5 < tempo < 5.0 and all(np.isfinite(result["score"]) for result in asked.values())
-    assert asked["procedural_ik"]["clips"][0]["frequency_ratio"] == pytest.approx(1.0, abs=0.2)  # it swings at the tempo
+    assert asked["procedural_ik"]["clips"][0]["frequency_ratio"] == pytest.approx(
+        1.0, abs=0.2
+    )  # it swings at the tempo
     tempos = realmocap.tempo_table(clips, references)
     assert set(tempos) == {"feminine", "active", "normal"} and tempos["active"]["takes"] == 1
     assert tempos["active"]["spectrum_hz"] == pytest.approx(tempos["active"]["strokes_hz"], rel=0.1)  # a clear swing

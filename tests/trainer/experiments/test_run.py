@@ -7,7 +7,6 @@ from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import checkpoint
 from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve
 
-
 SAVED = {"behaviour": "wave", "clips": "clips/manifest.json", "preset": "debug", "variant": "single_state",
          "seed": 4, "eval_every": 3, "epochs": 7}
 

@@ -109,7 +109,10 @@ def test_label_clip_fills_an_unlabelled_clip():
     assert (clip.behaviour, clip.arm) == ("WAVE", "LEFT")
     assert clip.attributes == clip.exaggeration == clip.label.exaggeration
     from rlanimate_addon.core.errors import RLAnimateError
-    with pytest.raises(RLAnimateError, match="points and waves only, not DANCE: label the clips of DANCE in a manifest"):
+
+    with pytest.raises(
+        RLAnimateError, match="points and waves only, not DANCE: label the clips of DANCE in a manifest"
+    ):
         autolabel.label_clip(clip, "dance")
 
 

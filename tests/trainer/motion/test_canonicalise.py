@@ -38,8 +38,9 @@ def test_swing_is_the_shortest_rotation_between_directions():
 
 def test_source_to_character_frame_stands_a_y_up_skeleton_facing_anywhere():
     # A Y-up skeleton facing +X (its left at -Z): the correction must map up to +Z and left to +X.
-    correction = canonicalise.source_to_character_frame(hips=(0, 1, 0), head=(0, 1.6, 0), left_shoulder=(0.1, 1.4, -0.2),
-                                          right_shoulder=(0.1, 1.4, 0.2))
+    correction = canonicalise.source_to_character_frame(
+        hips=(0, 1, 0), head=(0, 1.6, 0), left_shoulder=(0.1, 1.4, -0.2), right_shoulder=(0.1, 1.4, 0.2)
+    )
     np.testing.assert_allclose(correction @ (0, 1, 0), (0, 0, 1), atol=1e-12)
     np.testing.assert_allclose(correction @ (0, 0, -1), (1, 0, 0), atol=1e-12)
     np.testing.assert_allclose(correction @ correction.T, np.eye(3), atol=1e-12)
@@ -108,8 +109,7 @@ def _bandai_clip():
 
 def test_canonicalising_a_real_bandai_namco_wave_keeps_world_bone_directions():
     pytest.importorskip("bpy")
-    from trainer.blender_io import rig_session
-    from trainer.blender_io import clip_import
+    from trainer.blender_io import clip_import, rig_session
 
     path = _bandai_clip()
     rig_session.new_empty_scene()

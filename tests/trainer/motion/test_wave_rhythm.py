@@ -33,8 +33,10 @@ def test_a_slow_wave_is_read_at_its_own_rate_not_its_harmonics():
     no swing there, or a harmonic."""
     clip, synthesised = _clip(gs.GestureSpec("WAVE", "RIGHT", exaggeration=0.6, seed=4))
     slowed = np.linspace(0.0, clip.frames - 1, int(2.5 * clip.frames))
-    clip.rotvecs = np.stack([np.interp(slowed, np.arange(clip.frames), channel)
-                             for channel in clip.rotvecs.reshape(clip.frames, -1).T], axis=1).reshape(len(slowed), -1, 3)
+    clip.rotvecs = np.stack(
+        [np.interp(slowed, np.arange(clip.frames), channel) for channel in clip.rotvecs.reshape(clip.frames, -1).T],
+        axis=1,
+    ).reshape(len(slowed), -1, 3)
     made_hz = (gs.draw_style(4).wave_frequency - 0.2 * 0.6) / 2.5
     read = wave_rhythm.clip_rhythm(clip)
     assert read.frequency * clip.fps == pytest.approx(made_hz, rel=0.05)

@@ -31,7 +31,10 @@ def test_report_has_a_row_per_method_in_each_table(tmp_path):
     train = [_clip(p) for p in plan if p.split == "train"][::3]
     test = [_clip(p) for p in plan if p.split == "test"][::2]
     lengths = behaviour.class_lengths(train)
-    methods = {"no_motion": baselines.NoMotion(baselines.mean_start_pose(train)), "nearest_clip": baselines.NearestClip(train)}
+    methods = {
+        "no_motion": baselines.NoMotion(baselines.mean_start_pose(train)),
+        "nearest_clip": baselines.NearestClip(train),
+    }
     sets, clips = {"wave": {}, "point": {}, "point_exact_aim": {}}, {}
     for name, method in methods.items():
         rows = behaviour.request_rows(method, test, References(), kinematics.describe, lengths)

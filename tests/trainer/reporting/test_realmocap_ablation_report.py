@@ -15,7 +15,7 @@ def _results():
     names = ["typical tempo (as exported)", "mean rhythm, all waves' phase", "sampled states 1: x",
              "sampled states 2: x", "seed 1: y", "seed 2: y"]
     scores = [(60.0, 70.0), (62.5, 71.0), (50.0, 65.0), (54.0, 67.0), (40.0, 60.0), (44.0, 62.0)]
-    summaries = {name: _summary(*score) for name, score in zip(names, scores)}
+    summaries = {name: _summary(*score) for name, score in zip(names, scores, strict=True)}
     summaries["nearest_clip"] = _summary(74.0, 90.0)
     summaries["nearest_clip, tempo asked"] = _summary(80.0, 95.0)
     return {"command": "cmd", "seed": 0, "epochs": 50, "preset": "default", "variants": names,

@@ -13,8 +13,15 @@ def _clip(style, take, score, swing, accepted, elevation=2.0):
 
 
 def test_style_summaries_group_takes_by_the_style_in_their_names():
-    summaries = style_summaries({"clips": [_clip("normal", 9, 60.0, 0.5, False, 12.0), _clip("active", 9, 40.0, 0.2, False),
-                                           _clip("normal", 10, 80.0, 0.9, True, 4.0)]})
+    summaries = style_summaries(
+        {
+            "clips": [
+                _clip("normal", 9, 60.0, 0.5, False, 12.0),
+                _clip("active", 9, 40.0, 0.2, False),
+                _clip("normal", 10, 80.0, 0.9, True, 4.0),
+            ]
+        }
+    )
     assert list(summaries) == ["active", "normal"]
     undefined = style_summaries({"clips": [_clip("elderly", 1, 50.0, float("nan"), False)]})["elderly"]
     assert np.isnan(undefined["swing_ratio"]) and undefined["frequency_ratio"] == 1.0
@@ -63,11 +70,16 @@ def test_seed_rows_give_each_seed_then_their_mean_and_sd_then_retrieval():
                            "test_tempo": {"rlanimate": agent, "nearest_clip": _retrieval(41.0)},
                            "test_tempo_seeds": {"0": _seed(50.0, 55.0, 0.9, 1)}}}
     rows = seed_rows(results)
-    assert rows[-2:] == [["unseen styles, tempo asked", "RLAnimate, seed 0", "50.0", "55.0", "0.90", "1.00", "3.0", "1"],
-                         ["unseen styles, tempo asked", "Nearest clip", "70.0", "41.0", "1.00", "1.00", "2.0", "1"]]
-    assert [row[:2] for row in rows[:4]] == [["takes 009-010", "RLAnimate, seed 0"], ["takes 009-010", "RLAnimate, seed 1"],
-                                             ["takes 009-010", "RLAnimate, mean ± sd of 2"],
-                                             ["takes 009-010", "Nearest clip"]]
+    assert rows[-2:] == [
+        ["unseen styles, tempo asked", "RLAnimate, seed 0", "50.0", "55.0", "0.90", "1.00", "3.0", "1"],
+        ["unseen styles, tempo asked", "Nearest clip", "70.0", "41.0", "1.00", "1.00", "2.0", "1"],
+    ]
+    assert [row[:2] for row in rows[:4]] == [
+        ["takes 009-010", "RLAnimate, seed 0"],
+        ["takes 009-010", "RLAnimate, seed 1"],
+        ["takes 009-010", "RLAnimate, mean ± sd of 2"],
+        ["takes 009-010", "Nearest clip"],
+    ]
     assert rows[2][2:5] == ["**62.0 ± 2.8**", "**82.0 ± 2.8**", "**1.00 ± 0.14**"]
     assert rows[2][6] == "**3.0 ± 0.0**" and rows[3][3] == "81.0" and rows[3][6:] == ["2.0", "1"]
     # One seed: no mean row.

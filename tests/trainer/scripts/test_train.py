@@ -54,6 +54,9 @@ def test_unknown_preset_is_a_clear_error_before_any_clip_loads(tiny_library, tmp
     ("--epochs", "0", "--epochs 0: train at least 1 epoch"),
     ("--epochs", "-3", "--epochs -3: train at least 1 epoch"),
     ("--checkpoint-every", "0", "--checkpoint-every 0: write a checkpoint every 1 or more epochs"),
+    ("--import-memory-limit", "0", "--import-memory-limit 0: give a number above 0 (GB), such as 2"),
+    ("--import-time-limit", "-5", "--import-time-limit -5: give a number above 0 (seconds), such as 60"),
+    ("--import-workers", "0", "--import-workers 0: give a number above 0, such as 2"),
 ])
 def test_unusable_arguments_stop_the_script_before_any_clip_is_imported(tmp_path, monkeypatch, capsys, option,
                                                                         value, message):

@@ -19,11 +19,27 @@ Pointing contract: at the hold the index-finger base lies on the ray from the ar
 joint along `spaces.pointing_direction(arm, target)`, and the finger (Index1 head -> Index4 head)
 runs along that ray, so its line passes through the target at any distance.
 """
+from .arms import neutral_pose
 from .clips import GUIDE, MAX_WAVING, POINT, RAISE_HAND, SYNTHESISERS, WAVE, GestureClip, synthesise
 from .pose import ANIMATED_BONES, FINGER_BONES, FPS
-from .arms import neutral_pose
 from .style import GestureSpec, Style, draw_style
 from .timing import keyed_progress
 
-__all__ = ["ANIMATED_BONES", "FINGER_BONES", "FPS", "GUIDE", "MAX_WAVING", "POINT", "RAISE_HAND", "SYNTHESISERS", "WAVE",
-           "GestureClip", "GestureSpec", "Style", "draw_style", "keyed_progress", "neutral_pose", "synthesise"]
+__all__ = [
+    "ANIMATED_BONES",
+    "FINGER_BONES",
+    "FPS",
+    "GUIDE",
+    "MAX_WAVING",
+    "POINT",
+    "RAISE_HAND",
+    "SYNTHESISERS",
+    "WAVE",
+    "GestureClip",
+    "GestureSpec",
+    "Style",
+    "draw_style",
+    "keyed_progress",
+    "neutral_pose",
+    "synthesise",
+]

@@ -5,8 +5,18 @@ import numpy as np
 from rlanimate_addon.core import skeleton
 from rlanimate_addon.core.rotations import matrix_to_rotvec, rotvec_to_matrix
 
-from .pose import (ANIMATED_BONES, FORWARD, SIDE_SIGN, Pose, axis_rotation, bone_length, frame_from, perpendicular,
-    twist_angle, unit)
+from .pose import (
+    ANIMATED_BONES,
+    FORWARD,
+    SIDE_SIGN,
+    Pose,
+    axis_rotation,
+    bone_length,
+    frame_from,
+    perpendicular,
+    twist_angle,
+    unit,
+)
 
 
 def arm_prefix(arm):

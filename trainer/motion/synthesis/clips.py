@@ -17,7 +17,6 @@ from .style import GestureSpec, draw_style
 from .timing import blend_rotation, keyed_progress
 from .waving import wave_pose
 
-
 MAX_WAVING = 1.7  # s of oscillation at most, so no clip runs past 4.5 s
 
 #: The behaviours the generator makes: the paper's two and two more (docs/CLIPS.md).

@@ -6,8 +6,19 @@ from rlanimate_addon.core import skeleton, spaces
 from rlanimate_addon.core.rotations import matrix_to_rotvec
 
 from .arms import POINTING_HAND, arm_prefix, elbow_position, neutral_body, place_arm, pose_neutral_arm, shape_hand
-from .pose import (FORWARD, HEAD, OTHER_ARM, REST, SIDE_SIGN, UP, axis_rotation, bone_length, frame_from,
-    perpendicular, unit)
+from .pose import (
+    FORWARD,
+    HEAD,
+    OTHER_ARM,
+    REST,
+    SIDE_SIGN,
+    UP,
+    axis_rotation,
+    bone_length,
+    frame_from,
+    perpendicular,
+    unit,
+)
 
 
 def aim_head(pose, look_at, tilt=0.0, neck_share=0.4):
@@ -31,7 +42,7 @@ def aim_head(pose, look_at, tilt=0.0, neck_share=0.4):
 
 
 def turn_torso(pose, rotvec, shares=(0.3, 0.35, 0.35)):
-    for bone, share in zip(("Spine", "Spine1", "Spine2"), shares):
+    for bone, share in zip(("Spine", "Spine1", "Spine2"), shares, strict=True):
         pose.turn(bone, share * np.asarray(rotvec))
 
 

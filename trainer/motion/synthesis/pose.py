@@ -5,7 +5,6 @@ import numpy as np
 from rlanimate_addon.core import skeleton
 from rlanimate_addon.core.rotations import matrix_to_rotvec, rotvec_to_matrix
 
-
 FPS = 30
 
 FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")

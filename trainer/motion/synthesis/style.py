@@ -12,8 +12,8 @@ class GestureSpec:
     posture variation)."""
     behaviour: str
     arm: str
-    target: tuple = None
-    exaggeration: float = None
+    target: tuple[float, ...] | None = None
+    exaggeration: float | None = None
     seed: int = 0
 
 

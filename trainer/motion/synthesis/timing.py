@@ -12,7 +12,7 @@ def keyed_progress(times, knots):
     """Progress at `times` (T,) through (time, value) knots, minimum-jerk between consecutive knots:
     every knot is reached at rest, so the curve is smooth (C2) and each segment's speed one bell."""
     out = np.full(np.shape(times), float(knots[0][1]))
-    for (t0, v0), (t1, v1) in zip(knots[:-1], knots[1:]):
+    for (t0, v0), (t1, v1) in zip(knots[:-1], knots[1:], strict=True):
         inside = times >= t0
         out = np.where(inside, v0 + (v1 - v0) * minimum_jerk((times - t0) / max(t1 - t0, 1e-9)), out)
     return out

@@ -6,7 +6,6 @@ from .arms import OPEN_HAND, arm_prefix, neutral_body, place_arm, pose_neutral_a
 from .pointing import aim_head, turn_torso
 from .pose import FORWARD, OTHER_ARM, SIDE_SIGN, UP, Pose, bone_length, frame_from, unit
 
-
 _ADDRESSEE = np.array([0.0, -2.5, 1.62])  # whom the character waves at: ahead, at eye height
 
 

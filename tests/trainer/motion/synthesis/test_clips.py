@@ -143,8 +143,12 @@ def test_stroke_speed_is_bell_shaped():
     rng = np.random.default_rng()
     for arm in skeleton.ARMS:
         side = skeleton.ARM_PREFIX[arm]
-        for clip, phase in ((point(arm, random_target(rng, arm), 7), "stroke"), (point(arm, random_target(rng, arm), 8), "return"),
-                            (wave(arm, 0.7, 9), "raise"), (wave(arm, 0.3, 10), "lower")):
+        for clip, phase in (
+            (point(arm, random_target(rng, arm), 7), "stroke"),
+            (point(arm, random_target(rng, arm), 8), "return"),
+            (wave(arm, 0.7, 9), "raise"),
+            (wave(arm, 0.3, 10), "lower"),
+        ):
             first, last = clip.phases[phase]
             path = heads_of(clip)[first:last + 1, joint(side + "Hand")]
             speed = np.linalg.norm(np.diff(path, axis=0), axis=1)
