@@ -87,25 +87,8 @@ def test_a_new_gesture_from_fbx_clips_trains_and_bakes_from_the_panel(tmp_path, 
     clips, run = tmp_path / "clips", tmp_path / "run"
     clips.mkdir()
     write_gesture_library(clips)
-    assert (
-        train.main(
-            [
-                "trainer/train.py",
-                "--clips",
-                str(clips),
-                "--output",
-                str(run),
-                "--preset",
-                "debug",
-                "--epochs",
-                "2",
-                "--eval-every",
-                "0",
-                "--quiet",
-            ]
-        )
-        == 0
-    )
+    options = ["--output", str(run), "--preset", "debug", "--epochs", "2", "--eval-every", "0", "--quiet"]
+    assert train.main(["trainer/train.py", "--clips", str(clips), *options]) == 0
     weights, metadata = agent_file.load_agent_file(run / "agent.npz")
     assert metadata["behaviours"] == [{"name": "POINT", "kind": "target"}, {"name": "WAVE", "kind": "intensity"},
                                       {"name": "HELLO", "kind": "intensity"}]
