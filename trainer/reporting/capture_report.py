@@ -1,8 +1,8 @@
 """A capture folder's run: its labels table, and the comparison with retrieval on its held-out takes
 (<output>/capture_report.md; trainer/experiments/capture.py)."""
-from trainer.evaluation.paired import gap_cell, paired_gap
 from trainer.motion import capture_folder
 from trainer.reporting.behaviour_report import behaviour_words
+from trainer.reporting.paired import gap_cell, paired_gap
 from trainer.reporting.tables import markdown_table
 
 LABEL_COLUMNS = ("take", "behaviour (kind)", "arm", "label", "tempo", "frames", "split", "notes")

@@ -5,9 +5,9 @@ import matplotlib
 import numpy as np
 
 from rlanimate_addon.core import skeleton
-from trainer.evaluation.paired import gap_cell, paired_gap
 from trainer.motion.realmocap_takes import HOLDOUT_STYLES, TAKE_GROUPS, TEST_TAKES, VALIDATION_TAKES, parse_name
 from trainer.reporting.baselines_report import METHOD_LABELS
+from trainer.reporting.paired import gap_cell, paired_gap
 from trainer.reporting.tables import markdown_table
 
 matplotlib.use("Agg")

@@ -2,7 +2,6 @@
 import json
 from pathlib import Path
 
-from trainer.evaluation.scoring import SEEN_CLIP_COUNT
 from trainer.paths import shown
 from trainer.reporting.behaviour_report import behaviour_words, clip_words
 from trainer.reporting.tables import markdown_table
@@ -45,8 +44,9 @@ def report_lines(report):
              *markdown_table(["clip set", "clips", "score", "smoothness", "score, DTW", "behaviour (docs/METRICS.md)"],
                              _set_rows(report)), "",
              f"Every held-out clip of a trained behaviour is scored ({len(held_out)}). The training (seen) set is "
-             f"the paper's {SEEN_CLIP_COUNT} training clips, shared between the behaviours and spread evenly over "
-             "each one's clips (a behaviour's \"k of n\": k of its n training clips).", "", "Per held-out clip:", "",
+             f"the paper's {len(report['training']['clips'])} training clips, shared between the behaviours and "
+             "spread evenly over each one's clips (a behaviour's \"k of n\": k of its n training clips).", "",
+             "Per held-out clip:", "",
              *markdown_table(["clip", "behaviour", "score", "score, DTW", "smoothness", "measures"],
                              [[c["name"], c["behaviour"], f"{c['score']:.2f}", f"{c['aligned_score']:.2f}",
                                f"{c['smoothness']:.2f}", clip_words(c)] for c in held_out])]
