@@ -16,7 +16,12 @@
     end_chunks, end_chunks_wide
              the default with a fifth of the chunks ending at the gesture's last frame, where the arm
              comes down (trainer/agent/buffer.py), and that with every state and hidden layer twice as
-             wide (real capture: docs/results/realmocap.md, realmocap_ablation.md).
+             wide (real capture: docs/results/realmocap.md, realmocap_ablation.md);
+    end_chunks_long, end_chunks_smooth, end_chunks_phase
+             end_chunks with chunks of 64 frames (half as many, the same frames an update), so that a
+             slow real wave's whole cycle lies in one chunk; or with the pose-velocity term; or with the
+             wave's phase and its second harmonic beside the task state, as phase-conditioned motion models
+             give it (real capture's model search: docs/results/realmocap_model.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -35,9 +40,14 @@ class AgentConfig:
     min_std: float = 0.1  # floor of the prior's and posterior's standard deviations
     concentration_floor: float = 1.0  # floor of the Beta's alpha and beta (>= 1: unimodal)
     concentration_scale: float = 100.0  # alpha, beta = floor + scale * softplus(output)
+    phase_input: bool = False  # f2 and the heads also see the wave's phase and its harmonic (rhythm.phase_features)
 
     def to_dict(self):
-        return asdict(self)
+        """The fields as a dict; phase_input only when on, so that an agent without it is written as before."""
+        values = asdict(self)
+        if not self.phase_input:
+            del values["phase_input"]
+        return values
 
     @classmethod
     def from_dict(cls, values):
@@ -113,6 +123,10 @@ PRESETS = {
     "end_chunks": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
     "end_chunks_wide": (AgentConfig(task_size=128, behaviour_size=128, hidden_size=128, portrayal_hidden_size=128),
                         replace(_DEFAULT_TRAIN, last_frame_share=0.2)),  # ... and twice the width (capacity)
+    # Issue 45's model search on real capture (options: no other preset changes).
+    "end_chunks_long": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, chunk_length=64, chunk_count=16)),
+    "end_chunks_smooth": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
+    "end_chunks_phase": (AgentConfig(phase_input=True), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),

@@ -33,6 +33,7 @@ from torch import nn
 from torch.distributions import Beta, Independent, Normal
 
 from rlanimate_addon.core import agent_file, spaces
+from rlanimate_addon.core.behaviours import WAVE
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import losses as loss_terms
 from trainer.agent import unroll
@@ -80,8 +81,11 @@ class RLAnimateAgent(nn.Module):
             self.portrayal = MLP(O, c.portrayal_hidden_size, n, D)
         if self.uses_task_state:
             self.task_rnn = nn.GRU(O, c.task_size, batch_first=True)
-        task = c.task_size if self.uses_task_state else O
-        head_inputs = (c.task_size if self.uses_task_state else 0) + E + Z
+        if c.phase_input and not self.uses_task_state:
+            raise RLAnimateError(f"phase_input needs a task state to give the phase beside: the {variant} variant "
+                                 "has none.")
+        task = agent_file.task_width(c.to_dict(), variant, O)
+        head_inputs = (task if self.uses_task_state else 0) + E + Z
         self.behaviour_cell = nn.GRUCell(task + Z + A, E)
         self.prior = MLP(E, hid, n, 2 * Z)
         self.posterior = MLP(E + D, hid, n, 2 * Z)
@@ -99,7 +103,20 @@ class RLAnimateAgent(nn.Module):
         if not self.uses_task_state:
             return objectives
         states, _ = self.task_rnn(objectives)  # h_0 = 0
-        return states
+        return torch.cat([states, self.phase_features(objectives)], -1) if self.config.phase_input else states
+
+    def phase_features(self, objectives):
+        """(B, T, O) -> (B, T, 4): the wave's phase and second harmonic, zeros for other behaviours
+        (core.spaces.ObjectiveSpace.phase_features, in torch)."""
+        signals = objectives[..., spaces.OBJECTIVE_ATTRIBUTES][..., 1:]  # (B, T, 2) A sin, A cos
+        sine, cosine = signals.unbind(-1)
+        amplitude = torch.clamp(torch.hypot(sine, cosine), min=1e-9)
+        features = torch.stack([sine, cosine, 2.0 * sine * cosine / amplitude,
+                                (cosine ** 2 - sine ** 2) / amplitude], -1)
+        if WAVE not in self.space.names:
+            return torch.zeros_like(features)
+        label = objectives.new_tensor(self.space.labels[self.space.names.index(WAVE)])
+        return features * (objectives[..., :self.space.label_size] == label).all(-1, keepdim=True)
 
     def transition(self, e_prev, z_prev, a_prev, task):
         """f2: e_{t-1} (B, E), z_{t-1} (B, Z), a_{t-1} (B, 45), h_t (B, K) -> e_t (B, E)."""

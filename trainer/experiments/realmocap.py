@@ -52,13 +52,13 @@ from trainer.experiments.options import require_values
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
+from trainer.motion.hands import relaxed_hand
 from trainer.motion.realmocap_takes import (
     GUIDE_TARGET_DISTANCE,
     HOLDOUT_STYLES,
     PAPER_LABELS,
     TAKE_GROUPS,
     parse_name,
-    relaxed_hand,
     require_realmocap,
     style_holdout_split,
     take_group,
@@ -222,15 +222,19 @@ REQUESTS = {"": False, "_tempo": True}
 
 def compare(methods, clips, env, references, with_tempo=False):
     """{method: scoring.score_motions result} on `clips`, each answering the clip's request (with its tempo when
-    `with_tempo`); for waves also `label_error`, the mean |autolabel exaggeration of the generated wave -
+    `with_tempo`, and `tempo_fallbacks` {take: why} naming the takes whose request fell back to the label,
+    baselines.request_tempos); for waves also `label_error`, the mean |autolabel exaggeration of the generated wave -
     requested exaggeration| (does it portray the label?)."""
     results = {}
+    _, fallbacks = baselines.request_tempos(clips, with_tempo)
     for name, method in methods.items():
         motions = baselines.generate_for(method, clips, with_tempo)
         result = scoring.score_motions(env, motions, clips, references)
         if all(c.behaviour == behaviours.WAVE for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
                                                    for m, c in zip(motions, clips, strict=True)]))
+        if fallbacks:
+            result["tempo_fallbacks"] = fallbacks
         results[name] = result
     return results
 
@@ -268,7 +272,7 @@ def tempo_table(clips, references):
     for clip in clips:
         measures = behaviour_metrics.wave_measures(spaces.description_joint_positions(references.get(clip)[0]),
                                                    clip.arm)
-        spectrum = wave_rhythm.clip_tempo(clip)
+        spectrum = wave_rhythm.tempo_reading(clip)[0]
         entry = readings.setdefault(clip.style, {"spectrum": [], "strokes": [], "stroke": [], "groups": []})
         entry["spectrum"].append(np.nan if spectrum is None else spectrum)
         entry["strokes"].append(measures["frequency"] or np.nan)
