@@ -20,25 +20,29 @@ from rlanimate_addon.core import metrics
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.config import PRESETS
 from trainer.evaluation import baselines
-from trainer.experiments.realmocap import REQUESTS, RealMocapSettings, compare, real_run, train_real_runs, waves_and_env
+from trainer.experiments.realmocap import (
+    REQUESTS,
+    RealCaptureSettings,
+    RealMocapSettings,
+    compare,
+    real_run,
+    train_real_runs,
+    waves_and_env,
+)
 from trainer.experiments.realmocap_length import EXPERIMENTS
 from trainer.motion.fk import ClipReferences
-from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.realmocap_report import seed_summary
 
 
 @dataclass(frozen=True)
-class ModelSettings:
+class ModelSettings(RealCaptureSettings):
     """What the model search runs: the presets (the recipe first), the epochs, the seeds and the validation
     experiments."""
+    # config presets to compare, the recipe first (trainer/agent/config.py)
     presets: tuple[str, ...] = ("end_chunks", "end_chunks_long", "end_chunks_smooth")
-    epochs: int = 100
-    seeds: tuple[int, ...] = (0,)
-    experiments: tuple[str, ...] = ("takes", "style")
-    realmocap: str = str(REALMOCAP_DIR)
-    runs: str = str(REALMOCAP_RUNS)
-    results: str = str(RESULTS_DIR)
-    workers: int | None = None
+    epochs: int = 100  # iterations of Algorithm 1 per agent
+    seeds: tuple[int, ...] = (0,)  # training seeds
+    experiments: tuple[str, ...] = ("takes", "style")  # validation experiments: takes (007-008) and/or style (normal)
 
     def __post_init__(self):
         unknown = [p for p in self.presets if p not in PRESETS] + [e for e in self.experiments if e not in EXPERIMENTS]

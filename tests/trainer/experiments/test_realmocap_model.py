@@ -5,7 +5,7 @@ import pytest
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.experiments.realmocap_model import ModelSettings, validation_summary
 from trainer.reporting.realmocap_model_report import model_markdown, model_rows
-from trainer.scripts.realmocap_model import build_parser
+from trainer.scripts.realmocap_model import parse_settings
 
 
 def _clip(style, take, smoothness, last_error, score=80.0):
@@ -33,9 +33,9 @@ def test_unknown_presets_or_experiments_are_refused_before_any_training():
         ModelSettings(presets=("end_chunks", "huge"))
     with pytest.raises(RLAnimateError, match="unknown later"):
         ModelSettings(experiments=("later",))
-    args = build_parser().parse_args(["--presets", "end_chunks", "end_chunks_long", "--seeds", "0", "1"])
-    assert (args.presets, args.seeds, args.experiments) == (["end_chunks", "end_chunks_long"], [0, 1],
-                                                            ["takes", "style"])
+    settings = parse_settings(["prog", "--presets", "end_chunks", "end_chunks_long", "--seeds", "0", "1"])
+    assert (settings.presets, settings.seeds, settings.experiments) == (("end_chunks", "end_chunks_long"), (0, 1),
+                                                                        ("takes", "style"))
 
 
 def test_the_page_gives_each_preset_over_its_seeds_beside_retrieval():

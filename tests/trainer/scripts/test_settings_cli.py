@@ -20,6 +20,7 @@ from trainer.scripts import (
     realmocap_ablation,
     realmocap_gestures,
     realmocap_length,
+    realmocap_model,
 )
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -29,7 +30,8 @@ SCRIPTS = ((agent_ablation, agent_ablation.AblationSettings), (baselines, baseli
            (experiments, experiments.PaperSettings), (realmocap, realmocap.RealMocapSettings),
            (realmocap_ablation, realmocap_ablation.AblationSettings),
            (realmocap_gestures, realmocap_gestures.GestureSettings),
-           (realmocap_length, realmocap_length.LengthSettings))
+           (realmocap_length, realmocap_length.LengthSettings),
+           (realmocap_model, realmocap_model.ModelSettings))
 
 
 def options_without_help(settings_type, capsys, monkeypatch):
