@@ -28,8 +28,10 @@ def _agent_summary(context, behaviour):
     except RLAnimateError as error:
         return name, str(error)
     if behaviour not in agent.behaviours:
-        return name, (f"The chosen behaviour is not one of this agent's ("
-                      f"{', '.join(behaviours.title(b) for b in agent.behaviours)}): pick one above.")
+        lacking = f"This agent does not perform {behaviours.title(behaviour)}" if behaviour else \
+            "The chosen behaviour is not one of this agent's"
+        return name, (f"{lacking} (it performs {', '.join(behaviours.title(b) for b in agent.behaviours)}): pick "
+                      "one above, or choose an agent trained for it in Preferences.")
     average = agent.average_frames[behaviour]
     fps = properties.scene_fps(context.scene)
     average, shortest, longest = (frame_rate.scene_frames(n, fps)

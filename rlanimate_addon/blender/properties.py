@@ -3,7 +3,8 @@
 The names behaviour, arm, target, exaggeration, tempo, frame_count, start_frame, seed and exact_aim are a
 contract that outside tools and checks use: keep them. Until set, frame_count is the agent's average length of
 the behaviour's clips and start_frame the scene's current frame. `behaviour` lists the selected agent's behaviours
-(`behaviour_items`): its values are their ids, "POINT" and "WAVE" for those.
+(`behaviour_items`): its values are their ids, "POINT" and "WAVE" for those; `behaviour_name` keeps the id chosen,
+so that an agent that lacks it still shows and names it.
 """
 import zlib
 
@@ -111,29 +112,59 @@ def behaviour_number(behaviour):
 
 
 _items = {}
+#: The behaviour ids of the paper's pair by enum number.
+_NAMED_NUMBERS = {number: name for name, number in _NUMBERS.items()}
+
+
+def stored_behaviour(settings):
+    """The id of the behaviour the settings hold, whichever agent is selected: the one remembered when it was
+    chosen (`behaviour_name`) while the stored number is still its, else point or wave by number; None when the
+    stored number is of a behaviour not remembered."""
+    if settings is None:
+        return None
+    number = settings.get("behaviour", behaviour_number(POINT))
+    name = settings.get("behaviour_name", "")
+    return name if name and behaviour_number(name) == number else _NAMED_NUMBERS.get(number)
+
+
+def _lacking_item(name):
+    """The enum item of a behaviour the settings hold that the selected agent does not perform: shown, so that the
+    choice is read without Blender's 'matches no enum' warning and Generate can name it."""
+    title = behaviours.title(name)
+    return (name, f"{title} (not in this agent)", f"The selected agent does not perform {title}: pick one of its "
+            "behaviours, or choose an agent trained for it in Preferences", behaviour_number(name))
 
 
 def behaviour_items(settings, context):
     """The `behaviour` enum's items: the selected agent's behaviours (point and wave when it cannot be
-    loaded; the panel says why). The list is kept here, per set of behaviours: Blender reads the strings
-    after this returns, and crashes or shows garbage if Python has freed them (the bpy.props.EnumProperty
-    documentation's known bug with item callbacks)."""
+    loaded; the panel says why), and the one the settings hold when the agent lacks it (`_lacking_item`). The
+    list is kept here, per set of behaviours: Blender reads the strings after this returns, and crashes or shows
+    garbage if Python has freed them (the bpy.props.EnumProperty documentation's known bug with item callbacks)."""
     try:
         agent = preferences.selected_agent(context or bpy.context)
         declared = tuple((name, agent.kind(name)) for name in agent.behaviours)
     except RLAnimateError:
         declared = tuple(KNOWN_KINDS.items())
-    if declared not in _items:
-        _items[declared] = [(name, behaviours.title(name),
-                             _DESCRIPTIONS.get(name) or _KIND_DESCRIPTIONS[kind].format(name=behaviours.title(name)),
-                             behaviour_number(name)) for name, kind in declared]
-    return _items[declared]
+    held = stored_behaviour(settings)
+    lacking = held if held is not None and held not in dict(declared) else None
+    if (declared, lacking) not in _items:
+        _items[declared, lacking] = [
+            (name, behaviours.title(name),
+             _DESCRIPTIONS.get(name) or _KIND_DESCRIPTIONS[kind].format(name=behaviours.title(name)),
+             behaviour_number(name)) for name, kind in declared] + ([_lacking_item(lacking)] if lacking else [])
+    return _items[declared, lacking]
+
+
+def _remember_behaviour(settings, context):
+    """The enum's update: keep the chosen behaviour's id (`behaviour_name`), so that another agent that lacks it
+    still names it."""
+    settings["behaviour_name"] = settings.behaviour
 
 
 def chosen_behaviour(settings, context):
-    """The id of the settings' behaviour among the selected agent's, or "" when the stored choice is none of
-    them (another agent's): read from the stored enum number, as `settings.behaviour` would, without the
-    warning Blender prints for a value its items lack (the panel reads it on every redraw)."""
+    """The id of the settings' behaviour (one the selected agent lacks included, `behaviour_items`), or "" when the
+    stored choice is of a behaviour not remembered: read from the stored enum number, as `settings.behaviour`
+    would, without the warning Blender prints for a value its items lack (the panel reads it on every redraw)."""
     number = settings.get("behaviour", behaviour_number(POINT))
     return next((item[0] for item in behaviour_items(settings, context) if item[3] == number), "")
 
@@ -152,8 +183,11 @@ def behaviour_kind(context, behaviour):
 
 class RLANIMATE_PG_settings(bpy.types.PropertyGroup):
     behaviour: bpy.props.EnumProperty(
-        name="Behaviour", default=behaviour_number(POINT), items=behaviour_items,
+        name="Behaviour", default=behaviour_number(POINT), items=behaviour_items, update=_remember_behaviour,
         description="The gesture: one of the selected agent's behaviours")
+    behaviour_name: bpy.props.StringProperty(
+        name="Behaviour Name", default="", options={"HIDDEN"},
+        description="The id of the behaviour last chosen, kept so that an agent lacking it can name it")
     arm: bpy.props.EnumProperty(
         name="Arm", default="RIGHT",
         items=[("LEFT", "Left", "The character's left arm"), ("RIGHT", "Right", "The character's right arm")])

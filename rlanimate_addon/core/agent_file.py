@@ -86,6 +86,14 @@ def gru_shapes(name, inputs, size, suffix=""):
             f"{name}.bias_ih{suffix}": (3 * size,), f"{name}.bias_hh{suffix}": (3 * size,)}
 
 
+def task_width(agent_config, variant, objective_size):
+    """How wide the task input of f2 and the heads is: the task state, with the wave's phase features beside it
+    for an agent with `phase_input` (rhythm.PHASE_FEATURES), or the objective itself without a task state."""
+    if not uses_task_state(variant):
+        return objective_size
+    return agent_config["task_size"] + (rhythm.PHASE_FEATURES if agent_config.get("phase_input", False) else 0)
+
+
 def expected_weight_shapes(agent_config, variant, objective_size):
     """{array name: shape} of an agent with `agent_config` (a dict of AgentConfig fields), `variant` and
     objectives of `objective_size` (its ObjectiveSpace's size)."""
@@ -95,8 +103,8 @@ def expected_weight_shapes(agent_config, variant, objective_size):
     c = agent_config
     O, D, A = objective_size, spaces.DESCRIPTION_SIZE, spaces.ACTION_SIZE  # noqa: E741 (the paper's sizes)
     E, Z, hid, n = c["behaviour_size"], c["stochastic_size"], c["hidden_size"], c["hidden_layers"]
-    task = c["task_size"] if uses_task_state(variant) else O  # what f2 and the heads see of the task
-    head_inputs = (c["task_size"] if uses_task_state(variant) else 0) + E + Z
+    task = task_width(c, variant, O)  # what f2 and the heads see of the task
+    head_inputs = (task if uses_task_state(variant) else 0) + E + Z
     shapes = {}
     if uses_portrayal(variant):
         shapes.update(mlp_shapes("portrayal", O, c["portrayal_hidden_size"], n, D))
@@ -386,6 +394,12 @@ def _check_metadata_values(path, metadata):
         raise RLAnimateError(f"The agent file {path} has an invalid agent_config (widths 1-{MAX_SIZE}, "
                              f"hidden_layers 1-{MAX_HIDDEN_LAYERS}, {', '.join(_AGENT_SCALARS)} positive and "
                              f"at most {MAX_CONFIG_SCALAR:g}): re-export it with trainer/agent/agent_export.py.")
+    if not isinstance(config.get("phase_input", False), bool):
+        raise RLAnimateError(f"The agent file {path} has an invalid agent_config phase_input (true or false): "
+                             f"re-export it with trainer/agent/agent_export.py.")
+    if config.get("phase_input", False) and not uses_task_state(metadata["variant"]):
+        raise RLAnimateError(f"The agent file {path} gives phase_input to a {metadata['variant']} agent, which has "
+                             f"no task state to give it beside: re-export it with trainer/agent/agent_export.py.")
     if not isinstance(metadata["variant"], str):
         raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
                              f"{', '.join(VARIANTS)}.")
@@ -423,6 +437,10 @@ def _check_metadata_values(path, metadata):
         if problem:
             raise RLAnimateError(f"The agent file {path} has an invalid wave_rhythm ({problem}): re-export it with "
                                  f"trainer/agent/agent_export.py.")
+    still = metadata.get("still_free_arm", [])
+    if not isinstance(still, list) or any(not isinstance(b, str) or b not in space.names for b in still):
+        raise RLAnimateError(f"The agent file {path} has an invalid still_free_arm (need a list of the behaviours, "
+                             f"among {', '.join(space.names)}, whose free arm the gesture holds still): re-export it.")
     return {name: tuple(shape) for name, shape in expected.items()}
 
 

@@ -17,11 +17,13 @@ least half its largest distance from its first position.
 Guide ("this way"), over the same hold: the fingers head towards the target seen from above, the palm
 (`palm_normal`) faces up, the wrist is out from the shoulder. Raise hand: held with the hand up and the
 wrist still, the forearm near vertical, no side-to-side strokes beyond the raise and the lowering, and
-the wrist as high above the shoulder as the reference's.
+the wrist as high above the shoulder as the reference's. A behaviour without measures of its own (a user's
+gesture) is measured by its kind (`KIND_MEASURES`): an intensity one by the hand's peak height, a target one by
+its aim at the target, each with the other arm's rise.
 """
 import numpy as np
 
-from . import metrics, skeleton, spaces
+from . import behaviours, metrics, skeleton, spaces
 from .errors import RLAnimateError
 
 FPS = 30
@@ -484,13 +486,52 @@ def raise_row(generated, reference, arm, target, fps):
 MEASURES = {"WAVE": wave_row, "POINT": point_row, "GUIDE": guide_row, "RAISE_HAND": raise_row}
 
 
-def compare(generated, reference, behaviour, arm, target=None, fps=FPS):
+def peak_hand_height(positions, arm):
+    """Arm lengths: how high the arm's wrist goes above its shoulder joint, at its highest frame."""
+    p, side = _positions(positions), _side(arm)
+    return float((p[:, _JOINT[f"{side}_wrist"], 2] - p[:, _JOINT[f"{side}_shoulder"], 2]).max() / arm_length(p, arm))
+
+
+def intensity_row(generated, reference, arm, target, fps):
+    """An intensity behaviour's measures where it has none of its own (a user's gesture, such as a raised hand
+    named "hello"): what its exaggeration scales, the hand's peak height ('hand_height_error', arm lengths,
+    absolute, against the reference's), and the other arm's rise ('free_arm_rise', and the reference's)."""
+    gen, ref = spaces.description_joint_positions(generated), spaces.description_joint_positions(reference)
+    return {"hand_height_error": abs(peak_hand_height(gen, arm) - peak_hand_height(ref, arm)),
+            "free_arm_rise": free_arm_rise(gen, arm), "reference_free_arm_rise": free_arm_rise(ref, arm)}
+
+
+def aim_error(positions, arm, target, fps=FPS):
+    """Degrees between the shoulder joint's line to the index base and its line to `target` (3,), median over the
+    hold (the apex without one)."""
+    p, side = _positions(positions), _side(arm)
+    frames, _ = _hold_or_apex(p, arm, fps)
+    shoulder = p[0, _JOINT[f"{side}_shoulder"]]
+    base = p[frames, _JOINT[f"{side}_index_base"]]
+    return float(np.median(_degrees_between(base - shoulder, np.asarray(target, dtype=np.float64) - shoulder)))
+
+
+def target_row(generated, reference, arm, target, fps):
+    """A target behaviour's measures where it has none of its own: how far off its target it reaches
+    ('aim_error', degrees, and the reference's), and the other arm's rise."""
+    gen, ref = spaces.description_joint_positions(generated), spaces.description_joint_positions(reference)
+    return {"aim_error": aim_error(gen, arm, target, fps), "reference_aim_error": aim_error(ref, arm, target, fps),
+            "free_arm_rise": free_arm_rise(gen, arm), "reference_free_arm_rise": free_arm_rise(ref, arm)}
+
+
+#: The measures of a behaviour without MEASURES of its own, by its kind (a target one needs the target).
+KIND_MEASURES = {behaviours.INTENSITY: intensity_row, behaviours.TARGET: target_row}
+
+
+def compare(generated, reference, behaviour, arm, target=None, fps=FPS, kind=None):
     """The behaviour measures of one request, from descriptions (F, 42) of the generated clip and of
-    its reference (lengths may differ): raise and lower, and the behaviour's own MEASURES. A flat dict
-    of floats."""
+    its reference (lengths may differ): raise and lower, and the behaviour's own MEASURES, or else those of
+    its `kind` (KIND_MEASURES; a target behaviour's only with its target). A flat dict of floats."""
     gen, ref = np.asarray(generated), np.asarray(reference)
     gen_positions, ref_positions = spaces.description_joint_positions(gen), spaces.description_joint_positions(ref)
     result = {f"elevation_{k}": v for k, v in raise_lower(gen_positions, ref_positions, arm).items()}
     if behaviour in MEASURES:
         result.update(MEASURES[behaviour](gen, ref, arm, target, fps))
+    elif kind in KIND_MEASURES and (kind != behaviours.TARGET or target is not None):
+        result.update(KIND_MEASURES[kind](gen, ref, arm, target, fps))
     return result

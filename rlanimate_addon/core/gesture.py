@@ -561,6 +561,13 @@ def played_finger_base(canonical, arm):
 TORSO = rig_roles.SPINE + ("Neck", "Head")
 
 
+def free_arm_columns(names, arm):
+    """The columns of `names` (canonical roles) that are the joints of the arm other than `arm`, collar to index
+    base."""
+    side = skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
+    return [k for k, name in enumerate(names) if name in skeleton.ACTION_JOINTS and name.startswith(side)]
+
+
 def owned_joints(arm, still):
     """The action joints a gesture on `arm` keys: the spine, neck and head (a turn added to what plays
     underneath), its own arm, and, made as on a still rig, the other arm too (from its natural standing
@@ -614,9 +621,10 @@ def _played(request, rig, canonical):
     return names, played, standing, to_character
 
 
-def _blended(rig, names, columns, played, standing):
+def _blended(rig, names, columns, played, standing, held=()):
     """((N, D, 4) keyed, (N, D, 4) underneath): each bone blended from the pose it starts from into the
-    gesture and back (on a still rig, bones at rest start from the standing pose, not the bind pose). The
+    gesture and back (on a still rig, bones at rest start from the standing pose, not the bind pose); the
+    columns `held` (a free arm with no part in the gesture) stay on that start pose on every frame. The
     spine, neck and head take the turn that carries the animation's pose of them (`RigState.animation_at`)
     into the gesture's, by the same weights, on top of the pose underneath: over the animation alone the
     gesture's pose, and over other gestures that turn them too, the turns of all."""
@@ -631,6 +639,8 @@ def _blended(rig, names, columns, played, standing):
         start = np.where((np.linalg.norm(start[..., 1:], axis=-1) < AT_REST)[..., None], standing, start)
         at_rest = np.linalg.norm(animation[..., 1:], axis=-1) < AT_REST
         animation = np.where(at_rest[..., None], standing[torso], animation)
+    played = played.copy()
+    played[:, list(held)] = start[:, list(held)]  # an arm that has no part in the gesture stays where it was
     weights = blend_weights(count)
     keyed = blend_from_pose(start, played, weights)
     blended = blend_from_pose(animation, played[:, torso], weights)
@@ -653,7 +663,9 @@ def gesture_rotations(agent, request, rig):
     `keyed` is each bone's rotation as the gesture plays it over the pose underneath; `underneath` the
     rotation it would have without the gesture (its animation, else its pose), which a Combine layer
     needs. The bones are those the gesture owns (`owned_joints`, Point's hand shape, a target behaviour's
-    eyes). Every RLAnimateError is raised before anything is returned, so callers can write all or nothing.
+    eyes). On a still rig, a behaviour whose free arm has no part in it (the agent's `still_free_arm`) holds
+    that arm where it was; on an animated rig the gesture does not key that arm at all. Every RLAnimateError
+    is raised before anything is returned, so callers can write all or nothing.
     """
     return aimed(request, rig, blended_gesture(agent, request, rig))
 
@@ -681,7 +693,8 @@ def blended_gesture(agent: Any, request: "GestureRequest", rig: "RigState") -> B
     phase_base = played_finger_base(canonical, request.arm) if targeted else None
     names, played, standing, to_character = _played(request, rig, canonical)
     columns = [rig.skeleton.index[rig.roles[n]] for n in names]  # the eyes, keyed for Point, come after these
-    keyed, under = _blended(rig, names, columns, played, standing)
+    held = free_arm_columns(names, request.arm) if request.behaviour in agent.still_free_arm else []
+    keyed, under = _blended(rig, names, columns, played, standing, held)
     return Blended(tuple(names), tuple(columns), keyed, under, phase_base, to_character)
 
 

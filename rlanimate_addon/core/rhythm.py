@@ -192,6 +192,19 @@ class RhythmModel:
         return Rhythm(max(frequency, 0.0), start, float(np.clip(stop, start, 1.0)), phase, self.ramp)
 
 
+#: How many phase features a phase-input agent's heads see beside its task state (`phase_features`).
+PHASE_FEATURES = 4
+
+
+def phase_features(signals: np.ndarray) -> np.ndarray:
+    """(..., 4) [A sin(phi), A cos(phi), A sin(2 phi), A cos(2 phi)] of rhythm signals (..., 2) [A sin(phi),
+    A cos(phi)]: the swing's phase and its second harmonic, as phase-conditioned motion models give the pose
+    network its phase (an agent with AgentConfig.phase_input; the trainer's torch model computes the same)."""
+    sine, cosine = signals[..., 0], signals[..., 1]
+    amplitude = np.maximum(np.hypot(sine, cosine), 1e-9)
+    return np.stack([sine, cosine, 2.0 * sine * cosine / amplitude, (cosine ** 2 - sine ** 2) / amplitude], axis=-1)
+
+
 #: Cycles per frame: the slowest rate a tempo's logarithm is taken of.
 _SLOWEST = 1e-6
 

@@ -130,6 +130,9 @@ class GestureAgent:
         #: agent was not trained for gets the mean of the others, so the UI always has a default.
         self.average_frames = {b: trained.get(b, float(np.mean(list(trained.values()))))
                                for b in self.space.names}
+        #: The behaviours whose free arm has no part in them (their training clips leave it still): a gesture of
+        #: one holds that arm where it was (core/gesture.py). Files exported before it was kept hold none.
+        self.still_free_arm = frozenset(metadata.get("still_free_arm", ()))
         rhythm_values = metadata.get("wave_rhythm")
         #: The training waves' rhythms (core/rhythm.py), or None for an agent trained on the paper's objective.
         self.rhythm_model = None if rhythm_values is None else rhythm.RhythmModel.from_dict(rhythm_values)
@@ -143,7 +146,8 @@ class GestureAgent:
         self._concentration_scale = float(config["concentration_scale"])
         self._uses_portrayal = agent_file.uses_portrayal(self.variant)
         self._uses_task_state = agent_file.uses_task_state(self.variant)
-        task_size = int(config["task_size"]) if self._uses_task_state else self.space.size
+        self._phase_input = bool(config.get("phase_input", False))
+        task_size = agent_file.task_width(config, self.variant, self.space.size)
         if self._uses_portrayal:
             self._portrayal = _mlp_arrays(w, "portrayal", layers)
         if self._uses_task_state:
@@ -209,11 +213,19 @@ class GestureAgent:
             noise = None if seed is None else np.random.default_rng(seed).standard_normal(self._sizes[1])  # (Z,)
             return self._rollout(objectives, noise)
 
+    def _task(self, objectives):
+        """(N, K) what f2 and the heads see of the task: the task state (with the wave's phase features beside it,
+        rhythm.phase_features, for a phase-input agent), or the objectives without a task state."""
+        if not self._uses_task_state:
+            return objectives
+        task = _gru_sequence(objectives, self._task_rnn)
+        return np.hstack([task, self.space.phase_features(objectives)]) if self._phase_input else task
+
     def _rollout(self, objectives, noise):
         E, Z = self._sizes
         A = spaces.ACTION_SIZE
         count = len(objectives)
-        task = _gru_sequence(objectives, self._task_rnn) if self._uses_task_state else objectives  # (N, K)
+        task = self._task(objectives)  # (N, K)
         cell_inputs = task @ self._cell_task + self._cell_bias  # (N, 3E)
         hidden = len(self._belief[0][1])
         belief_inputs = np.broadcast_to(self._belief[0][1], (count, hidden))  # (N, hidden)

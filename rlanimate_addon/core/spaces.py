@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import ArrayLike
 
-from . import behaviours, skeleton
+from . import behaviours, rhythm, skeleton
 from .behaviours import TARGET, WAVE, Behaviour
 from .errors import RLAnimateError
 
@@ -127,6 +127,14 @@ class ObjectiveSpace:
         """(...,) bool: which objectives (..., L + 6) belong to a behaviour of `kind`."""
         masks = [self.label_mask(objectives, name) for name in self.of_kind(kind)]
         return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
+
+    def phase_features(self, objectives: ArrayLike) -> npt.NDArray[np.float64]:
+        """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): a wave's rhythm signals and their second
+        harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
+        objectives = np.asarray(objectives, dtype=np.float64)
+        wave = self.label_mask(objectives, WAVE) if WAVE in self.names else np.zeros(objectives.shape[:-1], bool)
+        features: npt.NDArray[np.float64] = rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:])
+        return features * wave[..., None]
 
     def behaviours_in(self, objectives: ArrayLike) -> set[str]:
         """The ids whose labels the objectives (..., L + 6) carry; RLAnimateError for a label of none."""

@@ -30,7 +30,10 @@ def _shown(settings):
     return {call[2] for call in _draw(settings) if call[0] == "prop"}
 
 
-def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survives_a_change_of_agent(widened_settings):
+def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survives_a_change_of_agent(
+        widened_settings, capfd):
+    """Switching to an agent that lacks the chosen behaviour keeps the choice, shows it as not in this agent (so
+    Blender reads it without a 'matches no enum' warning), and the panel and Generate name it."""
     settings, path, widened = widened_settings
     shipped = declared_agents.shipped_behaviours()
     preferences = addon_helpers.addon_preferences()
@@ -40,19 +43,29 @@ def test_the_enum_lists_the_selected_agents_behaviours_and_a_stored_choice_survi
     settings.behaviour = "BECKON"
     assert settings.behaviour == "BECKON"
     preferences.agent_path = ""  # the bundled agent has no Beckon: the choice is kept, not replaced
-    assert properties.chosen_behaviour(settings, bpy.context) == ""
-    with pytest.raises(TypeError, match='enum "BECKON" not found'):
-        settings.behaviour = "BECKON"
+    assert _listed(settings) == [*shipped, "BECKON"]
+    assert properties.behaviour_items(settings, bpy.context)[-1][1] == "Beckon (not in this agent)"
+    assert properties.chosen_behaviour(settings, bpy.context) == "BECKON" and settings.behaviour == "BECKON"
     errors = " ".join(c[1].get("text", "") for c in _draw(settings) if c[0] == "label" and c[1].get("icon") == "ERROR")
-    assert f"not one of this agent's ({declared_agents.listed_titles(shipped)}): pick one above" in errors
+    assert f"This agent does not perform Beckon (it performs {declared_agents.listed_titles(shipped)})" in errors
     with pytest.raises(RuntimeError, match=f"The selected agent performs {declared_agents.listed_titles(shipped)}, "
-                                           "not the behaviour chosen"):
+                                           "no Beckon: pick one of its behaviours"):
         addon_helpers.generate(addon_helpers.load_sample_rig(), settings)
+    assert "matches no enum" not in "".join(capfd.readouterr())
     preferences.agent_path = str(path)
-    assert settings.behaviour == "BECKON", "the same behaviour again with the agent that has it"
+    assert settings.behaviour == "BECKON" and _listed(settings) == list(widened), "the agent that has it again"
     settings.behaviour = "WAVE"
     preferences.agent_path = ""
-    assert settings.behaviour == "WAVE", "Point and Wave keep their values across agents"
+    assert settings.behaviour == "WAVE" and _listed(settings) == list(shipped), "Point and Wave keep their values"
+
+
+def test_a_choice_stored_before_its_name_was_kept_is_read_quietly_as_none_of_the_agents(widened_settings, capfd):
+    settings, path, _ = widened_settings
+    settings["behaviour"] = properties.behaviour_number("BECKON")  # no behaviour_name: a file saved before it
+    assert properties.chosen_behaviour(settings, bpy.context) == ""
+    errors = " ".join(c[1].get("text", "") for c in _draw(settings) if c[0] == "label" and c[1].get("icon") == "ERROR")
+    assert "The chosen behaviour is not one of this agent's" in errors
+    assert "matches no enum" not in "".join(capfd.readouterr()), "the panel reads the raw number, never the enum"
 
 
 def test_preferences_name_the_chosen_agents_behaviours(widened_settings):

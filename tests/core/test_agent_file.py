@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import torch
 
-from rlanimate_addon.core import agent_file, spaces
+from rlanimate_addon.core import agent_file, runtime, spaces
 from rlanimate_addon.core.agent_file import load_agent_file
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.agent_export import export_agent
@@ -224,6 +224,9 @@ def test_damaged_metadata_text(tmp_path, exported):
     ("average_frames", {"POINT": 90, "JUMP": 50}, "average_frames"),
     ("average_frames", {"POINT": 1}, "average_frames"),
     ("variant", "bigger", "unknown agent variant .bigger."),
+    ("still_free_arm", "WAVE", "still_free_arm"),
+    ("still_free_arm", ["JUMP"], "still_free_arm"),
+    ("still_free_arm", [["WAVE"]], "still_free_arm"),
 ])
 def test_invalid_metadata_values(tmp_path, exported, field, value, message):
     weights, metadata = load_agent_file(exported)
@@ -353,3 +356,11 @@ def test_an_agent_too_large_to_run_is_refused(tmp_path, exported):
     metadata["agent_config"].update(hidden_size=4096, hidden_layers=16)
     with pytest.raises(RLAnimateError, match="more than the add-on runs"):
         load_agent_file(rewrite(tmp_path / "big.npz", weights, metadata))
+
+
+def test_the_behaviours_that_hold_the_free_arm_still_are_read_and_old_files_hold_none(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    old = {key: value for key, value in metadata.items() if key != "still_free_arm"}
+    assert runtime.load_agent(rewrite(tmp_path / "old.npz", weights, old)).still_free_arm == frozenset()
+    held = runtime.load_agent(rewrite(tmp_path / "held.npz", weights, {**old, "still_free_arm": ["WAVE"]}))
+    assert held.still_free_arm == frozenset({"WAVE"})

@@ -244,3 +244,27 @@ def test_compare_reads_descriptions_of_the_canonical_skeleton():
     base = spaces.description_joint_positions(still)[0, JOINT["right_index_base"]]
     pointed = bm.compare(still, still, "POINT", "RIGHT", target=base + 2.0 * finger[0])
     assert pointed["pointing_angle"] == pytest.approx(0.0, abs=1e-6) and pointed["hold_ratio"] == 1.0
+
+
+def test_a_behaviour_without_measures_of_its_own_is_measured_by_its_kind():
+    """A user's intensity gesture ("hello": a raised hand) by the hand's peak height and the other arm's rise; a
+    target one by its aim at the target; a copy scores zero error, a still arm does not, and neither is measured
+    as something it is not (no wave, no point measures)."""
+    frames = 60
+    rise = np.clip(np.arange(frames) / 20.0, 0.0, 1.0)[:, None]
+    rotvecs = np.zeros((frames, len(skeleton.ACTION_JOINTS), 3))
+    rotvecs[:, skeleton.ACTION_JOINTS.index("RightArm")] = rise * (1.2, 0.0, 0.0)  # the right arm goes up
+    raised, still = kinematics.describe(rotvecs), kinematics.describe(np.zeros_like(rotvecs))
+    copied = bm.compare(raised, raised, "HELLO", "RIGHT", kind="intensity")
+    assert copied["hand_height_error"] == 0.0 and copied["free_arm_rise"] == pytest.approx(0.0, abs=1e-9)
+    assert "swing_ratio" not in copied and "pointing_angle" not in copied
+    assert bm.compare(still, raised, "HELLO", "RIGHT", kind="intensity")["hand_height_error"] > 0.3
+    assert set(bm.compare(raised, raised, "HELLO", "RIGHT")) == {f"elevation_{k}" for k in (
+        "first", "last", "reference_first", "reference_last", "first_error", "last_error")}, "no kind: elevation"
+    positions = spaces.description_joint_positions(raised)
+    shoulder, base = positions[0, JOINT["right_shoulder"]], positions[-1, JOINT["right_index_base"]]
+    aimed = bm.compare(raised, raised, "THIS_WAY", "RIGHT", target=shoulder + 3.0 * (base - shoulder), kind="target")
+    assert aimed["aim_error"] == pytest.approx(0.0, abs=0.5) and aimed["reference_aim_error"] == aimed["aim_error"]
+    assert bm.compare(still, raised, "THIS_WAY", "RIGHT", target=shoulder + 3.0 * (base - shoulder),
+                      kind="target")["aim_error"] > 30.0
+    assert "aim_error" not in bm.compare(raised, raised, "THIS_WAY", "RIGHT", kind="target"), "no target, no aim"

@@ -25,6 +25,7 @@ class ReplayAgent:
     action_bounds = spaces.DEFAULT_ACTION_BOUNDS
     average_frames = {"POINT": 50, "WAVE": 80}
     space = spaces.PAPER_SPACE
+    still_free_arm = frozenset()
 
     def kind(self, behaviour):
         return self.space.kind(behaviour)
@@ -438,6 +439,34 @@ def test_over_animation_a_gesture_keys_only_its_arm_and_adds_its_spine_and_head_
         kept = quat_multiply(quat_multiply(under_other[:, k], under[:, k] * conjugate), quats[:, k])
         assert np.allclose(np.abs(np.sum(over_other[:, k] * kept, axis=-1)), 1.0), "the other's turn stays"
 
+
+@pytest.mark.parametrize("animated", [False, True])
+def test_a_behaviour_whose_free_arm_has_no_part_holds_it_on_a_still_rig_and_leaves_it_to_the_animation(animated):
+    """An agent whose training clips left the free arm still (`still_free_arm`): on a still rig the gesture keys
+    that arm's joints on the standing pose it starts from on every frame, whatever the agent's own output for them;
+    over animation the gesture does not key that arm at all, held or not (`owned_joints`: it is the animation's).
+    The gesturing arm, and other behaviours, play as before."""
+    frames = 40
+    agent = ReplayAgent(RNG.uniform(0.2, 0.8, size=(frames, spaces.ACTION_SIZE)))
+    rig = _animated(gesture.canonical_rig(), frames) if animated else gesture.canonical_rig()
+    played_names, played, _ = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    agent.still_free_arm = frozenset({"WAVE"})
+    names, held, _ = gesture.gesture_rotations(agent, _request("WAVE", "RIGHT", frames=frames), rig)
+    assert names == played_names
+    free = gesture.free_arm_columns(names, "RIGHT")
+    if animated:
+        assert free == [], "over animation the free arm is not keyed"
+        np.testing.assert_allclose(held, played)
+        return
+    assert [names[k] for k in free] == ["LeftShoulder", "LeftArm", "LeftForeArm", "LeftHand", "LeftHandIndex1"]
+    start = np.broadcast_to([rotvec_to_quat(gesture.STANDING_POSE.get(names[k], np.zeros(3))) for k in free],
+                            (frames, len(free), 4))
+    assert np.allclose(np.abs(np.sum(held[:, free] * start, axis=-1)), 1.0)
+    assert not np.allclose(np.abs(np.sum(played[:, free] * start, axis=-1)), 1.0), "the agent's own output moves it"
+    moving = [k for k in range(len(names)) if k not in free]
+    np.testing.assert_allclose(held[:, moving], played[:, moving])
+    _, pointed, _ = gesture.gesture_rotations(agent, _request("POINT", frames=frames, targets=[-1.0, -2.0, 1.6]), rig)
+    assert not np.allclose(np.abs(np.sum(pointed[:, free] * start, axis=-1)), 1.0), "point is not held"
 
 def test_a_handover_starts_from_the_pose_of_its_first_frame_and_a_resting_bone_from_its_own_basis():
     frames, held = 30, 6

@@ -1,4 +1,6 @@
 """The numpy runtime reproduces the torch agent's deterministic rollout, for every variant."""
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import torch
@@ -32,12 +34,15 @@ def exported_agent(tmp_path, preset, variant, weight_gain=2.0, seed=0):
     """An agent with weights scaled up from their initialisation, so its dynamics are far from trivial."""
     torch.manual_seed(seed)
     agent = RLAnimateAgent(load_preset(preset)[0], variant)
+    return agent, _exported(agent, tmp_path / f"{preset}_{variant}.npz", weight_gain)
+
+
+def _exported(agent, path, weight_gain):
     with torch.no_grad():
         for parameter in agent.parameters():
             parameter.mul_(weight_gain)
-    path = tmp_path / f"{preset}_{variant}.npz"
     export_agent(agent, path, {"average_frames": {"POINT": 80, "WAVE": 95}})
-    return agent, path
+    return path
 
 
 def torch_rollout(agent, objectives):
@@ -55,6 +60,27 @@ def test_deterministic_rollout_matches_torch(tmp_path, preset, variant):
         assert actions.shape == expected.shape
         assert np.abs(actions - expected).max() < 1e-5
         assert expected.std(axis=0).max() > 1e-3  # the actions do change over the gesture
+
+
+@pytest.mark.parametrize("variant", ["rlanimate", "supervised"])
+def test_a_phase_input_agent_plays_as_torch_with_the_waves_phase_beside_its_task_state(tmp_path, variant):
+    """With phase_input the wave's phase and second harmonic sit beside the task state (spaces.phase_features, and
+    the torch model's own): the runtime plays torch's rollout, the file's shapes carry the 4 more inputs, and a
+    point's objectives (no phase) still play."""
+    torch.manual_seed(3)
+    config = replace(load_preset("default")[0], phase_input=True)
+    agent = RLAnimateAgent(config, variant)
+    path = _exported(agent, tmp_path / "phase.npz", 2.0)
+    runtime = load_agent(path)
+    assert agent.behaviour_cell.weight_ih.shape[1] == config.task_size + 4 + config.stochastic_size + 45
+    for objectives in objectives_for_tests():
+        assert np.abs(runtime.rollout(objectives) - torch_rollout(agent, objectives)).max() < 1e-5
+    swinging = objectives_for_tests()[2]
+    features = spaces.PAPER_SPACE.phase_features(swinging)
+    assert np.allclose(np.hypot(features[:, 2], features[:, 3]), np.hypot(features[:, 0], features[:, 1]))
+    assert not spaces.PAPER_SPACE.phase_features(objectives_for_tests()[0]).any(), "a point has no phase"
+    with pytest.raises(RLAnimateError, match="needs a task state"):
+        RLAnimateAgent(config, "single_state")
 
 
 @pytest.mark.parametrize("variant", VARIANTS)

@@ -8,8 +8,9 @@ One iteration (which we count as one epoch, as the paper's Figure 3 does):
        objectives only (it self-describes with its portrayal model), so the whole rollout can be
        computed before the environment is asked for the real descriptions d'_t. Each episode
        (o, a, d', m, FK of m) is appended to the buffer;
-    3. run T update steps, each on C random chunks of L frames (C grows with the behaviours beyond
-       two: chunks_per_update), with Adam on the description, KL and pose terms (the paper's L1 + L2 + L3).
+    3. run T update steps, each on C random chunks of L frames (beyond two behaviours the config's
+       update_steps_many and chunk_count_many: epoch_updates), with Adam on the description, KL and pose
+       terms (the paper's L1 + L2 + L3).
 Rollouts sample the Beta policy (deterministic=False) with the trainer's own torch generator, so
 that they explore and stay reproducible; evaluation rolls out deterministically. With
 `average_last_epochs` N, the agent that is evaluated and exported (`played_agent`) is the mean of the
@@ -18,6 +19,7 @@ rollouts keep using the weights being trained.
 """
 import math
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 import torch
@@ -29,6 +31,10 @@ from trainer.agent.buffer import EpisodeBuffer
 from trainer.motion import wave_rhythm
 from trainer.motion.clip import trained_behaviours
 from trainer.motion.fk import ClipReferences
+
+if TYPE_CHECKING:
+    from trainer.agent.config import TrainConfig
+    from trainer.agent.models import RLAnimateAgent
 
 
 def clips_for_behaviour(clips, behaviour, space):
@@ -48,6 +54,17 @@ def chunks_per_update(chunk_count, behaviour_count):
     return int(math.ceil(chunk_count * max(behaviour_count, 2) / 2))
 
 
+def epoch_updates(config: "TrainConfig", behaviour_count: int) -> tuple[int, int]:
+    """(T, C): an iteration's update steps and each step's chunks. For one or two behaviours the config's
+    `update_steps` and `chunk_count`; for more, its `update_steps_many` and `chunk_count_many` where given,
+    else those and chunks_per_update (docs/TRAINING.md, "The default preset")."""
+    steps, chunks = config.update_steps, chunks_per_update(config.chunk_count, behaviour_count)
+    if behaviour_count > 2:
+        steps = config.update_steps if config.update_steps_many is None else config.update_steps_many
+        chunks = chunks if config.chunk_count_many is None else config.chunk_count_many
+    return steps, chunks
+
+
 def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm=True):
     """(N, O) objectives of the ObjectiveSpace `space` for `clip`'s label, over its own length or
     `frame_count` frames.
@@ -65,12 +82,19 @@ def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm
     return space.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
 
 
-def rollout_actions(agent, objectives, deterministic=True, generator=None):
-    """(N, O) numpy objectives -> (N, 45) numpy actions in [0, 1] from one agent rollout."""
-    batch = torch.as_tensor(objectives, dtype=torch.float32)[None]  # (1, N, O)
+def rollout_actions(agent: "RLAnimateAgent", objectives: list[np.ndarray], deterministic: bool = True,
+                    generator: torch.Generator | None = None) -> list[np.ndarray]:
+    """A list of (N_i, O) numpy objectives -> the list of (N_i, 45) numpy actions in [0, 1], from one rollout
+    of the agent over all of them as a batch (one recurrent step a frame for the batch, not one an episode
+    a frame). A rollout is causal, each frame depending on earlier frames only, so a shorter episode is
+    padded at its end with its last objective and its actions cut back to its length."""
+    longest = max(len(objective) for objective in objectives)
+    padded = [np.concatenate([objective, np.repeat(objective[-1:], longest - len(objective), 0)])
+              for objective in objectives]
+    batch = torch.as_tensor(np.stack(padded), dtype=torch.float32)  # (B, longest, O)
     with torch.no_grad():
-        actions = agent.rollout(batch, deterministic=deterministic, generator=generator)  # (1, N, 45)
-    return actions[0].double().numpy()
+        actions = agent.rollout(batch, deterministic=deterministic, generator=generator)  # (B, longest, 45)
+    return [action[:len(objective)].double().numpy() for action, objective in zip(actions, objectives, strict=True)]
 
 
 def gradient_step(agent, optimizer, batch, config, bounds):
@@ -79,7 +103,7 @@ def gradient_step(agent, optimizer, batch, config, bounds):
     optimizer.zero_grad(set_to_none=True)
     losses["total"].backward()
     if getattr(config, "grad_clip", None):
-        torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip)
+        torch.nn.utils.clip_grad_norm_(agent.parameters(), config.grad_clip, foreach=True)
     optimizer.step()
     return losses
 
@@ -103,11 +127,11 @@ class Trainer:
         self.rhythm_model = None
         if waves and train_config.wave_rhythm:
             self.rhythm_model = wave_rhythm.fit_rhythm_model(waves)
-        #: C of the update steps: the config's for one or two behaviours, in proportion beyond
-        #: (chunks_per_update), so each behaviour keeps the chunks it has beside one other.
-        self.chunk_count = chunks_per_update(train_config.chunk_count, len(self.clip_groups))
+        #: T update steps an iteration of C chunks each: the config's for one or two behaviours, its
+        #: "many" ones beyond (epoch_updates).
+        self.update_steps, self.chunk_count = epoch_updates(train_config, len(self.clip_groups))
         self.references = references or ClipReferences(env)
-        self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate)
+        self.optimizer = torch.optim.Adam(agent.parameters(), lr=train_config.learning_rate, foreach=True)
         self.buffer = EpisodeBuffer()
         self.rng = np.random.default_rng(seed)
         self.decks = [[] for _ in self.clip_groups]  # per group: clip indices still to draw this pass
@@ -146,8 +170,7 @@ class Trainer:
                         clip.behaviour, clip.arm, self._random_direction(group, clip.arm), len(clip.rotvecs)))
                     imitated.append(False)
         self.agent.eval()
-        actions = [rollout_actions(self.agent, o, deterministic=False, generator=self.rollout_generator)
-                   for o in objectives]
+        actions = rollout_actions(self.agent, objectives, deterministic=False, generator=self.rollout_generator)
         rotvecs = spaces.decode_action(np.concatenate(actions), self.bounds)  # (sum F, 15, 3)
         descriptions = np.asarray(self.env.evaluate(rotvecs).descriptions)  # (sum F, 42)
         ends = np.cumsum([len(a) for a in actions])[:-1]
@@ -203,13 +226,13 @@ class Trainer:
             group["lr"] = self.learning_rate()
         self.agent.train()
         totals = {}
-        for _ in range(config.update_steps):
+        for _ in range(self.update_steps):
             batch = self.buffer.sample_chunks(self.chunk_count, config.chunk_length, self.rng,
                                               config.random_target_weight, config.last_frame_share)
             losses = gradient_step(self.agent, self.optimizer, batch, config, self.bounds)
             for name, value in losses.items():
                 totals[name] = totals.get(name, 0.0) + float(value.detach())
-        return {name: value / config.update_steps for name, value in totals.items()}
+        return {name: value / self.update_steps for name, value in totals.items()}
 
     def run_epoch(self):
         """One iteration of Algorithm 1; appends and returns its metrics."""

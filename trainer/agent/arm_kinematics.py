@@ -1,10 +1,13 @@
 """Differentiable forward kinematics of the canonical skeleton's arms, in torch (core/kinematics.py in numpy).
 
 The pointing term (trainer/agent/pointing.py) reads the finger line of the animation model's mean
-pose, and the wrist term (trainer/agent/losses.py) its wrist.
+pose, and the wrist term (trainer/agent/losses.py) its wrist. Each frame is posed on its own arm, both
+arms in one pass: the training step runs this on every pointing-hold and waving frame, and its cost is
+the number of torch calls, not their arithmetic.
 """
 import numpy as np
 import torch
+from torch import Tensor
 
 from rlanimate_addon.core import kinematics, skeleton, spaces
 
@@ -13,7 +16,7 @@ _REST = skeleton.rest_matrices()
 _FINGER_BONES = 4
 
 
-def _chain(arm):
+def _chain(arm: str) -> list[int]:
     """Bone indices from the root to the arm's index fingertip (HandIndex4), parents first."""
     index = kinematics.bone_index(skeleton.ARM_PREFIX[arm] + "HandIndex4")
     chain = []
@@ -24,51 +27,77 @@ def _chain(arm):
     return chain[::-1]
 
 
-class ArmKinematics:
-    """Differentiable heads of each arm's chain, its wrist, finger base and direction, from action rotation
-    vectors."""
+def arm_indices(objectives: Tensor) -> Tensor:
+    """(N,) long: the arm, as its index in skeleton.ARMS, that each objective (N, O) names."""
+    return objectives[..., spaces.OBJECTIVE_ARM].argmax(-1)
 
-    def __init__(self):
-        self._chains = {}
+
+class ArmKinematics:
+    """Differentiable wrist, finger base and finger direction of either arm from action rotation vectors.
+
+    The two arms' chains (root to index fingertip) have the same shape: K bones, the same of them turned
+    by an action joint. The bones past the index base (HandIndex2-4) are fixed, so the fingertip is a
+    fixed offset in the index base's frame. A pass gathers each frame's chain, makes all its joints'
+    rotations in one batched call (Rodrigues), then composes them down the chain.
+    """
+
+    def __init__(self) -> None:
+        locals_: list[list[np.ndarray]] = []
+        columns: list[list[int | None]] = []
         for arm in skeleton.ARMS:
             chain = _chain(arm)
-            local = [_REST[i] if k == 0 else np.linalg.inv(_REST[chain[k - 1]]) @ _REST[i]
-                     for k, i in enumerate(chain)]
-            columns = [skeleton.ACTION_JOINTS.index(skeleton.BONES[i].name)
-                       if skeleton.BONES[i].name in skeleton.ACTION_JOINTS else None for i in chain]
-            self._chains[arm] = (torch.as_tensor(np.array(local)), columns)  # float64; cast to the input's dtype
+            locals_.append([_REST[i] if k == 0 else np.linalg.inv(_REST[chain[k - 1]]) @ _REST[i]
+                            for k, i in enumerate(chain)])  # each bone in its parent's rest frame
+            columns.append([skeleton.ACTION_JOINTS.index(skeleton.BONES[i].name)
+                            if skeleton.BONES[i].name in skeleton.ACTION_JOINTS else None for i in chain])
+        local = np.array(locals_)  # (2, K, 4, 4)
+        #: The chain positions an action joint turns, the same on both arms.
+        self.turning = [k for k, column in enumerate(columns[0]) if column is not None]
+        #: HandIndex1's position in the chain: the index base.
+        self.base = local.shape[1] - _FINGER_BONES
+        if any([k for k, column in enumerate(side) if column is not None] != self.turning for side in columns) \
+                or self.turning[-1] != self.base:
+            raise ValueError("the arms' chains must turn at the same bones, the last being HandIndex1")
+        self._rotations = torch.as_tensor(local[:, :, :3, :3])  # (2, K, 3, 3), float64
+        self._offsets = torch.as_tensor(local[:, :, :3, 3])  # (2, K, 3)
+        self._columns = torch.as_tensor([[side[k] for k in self.turning] for side in columns])  # (2, R)
+        tips = []
+        for side in local:  # the fingertip in HandIndex1's frame, from HandIndex4 back up
+            tip = np.zeros(3)
+            for k in range(len(side) - 1, self.base, -1):
+                tip = side[k, :3, 3] + side[k, :3, :3] @ tip
+            tips.append(tip / np.linalg.norm(tip))
+        self._tips = torch.as_tensor(np.array(tips))  # (2, 3) unit
 
-    def finger(self, rotvecs, arm):
-        """rotvecs (..., 15, 3) -> index base (..., 3) and unit finger direction (..., 3)."""
-        heads = self.heads(rotvecs, arm)  # (..., K, 3)
-        base, tip = heads[..., -_FINGER_BONES, :], heads[..., -1, :]  # HandIndex1 and HandIndex4 heads
-        direction = tip - base
-        return base, direction / direction.norm(dim=-1, keepdim=True)
+    def finger(self, rotvecs: Tensor, arms: Tensor) -> tuple[Tensor, Tensor]:
+        """rotvecs (N, 15, 3), arms (N,) (indices in skeleton.ARMS) -> each frame's index base (N, 3) and unit
+        finger direction (N, 3)."""
+        rotation, base = self._down_chain(rotvecs, arms, self.base, with_rotation=True)
+        assert rotation is not None  # asked for
+        return base, (rotation @ self._tips.to(rotvecs.dtype)[arms, :, None])[..., 0]
 
-    def wrist(self, rotvecs, arm):
-        """rotvecs (..., 15, 3) -> the arm's wrist (its Hand bone's head) (..., 3)."""
-        return self.heads(rotvecs, arm, _FINGER_BONES)[..., -1, :]
+    def wrist(self, rotvecs: Tensor, arms: Tensor) -> Tensor:
+        """rotvecs (N, 15, 3), arms (N,) -> each frame's wrist (its arm's Hand bone's head) (N, 3)."""
+        return self._down_chain(rotvecs, arms, self.base - 1, with_rotation=False)[1]
 
-    def heads(self, rotvecs, arm, skip=0):
-        """rotvecs (..., 15, 3) -> the heads (..., K, 3) of the K bones from the root to the index tip, less
-        the last `skip` (a head depends only on the bones above it)."""
-        local, columns = self._chains[arm]
-        local, columns = local[:len(columns) - skip].to(rotvecs.dtype), columns[:len(columns) - skip]
-        batch = rotvecs.shape[:-2]
-        rotation, position = None, None  # the world rotation (..., 3, 3) and head (..., 3) down the chain
-        heads = []
-        for k, column in enumerate(columns):
-            turn = local[k, :3, :3] if column is None else local[k, :3, :3] @ _rotvec_to_matrix(rotvecs[..., column, :])
-            if rotation is None:
-                rotation, position = turn.expand(batch + (3, 3)), local[k, :3, 3].expand(batch + (3,))
-            else:
-                position = position + (rotation @ local[k, :3, 3:])[..., 0]
-                rotation = rotation @ turn
-            heads.append(position)
-        return torch.stack(heads, -2)
+    def _down_chain(self, rotvecs: Tensor, arms: Tensor, last: int,
+                    with_rotation: bool) -> tuple[Tensor | None, Tensor]:
+        """(world rotation (N, 3, 3) or None, head (N, 3)) of chain bone `last` of each frame's arm; the
+        rotation includes the bone's own turn."""
+        rest = self._rotations.to(rotvecs.dtype)[arms]  # (N, K, 3, 3)
+        offsets = self._offsets.to(rotvecs.dtype)[arms]  # (N, K, 3)
+        columns = self._columns[arms]  # (N, R)
+        joints = torch.gather(rotvecs, 1, columns[..., None].expand(-1, -1, 3))  # (N, R, 3)
+        turns = dict(zip(self.turning, (rest[:, self.turning] @ _rotvec_to_matrix(joints)).unbind(1), strict=True))
+        rotation, position = turns.get(0, rest[:, 0]), offsets[:, 0]
+        for k in range(1, last + 1):
+            position = position + (rotation @ offsets[:, k, :, None])[..., 0]
+            if k < last or with_rotation:
+                rotation = rotation @ turns.get(k, rest[:, k])
+        return (rotation if with_rotation else None), position
 
 
-def _rotvec_to_matrix(rotvec):
+def _rotvec_to_matrix(rotvec: Tensor) -> Tensor:
     """(..., 3) rotation vectors -> (..., 3, 3) matrices (Rodrigues), smooth at zero."""
     angle2 = (rotvec * rotvec).sum(-1, keepdim=True)[..., None]  # (..., 1, 1)
     angle = torch.sqrt(angle2 + 1e-12)
@@ -79,21 +108,10 @@ def _rotvec_to_matrix(rotvec):
     return eye + torch.sin(angle) / angle * cross + (1 - torch.cos(angle)) / (angle2 + 1e-12) * (cross @ cross)
 
 
-def action_rotvecs(actions, bounds):
+def action_rotvecs(actions: Tensor, bounds: Tensor) -> Tensor:
     """Actions (..., 45) in [0, 1] -> rotation vectors (..., 15, 3) within the action bounds (45, 2)."""
     low, high = bounds[:, 0], bounds[:, 1]
     return (low + actions * (high - low)).reshape(actions.shape[:-1] + (len(skeleton.ACTION_JOINTS), 3))
-
-
-def on_each_arm(objectives, frame_error):
-    """(N,) frame_error(arm, mask) (a (M,) tensor for the M frames of mask) put on the frames whose
-    objective (N, 7) names that arm; 0 elsewhere."""
-    error = objectives.new_zeros(objectives.shape[:-1])
-    for k, arm in enumerate(skeleton.ARMS):
-        mine = objectives[..., spaces.OBJECTIVE_ARM][..., k] > 0.5
-        if mine.any():
-            error = error.index_put((mine,), frame_error(arm, mine))
-    return error
 
 
 #: The canonical skeleton's arm chains, built once.

@@ -33,8 +33,10 @@ from torch import nn
 from torch.distributions import Beta, Independent, Normal
 
 from rlanimate_addon.core import agent_file, spaces
+from rlanimate_addon.core.behaviours import WAVE
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import losses as loss_terms
+from trainer.agent import unroll
 
 VARIANTS = agent_file.VARIANTS
 
@@ -79,8 +81,11 @@ class RLAnimateAgent(nn.Module):
             self.portrayal = MLP(O, c.portrayal_hidden_size, n, D)
         if self.uses_task_state:
             self.task_rnn = nn.GRU(O, c.task_size, batch_first=True)
-        task = c.task_size if self.uses_task_state else O
-        head_inputs = (c.task_size if self.uses_task_state else 0) + E + Z
+        if c.phase_input and not self.uses_task_state:
+            raise RLAnimateError(f"phase_input needs a task state to give the phase beside: the {variant} variant "
+                                 "has none.")
+        task = agent_file.task_width(c.to_dict(), variant, O)
+        head_inputs = (task if self.uses_task_state else 0) + E + Z
         self.behaviour_cell = nn.GRUCell(task + Z + A, E)
         self.prior = MLP(E, hid, n, 2 * Z)
         self.posterior = MLP(E + D, hid, n, 2 * Z)
@@ -98,7 +103,20 @@ class RLAnimateAgent(nn.Module):
         if not self.uses_task_state:
             return objectives
         states, _ = self.task_rnn(objectives)  # h_0 = 0
-        return states
+        return torch.cat([states, self.phase_features(objectives)], -1) if self.config.phase_input else states
+
+    def phase_features(self, objectives):
+        """(B, T, O) -> (B, T, 4): the wave's phase and second harmonic, zeros for other behaviours
+        (core.spaces.ObjectiveSpace.phase_features, in torch)."""
+        signals = objectives[..., spaces.OBJECTIVE_ATTRIBUTES][..., 1:]  # (B, T, 2) A sin, A cos
+        sine, cosine = signals.unbind(-1)
+        amplitude = torch.clamp(torch.hypot(sine, cosine), min=1e-9)
+        features = torch.stack([sine, cosine, 2.0 * sine * cosine / amplitude,
+                                (cosine ** 2 - sine ** 2) / amplitude], -1)
+        if WAVE not in self.space.names:
+            return torch.zeros_like(features)
+        label = objectives.new_tensor(self.space.labels[self.space.names.index(WAVE)])
+        return features * (objectives[..., :self.space.label_size] == label).all(-1, keepdim=True)
 
     def transition(self, e_prev, z_prev, a_prev, task):
         """f2: e_{t-1} (B, E), z_{t-1} (B, Z), a_{t-1} (B, 45), h_t (B, K) -> e_t (B, E)."""
@@ -122,10 +140,13 @@ class RLAnimateAgent(nn.Module):
 
     def policy(self, features):
         """Animation model: features (..., F) -> Beta over the action (..., 45)."""
+        return Independent(Beta(*self.policy_concentrations(features), validate_args=False), 1, validate_args=False)
+
+    def policy_concentrations(self, features: torch.Tensor) -> tuple[torch.Tensor, ...]:
+        """The animation model's Beta parameters (alpha, beta), each (..., 45), from features (..., F)."""
         concentrations = self.config.concentration_floor + \
             self.config.concentration_scale * F.softplus(self.animation(features))  # (..., 90)
-        alpha, beta = concentrations.chunk(2, -1)
-        return Independent(Beta(alpha, beta, validate_args=False), 1, validate_args=False)
+        return concentrations.chunk(2, -1)
 
     def decode(self, features):
         """Description decoder: features (..., F) -> predicted real description (..., 42)."""
@@ -178,27 +199,29 @@ class RLAnimateAgent(nn.Module):
         objectives (B, T, 7); previous_actions (B, T, 45), a_{t-1} for each frame; conditions
         (B, T, 42), the d_t the posterior sees. Returns {"features" (B, T, F), "prior", "posterior"
         (Gaussians over (B, T, Z))}.
+
+        Only e_{t-1} and z_{t-1} are recurrent: the parts of f2's input gates that come from h_t and
+        a_{t-1}, and of the posterior's first layer that come from d_t, are computed for every frame in
+        one product first; the frame-by-frame rest is trainer/agent/unroll.py, whose backward pass is
+        written out (the same GRU cell and MLP, at a fraction of autograd's per-operation cost).
         """
         task = self.task_features(objectives)  # (B, T, K)
-        e, z, _ = self.initial_state(objectives.shape[0], objectives)
-        es, zs, means, stds = [], [], [], []
-        # unbind, not [:, t]: the gradient of T slices is one stack, not T zero-filled (B, T, .) tensors
-        for task_t, a_prev, condition in zip(
-            task.unbind(1), previous_actions.unbind(1), conditions.unbind(1), strict=True
-        ):
-            e = self.transition(e, z, a_prev, task_t)
-            mean, std = self.posterior_parameters(e, condition)
-            z = mean + torch.empty_like(mean).normal_() * std  # Normal(mean, std).rsample(), draw for draw
-            es.append(e)
-            zs.append(z)
-            means.append(mean)
-            stds.append(std)
-        e, z = torch.stack(es, 1), torch.stack(zs, 1)  # (B, T, E), (B, T, Z)
-        return {"features": self.features(task, e, z),
-                "prior": self.prior_belief(e),
-                "posterior": gaussian(torch.stack(means, 1), torch.stack(stds, 1))}
+        cell, (first, *later) = self.behaviour_cell, self.posterior.layers
+        sizes = [task.shape[-1], self.config.stochastic_size, previous_actions.shape[-1]]
+        weight_task, weight_z, weight_action = cell.weight_ih.split(sizes, 1)
+        input_gates = F.linear(torch.cat([task, previous_actions], -1), torch.cat([weight_task, weight_action], 1),
+                               cell.bias_ih)  # (B, T, 3E) without z_{t-1}'s part
+        weight_e, weight_condition = first.weight.split([self.config.behaviour_size, conditions.shape[-1]], 1)
+        posterior_inputs = F.linear(conditions, weight_condition, first.bias)  # (B, T, H) without e_t's part
+        # Normal(mean, std).rsample() draw for draw: one (T, B, Z) draw is the T per-frame draws in turn
+        noise = objectives.new_empty((objectives.shape[1], objectives.shape[0], sizes[1])).normal_()
+        e, z, mean, std = unroll.posterior_unroll(
+            input_gates, posterior_inputs, noise, weight_z, cell.weight_hh, cell.bias_hh, weight_e,
+            [(layer.weight, layer.bias) for layer in later], self.config.min_std)  # each (B, T, .)
+        return {"features": self.features(task, e, z), "prior": self.prior_belief(e), "posterior": gaussian(mean, std)}
 
     def losses(self, batch, train_config, bounds=None):
         """Per-term scalar losses and their weighted "total" on a batch of chunks (trainer/agent/losses.py);
         `bounds` (45, 2), the action bounds, turn on the pointing term."""
         return loss_terms.agent_losses(self, batch, train_config, bounds)
+

@@ -15,7 +15,7 @@ import numpy as np
 import torch
 
 from rlanimate_addon.core import skeleton, spaces
-from trainer.agent.arm_kinematics import ARMS, action_rotvecs, on_each_arm
+from trainer.agent.arm_kinematics import ARMS, action_rotvecs, arm_indices
 
 #: Metres: the nearest target distance the agent is asked to hit (targets are 1.5-4 m away).
 REFERENCE_DISTANCE = 1.5
@@ -24,20 +24,19 @@ HOLD_ANGLE, HOLD_OFFSET = np.radians(1.0), 0.01
 
 
 def pointing_error(actions, objectives, bounds):
-    """(N,) pointing term of actions (N, 45) in [0, 1] against target objectives (N, O): pass only the
-    frames that count (the hold), since forward kinematics is most of a training step's cost."""
-    rotvecs = action_rotvecs(actions, bounds)
+    """(N,) pointing term of actions (N, 45) in [0, 1] against target objectives (N, O), each frame on its
+    objective's arm: pass only the frames that count (the hold), since forward kinematics is most of a
+    training step's cost."""
+    arms = arm_indices(objectives)
+    base, finger = ARMS.finger(action_rotvecs(actions, bounds), arms)
     ray = objectives[..., spaces.OBJECTIVE_ATTRIBUTES]
+    offset = base - _SHOULDERS.to(actions.dtype)[arms]
+    across = offset - (offset * ray).sum(-1, keepdim=True) * ray
+    return (finger - ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
 
-    def arm_error(arm, mine):  # mine: the frames this arm points on
-        base, finger = ARMS.finger(rotvecs[mine], arm)
-        arm_ray = ray[mine]
-        offset = base - torch.as_tensor(skeleton.shoulder_rest_position(arm), dtype=actions.dtype)
-        across = offset - (offset * arm_ray).sum(-1, keepdim=True) * arm_ray
-        return (finger - arm_ray).pow(2).sum(-1) + across.pow(2).sum(-1) / REFERENCE_DISTANCE ** 2
 
-    return on_each_arm(objectives, arm_error)
-
+#: The rest shoulder (2, 3) of each arm (skeleton.ARMS order), where its pointing rays start.
+_SHOULDERS = torch.as_tensor(np.array([skeleton.shoulder_rest_position(arm) for arm in skeleton.ARMS]))
 
 _OUTWARD = {"LEFT": 1.0, "RIGHT": -1.0}  # +X is the character's left
 

@@ -33,6 +33,7 @@ from trainer.blender_io import import_worker, rig_session
 from trainer.blender_io.import_worker import ImportLimits
 from trainer.motion import canonicalise, clip_cache
 from trainer.motion.clip import ClipSet, MotionClip
+from trainer.motion.hands import with_hand
 from trainer.motion.manifest import ManifestEntry, checked_entries, labelled, read_manifest
 
 EXPECTED_FPS = 30.0
@@ -367,7 +368,8 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
                           limits=None):
     """Import every clip of a directory (its manifest.json when it has one, else every .fbx/.bvh) or
     of a manifest file. Returns (clips, problems): the clips that imported, and one message per file
-    that did not. Clips listed in a manifest carry its labels. cache_dir: where imported clips are
+    that did not. Clips listed in a manifest carry its labels; a clip without finger data gets the relaxed hand
+    (motion/hands.py). cache_dir: where imported clips are
     cached (default: `.import_cache/` beside a manifest; no cache for a folder without one, so that
     shared data folders stay untouched); False imports afresh without caching. progress: a stream to
     show a progress bar on (None: no bar). The files the cache lacks are imported by `workers` import
@@ -396,6 +398,7 @@ def import_clip_directory(path_or_manifest, expected_fps=None, cache_dir=None, p
             clip = imported[folder / entry.file, entry.fps]
             if isinstance(clip, RLAnimateError):
                 raise clip
+            clip = with_hand(clip)  # a new clip when it gets the relaxed hand
             if manifest_path is not None:  # a copy: two entries may name one file
                 clip = labelled(replace(clip), entry, manifest_path)
             clips.append(clip)

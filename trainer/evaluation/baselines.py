@@ -31,7 +31,7 @@ from rlanimate_addon.core import behaviours, rotations, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.gesture import slerp
 from trainer.motion.clip import MotionClip
-from trainer.motion.wave_rhythm import clip_tempo
+from trainer.motion.wave_rhythm import tempo_reading
 
 
 def mean_start_pose(clips: Sequence[MotionClip]) -> np.ndarray:
@@ -69,7 +69,7 @@ class NearestClip:
 
     def __init__(self, clips):
         self.clips = list(clips)
-        self._tempos = {}  # {id(clip): clip_tempo(clip)}, read when a request first names a tempo
+        self._tempos = {}  # {id(clip): its tempo (Hz) or None (tempo_reading)}, read when a request first names one
 
     def nearest(self, behaviour, arm, attributes, tempo=None):
         """The training clip of `behaviour` and `arm` whose label (and tempo, Hz, when given) is closest to
@@ -82,10 +82,10 @@ class NearestClip:
 
     def _nearest_in_tempo(self, candidates, exaggeration, tempo):
         """The candidate nearest (exaggeration, log tempo), each in units of its sd over the candidates
-        that swing; one that does not swing only when none does."""
+        whose tempo can be read; one whose tempo cannot only when none can."""
         for clip in candidates:
             if id(clip) not in self._tempos:
-                self._tempos[id(clip)] = clip_tempo(clip)
+                self._tempos[id(clip)] = tempo_reading(clip)[0]
         tempos = [self._tempos[id(c)] for c in candidates]
         swinging = [(c, t) for c, t in zip(candidates, tempos, strict=True) if t is not None]
         if not swinging:
@@ -170,11 +170,26 @@ def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=Non
 
 def generate_for(baseline: Any, clips: Sequence[MotionClip], with_tempo: bool = False) -> list[np.ndarray]:
     """The baseline's answer to each clip's own request (label and length, and `with_tempo` a wave's own
-    tempo, wave_rhythm.clip_tempo): list of (F_i, 15, 3)."""
-    return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs), tempo=request_tempo(c, with_tempo))
-            for c in clips]
+    tempo where it can be read, request_tempos): list of (F_i, 15, 3)."""
+    tempos, _ = request_tempos(clips, with_tempo)
+    return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs), tempo=tempo)
+            for c, tempo in zip(clips, tempos, strict=True)]
+
+
+def request_tempos(clips: Sequence[MotionClip], with_tempo: bool) -> tuple[list[float | None], dict[str, str]]:
+    """(tempos, fallbacks): the tempo (Hz) each clip's request names, and {clip name: why} for the waves whose
+    request falls back to the label when `with_tempo` (a take under a second, one that does not swing)."""
+    readings = [request_tempo_reading(clip, with_tempo) for clip in clips]
+    return [tempo for tempo, _ in readings], {c.name: why for c, (_, why) in zip(clips, readings, strict=True) if why}
 
 
 def request_tempo(clip: MotionClip, with_tempo: bool) -> float | None:
-    """The tempo (Hz) a request for `clip` names: the wave's own when `with_tempo`, else None."""
-    return clip_tempo(clip) if with_tempo and clip.behaviour == behaviours.WAVE else None
+    """The tempo (Hz) a request for `clip` names: the wave's own when `with_tempo` and it can be read, else None."""
+    return request_tempo_reading(clip, with_tempo)[0]
+
+
+def request_tempo_reading(clip: MotionClip, with_tempo: bool) -> tuple[float | None, str | None]:
+    """(tempo in Hz or None, why a wave's request asked for a tempo names none, else None)."""
+    if not with_tempo or clip.behaviour != behaviours.WAVE:
+        return None, None
+    return tempo_reading(clip)

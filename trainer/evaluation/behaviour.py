@@ -77,7 +77,8 @@ def request_rows(method, clips, references, describe, lengths, exact_aim=False, 
                "smoothness": metrics.smoothness(positions),
                "score_class_length": bm.score_at_length(class_positions, reference_positions),
                "aligned_score": bm.aligned_score(class_positions, reference_positions)}
-        row.update(bm.compare(own, reference, behaviour, arm, target))
+        kind = None if behaviour in bm.MEASURES else clip.behaviour_kind  # measured by its kind without its own
+        row.update(bm.compare(own, reference, behaviour, arm, target, kind=kind))
         rows.append(row)
     return rows
 
@@ -219,6 +220,10 @@ def summarise(rows):
             entry["reach_median"] = float(np.median(values("reach")))
             entry["hold_ratio_median"] = float(np.nanmedian(values("hold_ratio")))
             entry["accepted_share"] = float(values("guide_accepted").mean())
+        elif "hand_height_error" in group[0] or "aim_error" in group[0]:  # measured by its kind
+            key = "hand_height_error" if "hand_height_error" in group[0] else "aim_error"
+            entry[f"{key}_median"], entry[f"{key}_max"] = float(np.median(values(key))), float(values(key).max())
+            entry["free_arm_rise_max"] = float(values("free_arm_rise").max())
         elif "raise_accepted" in group[0]:
             entry["height_error_median"] = float(np.median(values("height_error")))
             entry["height_error_max"] = float(values("height_error").max())

@@ -36,7 +36,7 @@ def select_clips(clips, trained, count=None):
 
 def generate_descriptions(agent, env, objectives, bounds=spaces.DEFAULT_ACTION_BOUNDS):
     """Deterministic rollouts for a list of (N_i, O) objectives -> list of (N_i, 42) descriptions."""
-    actions = [rollout_actions(agent, objective, deterministic=True) for objective in objectives]
+    actions = rollout_actions(agent, objectives, deterministic=True)
     rotvecs = spaces.decode_action(np.concatenate(actions), bounds)  # (sum N, 15, 3)
     descriptions = np.asarray(env.evaluate(rotvecs).descriptions)  # (sum N, 42)
     return np.split(descriptions, np.cumsum([len(a) for a in actions])[:-1])
@@ -72,7 +72,8 @@ def clip_row(clip, generated, reference):
            "aligned_score": behaviour_metrics.aligned_score(positions, reference_positions)}
     target = clip_target(clip)
     if target is not None or clip.behaviour_kind == behaviours.INTENSITY:
-        row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm, target))
+        row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm, target,
+                                             kind=clip.behaviour_kind))
     else:  # a pointing clip without a target (real capture): its elevation only
         row.update({f"elevation_{k}": v for k, v in behaviour_metrics.raise_lower(
             positions, reference_positions, clip.arm).items()})

@@ -13,6 +13,7 @@ finished are not trained again.
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import torch
@@ -23,6 +24,7 @@ from trainer.agent.config import load_preset
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.evaluation import behaviour
 from trainer.evaluation.baselines import AgentMethod
+from trainer.experiments.options import some_of
 from trainer.experiments.run import RunSettings, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, shown
@@ -49,11 +51,12 @@ SEEDS = (1, 2, 3)
 @dataclass(frozen=True)
 class AblationSettings:
     """Which ablations to train (unless finished) and measure, and where."""
-    runs: str = str(REPO_ROOT / "runs" / "agent_ablation")
-    results: str = str(RESULTS_DIR)
+    runs: str = str(REPO_ROOT / "runs" / "agent_ablation")  # the training runs' folder, one subfolder per ablation
+    results: str = str(RESULTS_DIR)  # where agent_ablation.json and .md go
     targets: int = 100  # random pointing targets per arm
-    only: tuple[str, ...] = ()  # train and measure only these; the other rows stay as agent_ablation.json has them
-    address: str | None = None  # a Ray cluster to join for the training runs; None: a local Ray
+    # train and measure only these (none: every ablation); the other rows stay as agent_ablation.json has them
+    only: Annotated[tuple[str, ...], some_of(ABLATIONS)] = ()
+    address: str | None = None  # join a Ray cluster: auto or ray://HOST:PORT (None: a local Ray)
     workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
 
 

@@ -6,6 +6,7 @@ and the harder split), Figure 3 and length flexibility from the finished runs: `
 import json
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 import torch
@@ -19,6 +20,7 @@ from trainer.blender_io.procedural_ik import ProceduralIK
 from trainer.evaluation import behaviour, scoring
 from trainer.evaluation.baselines import AgentMethod, ClassMean, NearestClip, NoMotion, mean_start_pose
 from trainer.evaluation.harder_split import harder_clips
+from trainer.experiments.options import require_values, some_of
 from trainer.experiments.run import RunSettings, is_finished, train_runs
 from trainer.files import atomic_write_text
 from trainer.paths import DEFAULT_MANIFEST, REPO_ROOT, RESULTS_DIR, seed_folder
@@ -36,18 +38,22 @@ LENGTH_SCALES = tuple(float(s) for s in np.round(np.arange(0.3, 1.71, 0.1), 2))
 @dataclass(frozen=True)
 class PaperSettings:
     """What the Section 4 experiments run: every (seed, variant, column) for the paper's epochs x `epoch_scale`."""
-    preset: str = "default"  # config preset of every run
+    preset: str = "default"  # config preset of every run: debug, default or paper
     epoch_scale: float = 1.0  # fraction of the paper's 50 / 100 epochs to train (CPU budget)
-    variants: tuple[str, ...] = VARIANTS
-    columns: tuple[str, ...] = COLUMNS
-    clips: str = str(DEFAULT_MANIFEST)
-    runs: str = str(REPO_ROOT / "runs" / "experiments")  # seed 0's runs; seed N's in the sibling <runs>_seed<N>
-    results: str = str(RESULTS_DIR)
-    eval_every: int = 5
-    seeds: tuple[int, ...] = (0, 1, 2)
-    address: str | None = None  # a Ray cluster to join ("auto", "ray://HOST:PORT"); None: a local Ray
+    variants: Annotated[tuple[str, ...], some_of(VARIANTS)] = VARIANTS  # the variants (Table 4's rows) to train
+    columns: Annotated[tuple[str, ...], some_of(COLUMNS)] = COLUMNS  # the behaviours (Table 4's columns) to train
+    clips: str = str(DEFAULT_MANIFEST)  # clip library: a manifest.json or the folder that holds one
+    runs: str = str(REPO_ROOT / "runs" / "experiments")  # seed 0's runs; seed N's go to the sibling <runs>_seed<N>
+    results: str = str(RESULTS_DIR)  # where table4.json and .md and the figures go
+    eval_every: int = 5  # evaluate each run on seen and unseen clips every N epochs (Figure 3)
+    seeds: tuple[int, ...] = (0, 1, 2)  # training seeds: one run per seed, variant and column
+    # join a Ray cluster: auto (started on this machine by ray start) or ray://HOST:PORT (None: a local Ray, no set-up)
+    address: str | None = None
     workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
     skip_training: bool = False  # report the runs that finished, train none
+
+    def __post_init__(self) -> None:
+        require_values(self, "variants", "columns", "seeds")
 
 
 def run_folder(settings, seed, variant, column):

@@ -48,16 +48,17 @@ from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation import baselines, scoring
 from trainer.evaluation.label_reach import label_reach
+from trainer.experiments.options import require_values
 from trainer.experiments.run import RunSettings, is_finished, train_logged, train_runs
 from trainer.motion import autolabel, wave_rhythm
 from trainer.motion.fk import ClipReferences
+from trainer.motion.hands import relaxed_hand
 from trainer.motion.realmocap_takes import (
     GUIDE_TARGET_DISTANCE,
     HOLDOUT_STYLES,
     PAPER_LABELS,
     TAKE_GROUPS,
     parse_name,
-    relaxed_hand,
     require_realmocap,
     style_holdout_split,
     take_group,
@@ -221,15 +222,19 @@ REQUESTS = {"": False, "_tempo": True}
 
 def compare(methods, clips, env, references, with_tempo=False):
     """{method: scoring.score_motions result} on `clips`, each answering the clip's request (with its tempo when
-    `with_tempo`); for waves also `label_error`, the mean |autolabel exaggeration of the generated wave -
+    `with_tempo`, and `tempo_fallbacks` {take: why} naming the takes whose request fell back to the label,
+    baselines.request_tempos); for waves also `label_error`, the mean |autolabel exaggeration of the generated wave -
     requested exaggeration| (does it portray the label?)."""
     results = {}
+    _, fallbacks = baselines.request_tempos(clips, with_tempo)
     for name, method in methods.items():
         motions = baselines.generate_for(method, clips, with_tempo)
         result = scoring.score_motions(env, motions, clips, references)
         if all(c.behaviour == behaviours.WAVE for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
                                                    for m, c in zip(motions, clips, strict=True)]))
+        if fallbacks:
+            result["tempo_fallbacks"] = fallbacks
         results[name] = result
     return results
 
@@ -267,7 +272,7 @@ def tempo_table(clips, references):
     for clip in clips:
         measures = behaviour_metrics.wave_measures(spaces.description_joint_positions(references.get(clip)[0]),
                                                    clip.arm)
-        spectrum = wave_rhythm.clip_tempo(clip)
+        spectrum = wave_rhythm.tempo_reading(clip)[0]
         entry = readings.setdefault(clip.style, {"spectrum": [], "strokes": [], "stroke": [], "groups": []})
         entry["spectrum"].append(np.nan if spectrum is None else spectrum)
         entry["strokes"].append(measures["frequency"] or np.nan)
@@ -321,18 +326,31 @@ def _summary(result):
 
 
 @dataclass(frozen=True)
-class RealMocapSettings:
-    """What the real-capture experiments run."""
+class RealCaptureSettings:
+    """What every real-capture experiment's settings have: the capture, its runs and results, and how many of its
+    training runs at a time."""
     realmocap: str = str(REALMOCAP_DIR)  # the capture's folder (wave/, bye/, guide/)
-    epochs: int = 100  # per agent: chosen on validation takes (docs/results/realmocap_length.md; paper: 50)
-    preset: str = "end_chunks"  # docs/results/realmocap_ablation.md: the arm comes down in time
-    seeds: tuple[int, ...] = (0, 1, 2)  # the first seed's agents give the full tables and the figure
-    point_agent: str | None = None  # exported pointing agent for the guide clips (None: see point_agent_and_library)
-    runs: str = str(REALMOCAP_RUNS)
-    results: str = str(RESULTS_DIR)  # where realmocap_frames.png goes
-    import_workers: int = 1  # import the takes the cache lacks with this many Blenders at once (Ray tasks)
-    address: str | None = None  # a Ray cluster to join ("auto", "ray://HOST:PORT"); None: a local Ray
+    runs: str = str(REALMOCAP_RUNS)  # seed 0's runs and the import cache; seed N's go to <runs>_seed<N>
+    results: str = str(RESULTS_DIR)  # where the results go: JSON, a Markdown page and figures
     workers: int | None = None  # a local Ray's training runs at a time (None: one per CPU)
+
+
+@dataclass(frozen=True)
+class RealMocapSettings(RealCaptureSettings):
+    """What the real-capture experiments run."""
+    # iterations of Algorithm 1 per agent (chosen on validation takes: docs/results/realmocap_length.md; paper: 50)
+    epochs: int = 100
+    preset: str = "end_chunks"  # config preset (docs/results/realmocap_ablation.md: the arm comes down in time)
+    seeds: tuple[int, ...] = (0, 1, 2)  # training seeds; the first seed's agents give the full tables and the figure
+    # exported pointing agent (.npz) for the guide clips (None: the installed agent when trained, else one trained
+    # here on the sample library)
+    point_agent: str | None = None
+    import_workers: int = 1  # import the takes the cache lacks with N Blenders at once (Ray tasks)
+    # join a Ray cluster: auto (started on this machine by ray start) or ray://HOST:PORT (None: a local Ray, no set-up)
+    address: str | None = None
+
+    def __post_init__(self) -> None:
+        require_values(self, "seeds")
 
 
 def run_experiments(settings: RealMocapSettings) -> dict:

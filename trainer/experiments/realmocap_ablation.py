@@ -30,6 +30,7 @@ import time
 from collections import defaultdict
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Annotated
 
 import numpy as np
 
@@ -38,11 +39,11 @@ from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rhythm import EARLIER_TEMPO_BANDWIDTH, RhythmModel
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import swinging_check
-from trainer.experiments.realmocap import compare, real_run, train_real_runs, waves_and_env
+from trainer.experiments.options import some_of
+from trainer.experiments.realmocap import RealCaptureSettings, compare, real_run, train_real_runs, waves_and_env
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import style_holdout_split, wave_split
-from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.plots import wave_hand_paths
 from trainer.reporting.realmocap_ablation_report import RETRIEVAL, RETRIEVAL_TEMPO
 from trainer.reporting.realmocap_report import seed_summary
@@ -99,23 +100,24 @@ OWN_RHYTHM = "each take's own rhythm (not a method: the request cannot say it)"
 
 
 @dataclass(frozen=True)
-class AblationSettings:
-    """What the ablation runs: which experiments (EXPERIMENTS), the training seed and length of their agents."""
-    experiments: tuple[str, ...] = ("wave", "holdout")
-    seed: int = 0
-    epochs: int = 50
-    preset: str = "end_chunks"
-    compare_presets: tuple[str, ...] = ("default",)  # agents of these presets too (preset_variants)
-    realmocap: str = str(REALMOCAP_DIR)
-    runs: str = str(REALMOCAP_RUNS)
-    results: str = str(RESULTS_DIR)
-    workers: int | None = None
+class AblationSettings(RealCaptureSettings):
+    """What the ablation runs: which experiments (EXPERIMENTS), the training seed and length of their agents. A name
+    given twice counts once."""
+    # which agents to train and play: wave (tested on takes 009-010), holdout (unseen styles)
+    experiments: Annotated[tuple[str, ...], some_of(EXPERIMENTS)] = ("wave", "holdout")
+    seed: int = 0  # the agents' training seed
+    epochs: int = 50  # iterations of Algorithm 1 per agent
+    preset: str = "end_chunks"  # the config preset of the agents whose play-time settings vary
+    # agents trained with these presets too, played as trained and asked the tempo
+    compare_presets: tuple[str, ...] = ("default",)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         unknown = [name for name in self.experiments if name not in EXPERIMENTS]
         if unknown or not self.experiments:
             raise RLAnimateError(f"Unknown real-capture experiment(s) {unknown or '(none)'}: choose from "
                                  f"{', '.join(EXPERIMENTS)}.")
+        object.__setattr__(self, "experiments", tuple(dict.fromkeys(self.experiments)))  # frozen: set once, here
+        object.__setattr__(self, "compare_presets", tuple(dict.fromkeys(self.compare_presets)))
 
 
 class VariantMethod:

@@ -26,7 +26,8 @@ from rlanimate_addon.core import behaviours
 from trainer.blender_io.fk_env import FKEnvironment
 from trainer.blender_io.rig_session import blender_output, new_empty_scene
 from trainer.evaluation import baselines, scoring
-from trainer.experiments.realmocap import load_folder, real_run, train_real_runs
+from trainer.experiments.options import require_values
+from trainer.experiments.realmocap import RealCaptureSettings, load_folder, real_run, train_real_runs
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import (
     GESTURE_LABELS,
@@ -35,7 +36,6 @@ from trainer.motion.realmocap_takes import (
     require_realmocap,
     wave_split,
 )
-from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.realmocap_gestures_report import held_out_summary
 
 NAME = "gestures"
@@ -44,17 +44,17 @@ GUIDE = GESTURE_LABELS["guide"].name
 
 
 @dataclass(frozen=True)
-class GestureSettings:
+class GestureSettings(RealCaptureSettings):
     """What the gesture experiment runs."""
-    realmocap: str = str(REALMOCAP_DIR)
-    epochs: int = 50  # iterations of Algorithm 1 (the wave experiment's 50)
-    preset: str = "default"
-    seeds: tuple[int, ...] = (0,)  # one agent each, trained one after another; the first gives the full tables
-    runs: str = str(REALMOCAP_RUNS)
-    results: str = str(RESULTS_DIR)
-    import_workers: int = 1
-    address: str | None = None
-    workers: int | None = 1  # one training at a time
+    epochs: int = 50  # iterations of Algorithm 1 (paper: 50)
+    preset: str = "default"  # config preset
+    seeds: tuple[int, ...] = (0,)  # training seeds, one agent each; the first seed's agent gives the full tables
+    import_workers: int = 1  # import the takes the cache lacks with N Blenders at once (Ray tasks)
+    address: str | None = None  # join a Ray cluster: auto or ray://HOST:PORT (None: a local Ray)
+    workers: int | None = 1  # training runs at a time (1: one after another; None: one per CPU)
+
+    def __post_init__(self) -> None:
+        require_values(self, "seeds")
 
 
 def gesture_sets(waves, byes, guides):

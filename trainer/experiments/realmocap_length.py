@@ -30,12 +30,19 @@ from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import swinging_check
-from trainer.experiments.realmocap import REQUESTS, RealMocapSettings, compare, real_run, train_real_runs, waves_and_env
+from trainer.experiments.realmocap import (
+    REQUESTS,
+    RealCaptureSettings,
+    RealMocapSettings,
+    compare,
+    real_run,
+    train_real_runs,
+    waves_and_env,
+)
 from trainer.experiments.realmocap_ablation import VariantMethod
 from trainer.motion import wave_rhythm
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import style_validation_split, take_validation_split
-from trainer.paths import REALMOCAP_DIR, REALMOCAP_RUNS, RESULTS_DIR
 from trainer.reporting.realmocap_report import seed_summary
 
 #: {name: (split, what it validates)}.
@@ -47,18 +54,15 @@ TEMPO_KERNELS = (1.05, 1.1, 1.15, 1.25)
 
 
 @dataclass(frozen=True)
-class LengthSettings:
+class LengthSettings(RealCaptureSettings):
     """What the length search runs: the lengths (epochs, rising), one training seed and preset, and the
     exaggeration and tempo kernels the chosen length's agents play."""
-    lengths: tuple[int, ...] = (50, 100, 200)
-    exaggeration_kernels: tuple[float, ...] = EXAGGERATION_KERNELS
+    lengths: tuple[int, ...] = (50, 100, 200)  # epoch counts to compare, rising
+    exaggeration_kernels: tuple[float, ...] = EXAGGERATION_KERNELS  # exaggeration kernels (sd) to compare
+    # tempo kernels to compare, each the rate factor whose log is its sd in log Hz
     tempo_kernels: tuple[float, ...] = TEMPO_KERNELS
-    seed: int = 0
-    preset: str = "end_chunks"
-    realmocap: str = str(REALMOCAP_DIR)
-    runs: str = str(REALMOCAP_RUNS)
-    results: str = str(RESULTS_DIR)
-    workers: int | None = None
+    seed: int = 0  # the agents' training seed
+    preset: str = "end_chunks"  # config preset
 
     def __post_init__(self):
         if (

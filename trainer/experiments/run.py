@@ -33,6 +33,7 @@ from trainer.agent.models import RLAnimateAgent
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
+from trainer.motion.autolabel import still_free_arm
 from trainer.motion.clip import trained_behaviours, training_space
 from trainer.motion.library_checks import check_new_behaviours, left_out
 from trainer.motion.manifest import manifest_path
@@ -227,7 +228,7 @@ def train(settings: RunSettings, session: Any) -> tuple[dict, Trainer]:
     if final is None:  # resumed a run that had already finished
         final = evaluate_seen_unseen(trainer, session)
     log.close()
-    report = _report(settings, trainer, final, epochs, session.problems)
+    report = _report(settings, trainer, final, epochs, session.problems, session.test_clips)
     export_agent(trainer.played_agent, output / "agent.npz", _agent_metadata(report, trainer))
     write_run_report(report, output)
     plots.training_curves(trainer.history, output / "training_curves.png",
@@ -280,7 +281,15 @@ def _flatten(evaluation):
             for name in ("score", "smoothness")}
 
 
-def _report(settings, trainer, final, epochs, skipped):
+def _not_scored(trainer, held_out_clips):
+    """[{name, behaviour, why}] of the held-out clips the run does not score: those of behaviours it did not train."""
+    trained = ", ".join(behaviours.key(b) for b in trainer.trained)
+    return [{"name": getattr(clip, "name", ""), "behaviour": behaviours.key(clip.behaviour),
+             "why": f"the agent was not trained on {behaviours.key(clip.behaviour)} (--behaviour {trained})"}
+            for clip in held_out_clips if clip.behaviour not in trainer.trained]
+
+
+def _report(settings, trainer, final, epochs, skipped, held_out_clips=()):
     seconds = sum(e["collect_seconds"] + e["update_seconds"] for e in trainer.history)
     cpu_seconds = sum(e["cpu_seconds"] for e in trainer.history)
     return {
@@ -292,6 +301,8 @@ def _report(settings, trainer, final, epochs, skipped):
         "held_out": final.get("unseen"), "training": final["seen"],  # held_out None: no held-out clips
         "final_losses": {k[5:]: v for k, v in trainer.history[-1].items() if k.startswith("loss/")},
         "skipped_clips": list(skipped),
+        "training_clips": {behaviours.key(group[0].behaviour): len(group) for group in trainer.clip_groups},
+        "not_scored": _not_scored(trainer, held_out_clips),
     }
 
 
@@ -306,6 +317,7 @@ def _agent_metadata(report, trainer):
             "action_bounds": trainer.bounds,
             "average_frames": {name: float(np.mean(values)) for name, values in lengths.items()},
             "wave_rhythm": None if trainer.rhythm_model is None else trainer.rhythm_model.to_dict(),
+            "still_free_arm": still_free_arm([clip for group in trainer.clip_groups for clip in group]),
             "evaluation": {} if report["held_out"] is None else {  # {}: no held-out clips
                 "held_out_score": report["held_out"]["score"], "held_out_smoothness": report["held_out"]["smoothness"]}}
 

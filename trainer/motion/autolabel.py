@@ -19,11 +19,20 @@ The constants were set on the real capture (docs/REALMOCAP.md): a small, low, be
 about 80 deg up, strokes of 0.1 L) labels near 0.1, a straight overhead wave with strokes of 0.45 L
 near 0.75, and one with whole-arm sweeps wider than L near 1.
 
+Another intensity behaviour (raise a hand, or one of the user's own): how high the arm goes, the
+ELEVATION_PERCENTILE-th percentile of elevation_t, which a capture folder's labels place between the lowest
+and highest takes of the behaviour (trainer/motion/capture_folder.py).
+
 Pointing direction: at the hold (the stillest frame while the arm is raised), the unit vector from the
 arm's rest shoulder to the index-finger base, i.e. the objective `spaces.pointing_direction` whose
 ray the finger base lies on.
+
+A take's behaviour comes from its names (`behaviour_from_name`): a known behaviour's word in its file name, else
+the name of the folder that holds it.
 """
+import re
 from collections import namedtuple
+from pathlib import Path
 
 import numpy as np
 
@@ -45,6 +54,9 @@ WaveLabel = namedtuple("WaveLabel", "arm exaggeration elevation stroke travel")
 PointLabel = namedtuple("PointLabel", "arm direction hold_frame")
 
 _SIDES = {"LEFT": "Left", "RIGHT": "Right"}
+#: The behaviours a take's file name can name by a word of it, with their kinds: the paper's pair and the
+#: sample library's other two (docs/CLIPS.md).
+NAMED_BEHAVIOURS = {**behaviours.KNOWN_KINDS, "GUIDE": behaviours.TARGET, "RAISE_HAND": behaviours.INTENSITY}
 
 
 def arm_length(side="Left"):
@@ -141,6 +153,70 @@ def label_point(rotvecs, arm=None):
     hold = int(np.flatnonzero(raised)[np.argmin(speed[raised])])
     direction = spaces.pointing_direction(arm, heads[side + "HandIndex1"][hold])
     return PointLabel(arm, direction, hold)
+
+
+def name_words(path) -> list[str]:
+    """The lower-case words of a file name's stem ("dataset-2_wave-left-hand_active_001" -> dataset, 2, wave, ...)."""
+    return [word for word in re.split(r"[^a-z0-9]+", Path(path).stem.lower()) if word]
+
+
+def behaviour_from_name(path) -> str:
+    """The behaviour id a take's names give: a NAMED_BEHAVIOURS word in its file name ("wave_left_003.fbx",
+    "raise_hand_right_001.bvh"), else the name of the folder that holds it ("hello/take_001.bvh" -> HELLO);
+    RLAnimateError naming the fix when that folder's name is no behaviour name."""
+    joined = "_" + "_".join(name_words(path)) + "_"
+    named = [name for name in NAMED_BEHAVIOURS if f"_{name.lower()}_" in joined]
+    if named:
+        return max(named, key=len)  # raise_hand, not a shorter name inside it
+    folder = Path(path).parent.name
+    try:
+        return behaviours.parse(folder)
+    except RLAnimateError:
+        words = ", ".join(b.lower() for b in NAMED_BEHAVIOURS)
+        raise RLAnimateError(f"{path}: its name has no behaviour's word ({words}) and its folder's name {folder!r} is "
+                             f"no behaviour name: put the takes of each gesture in a folder named for it (hello/, "
+                             f"this_way/), or name the files for it.") from None
+
+
+def arm_from_name(path) -> str | None:
+    """'LEFT' or 'RIGHT' when exactly one of those words is in the file name, else None."""
+    named = {word.upper() for word in name_words(path)} & set(skeleton.ARMS)
+    return named.pop() if len(named) == 1 else None
+
+
+def arm_elevation(rotvecs, arm=None) -> tuple[str, float]:
+    """(arm, degrees): the moving arm (or `arm`) and how high it goes, the ELEVATION_PERCENTILE-th percentile
+    of its elevation_t: the measure an intensity behaviour other than WAVE is labelled by."""
+    vectors = _arm_vectors(rotvecs)
+    arm = arm or max(vectors, key=lambda side: _travel(vectors[side]))
+    return arm, float(np.percentile(_elevation(vectors[arm]), ELEVATION_PERCENTILE))
+
+
+#: Metres: a behaviour's free arm has no part in it when, in its median training clip, that arm's wrist strays at
+#: most this far from where it stood at the first frame (moved by its own joints alone): the add-on then holds
+#: it where it was (core/gesture.py).
+FREE_ARM_STILL = 0.05
+
+
+def free_arm_shift(rotvecs, arm) -> float:
+    """Metres: the farthest the wrist of the arm other than `arm` strays from its first frame's place, moved by that
+    arm's own joints alone (collar to index base; the spine held at its first frame)."""
+    r = _checked(rotvecs)
+    side = _SIDES["RIGHT" if arm == "LEFT" else "LEFT"]
+    free = [k for k, name in enumerate(skeleton.ACTION_JOINTS) if name.startswith(side)]
+    moved = np.repeat(r[:1], len(r), axis=0)
+    moved[:, free] = r[:, free]
+    wrist = joint_heads(moved, [side + "Hand"])[side + "Hand"]  # (F, 3)
+    return float(np.linalg.norm(wrist - wrist[0], axis=1).max())
+
+
+def still_free_arm(clips) -> list[str]:
+    """The ids of the behaviours among `clips` (MotionClips with behaviour and arm) whose free arm has no part in
+    them: the median free_arm_shift of their clips is at most FREE_ARM_STILL."""
+    shifts: dict[str, list[float]] = {}
+    for clip in clips:
+        shifts.setdefault(clip.behaviour, []).append(free_arm_shift(clip.rotvecs, clip.arm))
+    return sorted(b for b, values in shifts.items() if float(np.median(values)) <= FREE_ARM_STILL)
 
 
 def label_clip(clip, behaviour):

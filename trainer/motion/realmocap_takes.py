@@ -1,15 +1,12 @@
-"""The Bandai Namco real motion capture as data: file names, styles and takes, splits, and the relaxed hand
-put on a capture without fingers (numpy; the clips are read in place from ../shared/realmocap/, CC BY-NC)."""
-import functools
+"""The Bandai Namco real motion capture as data: file names, styles and takes, and splits (numpy; the clips are
+read in place from ../shared/realmocap/, CC BY-NC; a capture without fingers gets trainer/motion/hands.py's hand)."""
 import re
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, skeleton
+from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.errors import RLAnimateError
-from trainer.motion.synthesis import FINGER_BONES, neutral_pose
 from trainer.paths import REALMOCAP_DIR
 
 STYLES = ("active", "elderly", "exhausted", "feminine", "masculine", "normal", "youthful")
@@ -75,6 +72,13 @@ def take_paths(folder):
     return [path for path in sorted(Path(folder).glob("*.bvh")) if parse_name(path)["take"] not in WITHHELD_TAKES]
 
 
+def is_withheld(path) -> bool:
+    """Whether `path` is named as one of the dataset's withheld takes (WITHHELD_TAKES): any file whose name reads
+    as a Bandai Namco take of those numbers, wherever it lies; decided from the name alone."""
+    match = _NAME.match(Path(path).stem)
+    return match is not None and match["take"] in WITHHELD_TAKES
+
+
 def parse_name(path):
     """{'content', 'arm' (LEFT/RIGHT or None), 'style', 'take'} of a real-mocap file name."""
     match = _NAME.match(Path(path).stem)
@@ -83,25 +87,6 @@ def parse_name(path):
     side = match["side"]
     return {"content": match["content"], "arm": side.upper() if side else None,
             "style": match["style"], "take": match["take"]}
-
-
-@functools.cache
-def _relaxed_hand():
-    """{finger bone: (3,) rotation vector} of the synthesised neutral pose's relaxed hands."""
-    return {name: rotvec for name, rotvec in neutral_pose().items() if name in FINGER_BONES}
-
-
-def relaxed_hand(clip):
-    """`clip` with the synthesised clips' relaxed hand (synthesis.neutral_pose) on both sides, for a capture
-    without fingers: Index1 in its rotvecs, the other finger bones in .fingers."""
-    rotvecs = np.array(clip.rotvecs, dtype=np.float64)
-    fingers = dict(clip.fingers)
-    for name, rotvec in _relaxed_hand().items():
-        if name in skeleton.ACTION_JOINTS:
-            rotvecs[:, skeleton.ACTION_JOINTS.index(name)] = rotvec
-        else:
-            fingers[name] = np.tile(rotvec, (len(rotvecs), 1))
-    return replace(clip, rotvecs=rotvecs, fingers=fingers)
 
 
 def take_group(take):

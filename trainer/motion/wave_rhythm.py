@@ -100,6 +100,16 @@ def clip_tempo(clip):
     return None if read is None else read.frequency * clip.fps
 
 
+def tempo_reading(clip):
+    """(Hz, None): the tempo a request for a wave clip names (clip_tempo), or (None, why not) for a take whose tempo
+    cannot be read: one shorter than MIN_SECONDS, or one whose hand does not swing side to side. A request for such
+    a take names no tempo: its rhythm comes from its label."""
+    if clip.frames < MIN_SECONDS * clip.fps:
+        return None, f"{clip.frames} frames, under {MIN_SECONDS:g} s: too short to read its swing"
+    tempo = clip_tempo(clip)
+    return (tempo, None) if tempo is not None else (None, "its hand does not swing side to side")
+
+
 def swinging(waves):
     """[(clip, its Rhythm)] of the wave clips whose hand swings side to side (clip_rhythm), in their order."""
     return [(clip, read) for clip in waves if (read := clip_rhythm(clip)) is not None]

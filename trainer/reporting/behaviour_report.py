@@ -48,10 +48,37 @@ def behaviour_words(behaviour, entry):
     if behaviour == "raise_hand":
         return (f"height error {_f(entry['height_error_median'])} arm lengths median, {_accepted(entry)} raises "
                 f"accepted; {elevation}")
+    if "hand_height_error_median" in entry:
+        return (f"intensity: hand height error {_f(entry['hand_height_error_median'])} arm lengths median "
+                f"({_f(entry['hand_height_error_max'])} max), free arm rise {_f(entry['free_arm_rise_max'])} max; "
+                f"{elevation}")
+    if "aim_error_median" in entry:
+        return (f"target: aim error {_f(entry['aim_error_median'], 1)} deg median ({_f(entry['aim_error_max'], 1)} "
+                f"max), free arm rise {_f(entry['free_arm_rise_max'])} max; {elevation}")
     if "pointing_angle_median" in entry:
         return (f"own aim {_f(entry['pointing_angle_median'], 1)} deg median, {_f(entry['pointing_angle_max'], 1)} "
                 f"max; {elevation}")
     return elevation
+
+
+def clip_words(row):
+    """One line of a scored clip's measures (a scoring.clip_row), named for what its behaviour or kind measures."""
+    if "wave_accepted" in row:
+        return (f"swing {_f(row['swing_ratio'])}x, frequency {_f(row['frequency_ratio'])}x, "
+                f"{'accepted' if row['wave_accepted'] else 'not accepted'}")
+    if "guide_accepted" in row:
+        return f"heading {_f(row['heading_error'], 1)} deg, {'accepted' if row['guide_accepted'] else 'not accepted'}"
+    if "raise_accepted" in row:
+        return (f"height error {_f(row['height_error'])} arm lengths, "
+                f"{'accepted' if row['raise_accepted'] else 'not accepted'}")
+    if "pointing_angle" in row:
+        return f"own aim {_f(row['pointing_angle'], 1)} deg"
+    if "hand_height_error" in row:
+        return (f"intensity: hand height error {_f(row['hand_height_error'])} arm lengths, free arm rise "
+                f"{_f(row['free_arm_rise'])}")
+    if "aim_error" in row:
+        return f"target: aim error {_f(row['aim_error'], 1)} deg, free arm rise {_f(row['free_arm_rise'])}"
+    return f"elevation error last frame {_f(row['elevation_last_error'], 1)} deg"
 
 
 def _accepted(entry):

@@ -7,6 +7,7 @@ import numpy as np
 from rlanimate_addon.core import skeleton
 from trainer.motion.realmocap_takes import HOLDOUT_STYLES, TAKE_GROUPS, TEST_TAKES, VALIDATION_TAKES, parse_name
 from trainer.reporting.baselines_report import METHOD_LABELS
+from trainer.reporting.paired import gap_cell, paired_gap
 from trainer.reporting.tables import markdown_table
 
 matplotlib.use("Agg")
@@ -134,7 +135,16 @@ def seed_summary(result):
             "frequency_ratio_median": wave["frequency_ratio_median"],
             "elevation_last_error_median": wave["elevation_last_error_median"],
             "accepted": int(round(wave["accepted_share"] * len(result["clips"]))),
-            "by_style": style_summaries(result)}
+            "by_style": style_summaries(result), "take_scores": take_scores(result)}
+
+
+#: The per-take measures the side-by-side table pairs: (key of a clip's row, what the table calls it).
+PAIRED_MEASURES = (("score", "score"), ("aligned_score", "DTW"))
+
+
+def take_scores(result):
+    """{measure: [per take, in the set's order]} of a scoring result's clips, for PAIRED_MEASURES."""
+    return {key: [clip[key] for clip in result["clips"]] for key, _ in PAIRED_MEASURES}
 
 
 def seed_rows(results):
@@ -159,6 +169,72 @@ def seed_rows(results):
             ]
         )
     return rows
+
+
+#: The test sets the side-by-side table asks both ways: (experiment, set, label).
+BOTH_REQUEST_SETS = (("wave", "test", "takes 009-010"), ("holdout", "test", "unseen styles"),
+                     ("wave", "bye", "goodbye waves"))
+#: The two requests, by the suffix of their result keys (trainer.experiments.realmocap.REQUESTS).
+REQUEST_LABELS = {"": "the paper's (label only)", "_tempo": "tempo asked"}
+
+
+def seed_take_means(methods, seeds):
+    """({measure: per-take mean over the seeds' agents}, seeds used) of RLAnimate on one set: seed_summary's
+    take_scores of each seed that has them, else the first seed's full result alone."""
+    kept = [summary["take_scores"] for summary in seeds.values() if "take_scores" in summary]
+    kept = kept or [take_scores(methods["rlanimate"])]
+    return {key: np.mean([scores[key] for scores in kept], axis=0) for key, _ in PAIRED_MEASURES}, len(kept)
+
+
+def request_cells(methods, seeds):
+    """Cells of one set and request: RLAnimate's score / DTW (mean ± sd over seeds), retrieval's, and the paired
+    gaps (RLAnimate's per-take mean over seeds - retrieval's, 95% interval over the takes)."""
+    ours, used = seed_take_means(methods, seeds)
+    theirs = take_scores(methods["nearest_clip"])
+    per_seed = [[summary[key] for key, _ in PAIRED_MEASURES] for summary in seeds.values()]
+    agent = " / ".join(mean_and_sd(values, 1) if len(per_seed) > 1 else f"{values[0]:.1f}"
+                       for values in zip(*per_seed, strict=True))
+    retrieval = " / ".join(f"{np.mean(theirs[key]):.1f}" for key, _ in PAIRED_MEASURES)
+    return [agent, retrieval, *(gap_cell(paired_gap(ours[key], theirs[key])) for key, _ in PAIRED_MEASURES),
+            f"{used}"]
+
+
+def both_request_rows(results):
+    """Rows of the side-by-side table: each set of BOTH_REQUEST_SETS, asked the paper's way and with the tempo."""
+    rows = []
+    for name, set_name, label in BOTH_REQUEST_SETS:
+        for suffix, request in REQUEST_LABELS.items():
+            key = set_name + suffix
+            if key in results.get(name, {}):
+                rows.append([label, request, *request_cells(results[name][key], results[name][f"{key}_seeds"])])
+    return rows
+
+
+def fallback_notes(results):
+    """One line per set whose tempo-asked requests fell back to the label for some takes, naming them and why."""
+    notes = []
+    for name, set_name, label in BOTH_REQUEST_SETS:
+        fallbacks = results.get(name, {}).get(f"{set_name}_tempo", {}).get("rlanimate", {}).get("tempo_fallbacks")
+        if fallbacks:
+            notes.append(f"- {label}, tempo asked: {len(fallbacks)} take(s) asked with the label alone: " +
+                         "; ".join(f"{take} ({why})" for take, why in fallbacks.items()) + ".")
+    return notes
+
+
+def both_requests_section(results):
+    """Lines of the page's first section: each test set asked both ways, side by side (both_request_rows)."""
+    notes = fallback_notes(results)
+    return ["## Both requests, side by side", "",
+            "Each test take asked the paper's way (its auto-label and length) and again naming its tempo (the Hz at "
+            "which its hand swings, as a user types it in the panel's Tempo). Score / DTW score: RLAnimate's mean ± "
+            "sd over the seeds' agents, and nearest-clip retrieval's from the same training takes. Gap: RLAnimate's "
+            "per-take score (mean over the seeds paired: those whose per-take scores the results keep, the first "
+            "seed's alone in pages scored before they were kept) minus retrieval's on the same take, mean and 95% "
+            "interval over the takes.", "",
+            *markdown_table(["test set", "request", "RLAnimate score / DTW", "retrieval score / DTW",
+                             "paired score gap (95%)", "paired DTW gap (95%)", "seeds paired"],
+                            both_request_rows(results)),
+            *(["", *notes] if notes else []), ""]
 
 
 def cpu_list(entry):
@@ -262,6 +338,7 @@ def realmocap_markdown(results):
              f"Regenerate: `{results['command']}`.", "",
              *([f"**One seed only (seed {results['seeds'][0]}): no spread over seeds is given, and one seed's "
                 "agent can sit a few points either side of the mean.**", ""] if len(results["seeds"]) == 1 else []),
+             *both_requests_section(results),
              "## Auto-labels per style (one-arm waves: takes 001-010 and 021-036)", "",
              *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
                               "arm detected", "tempo, spectrum (Hz)", "tempo, strokes (Hz)", "stroke (cm)"],

@@ -3,7 +3,8 @@ docs/results/baselines.json and .md.
 
     nice -n 10 python -m trainer.scripts.baselines [--agent PATH] [--clips MANIFEST] [--results DIR]
 """
-import argparse
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +20,21 @@ from trainer.motion import autolabel
 from trainer.motion.fk import ClipReferences
 from trainer.paths import DEFAULT_MANIFEST, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.reporting.baselines_report import write_baselines_results
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts import cli
+from trainer.scripts.cli import run_main
+
+
+@dataclass(frozen=True)
+class BaselinesSettings:
+    """What the sample-library comparison scores, and where it writes."""
+    agent: str = str(INSTALLED_AGENT)  # exported RLAnimate agent (.npz)
+    clips: str = str(DEFAULT_MANIFEST)  # clip library: a manifest.json or the folder that holds one
+    results: str = str(RESULTS_DIR)  # where baselines.json and .md go
+
+
+def parse_settings(argv: Sequence[str] | None = None) -> BaselinesSettings:
+    """BaselinesSettings from the command line."""
+    return cli.parse_settings(BaselinesSettings, argv, prog="python -m trainer.scripts.baselines", doc=__doc__)
 
 
 def sample_library_comparison(agent_path, manifest):
@@ -48,22 +63,18 @@ def sample_library_comparison(agent_path, manifest):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.baselines", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--agent", default=str(INSTALLED_AGENT), help="exported RLAnimate agent (.npz)")
-    parser.add_argument("--clips", default=str(DEFAULT_MANIFEST))
-    parser.add_argument("--results", default=str(RESULTS_DIR))
-    options = parser.parse_args(script_args(argv))
+    settings = parse_settings(argv)
     torch.set_num_threads(1)
     new_empty_scene()
-    sets, training = sample_library_comparison(options.agent, options.clips)
-    agent = shown(options.agent)
+    sets, training = sample_library_comparison(settings.agent, settings.clips)
+    agent = shown(settings.agent)
     provenance = "untrained" if training.get("untrained") else ", ".join(
         f"{k} {training[k]}" for k in ("behaviour", "variant", "preset", "epochs", "episodes") if k in training)
-    write_baselines_results(options.results, "sample library",
+    write_baselines_results(settings.results, "sample library",
                   f"The 10 held-out clips of sample_rigs/clips (targets and exaggerations no training clip has). "
                   f"RLAnimate: `{agent}` ({provenance}). "
                   f"Regenerate: `nice -n 10 python -m trainer.scripts.baselines --agent {agent}`.", sets)
-    print((Path(options.results) / "baselines.md").read_text())
+    print((Path(settings.results) / "baselines.md").read_text())
     return 0
 
 

@@ -1,6 +1,7 @@
 """Behaviour metrics of RLAnimate and the baselines on the sample library's held-out requests:
-docs/results/behaviour.{json,md}, the held-out waves' hand paths (docs/results/behaviour_wave_paths.png) and,
-when the library has guide and raise-hand clips, theirs (behaviour_guide_paths.png, behaviour_raise_hand_paths.png).
+docs/results/behaviour.{json,md}, the held-out waves' and points' hand paths (docs/results/behaviour_wave_paths.png,
+behaviour_point_paths.png) and, when the library has guide and raise-hand clips, theirs (behaviour_guide_paths.png,
+behaviour_raise_hand_paths.png).
 
     nice -n 10 python -m trainer.scripts.behaviour [--agent PATH] [--clips MANIFEST] [--results DIR]
                                                    [--targets 100] [--seeds 1 2 3 4]
@@ -24,6 +25,7 @@ from trainer.reporting.plots import gesture_hand_paths, wave_hand_paths
 from trainer.scripts.cli import run_main, script_args
 
 WAVE_PATHS = "behaviour_wave_paths.png"
+POINT_PATHS = "behaviour_point_paths.png"
 #: The hand-path figure of each further behaviour's held-out requests.
 HELD_PATHS = {GUIDE: "behaviour_guide_paths.png", RAISE_HAND: "behaviour_raise_hand_paths.png"}
 
@@ -80,6 +82,9 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
     wave_hand_paths(panels, Path(results_dir) / WAVE_PATHS)
     figures = {f"docs/results/{WAVE_PATHS}": "the held-out waves' wrist, reference against RLAnimate "
                                              "(deterministic and one seed) and the class mean"}
+    gesture_hand_paths([_held_panel(clip, session, methods) for clip in points], Path(results_dir) / POINT_PATHS)
+    figures[f"docs/results/{POINT_PATHS}"] = ("the held-out points' wrist, reference against RLAnimate (its own aim) "
+                                              "and the class mean")
     for behaviour_id, figure in HELD_PATHS.items():
         requests = [c for c in held if c.behaviour == behaviour_id]
         if requests:
@@ -118,7 +123,7 @@ def behaviour_report(agent_path, manifest, target_count, seeds, results_dir, tar
 
 
 def _held_panel(clip, session, methods):
-    """(title, arm, {label: positions}, target) of one guide or raise-hand request for gesture_hand_paths."""
+    """(title, arm, {label: positions}, target) of one point, guide or raise-hand request for gesture_hand_paths."""
     reference = spaces.description_joint_positions(session.references.get(clip)[0])
     answers = {label: spaces.description_joint_positions(session.describe(methods[key].generate(
         clip.behaviour, clip.arm, clip.attributes, len(clip.rotvecs))))

@@ -1,16 +1,35 @@
-"""What every trainer script shares: its own arguments under Blender or Python, clear errors, and its results
-written as JSON beside a Markdown page."""
+"""What every trainer script shares: its command line made from its settings dataclass, its own arguments under
+Blender or Python, clear errors, and its results written as JSON beside a Markdown page."""
 import json
 import sys
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TypeVar
+
+import tyro
 
 from rlanimate_addon.core.errors import RLAnimateError
 
+Settings = TypeVar("Settings")
 
-def script_args(argv=None):
+
+def script_args(argv: Sequence[str] | None = None) -> list[str]:
     """The script's own arguments: those after `--` under Blender (`blender -b -P script -- ARGS`), else argv[1:]."""
-    argv = sys.argv if argv is None else argv
+    argv = list(sys.argv if argv is None else argv)
     return argv[argv.index("--") + 1:] if "--" in argv else argv[1:]
+
+
+def parse_settings(settings_type: type[Settings], argv: Sequence[str] | None = None, *, prog: str,
+                   doc: str | None) -> Settings:
+    """A `settings_type` (a frozen settings dataclass) from the command line `argv` (sys.argv when None; see
+    script_args): each field is an option named as it is with hyphens (`epoch_scale`: `--epoch-scale`), its
+    comment the help, its default the dataclass's; a tuple takes several values (`--seeds 0 1`), a bool is a flag
+    (`--skip-training`). --help shows them with `prog` and the first paragraph of the script's `doc`; a bad value
+    exits with status 2 and a message, as argparse does. The dataclass checks the values it is given
+    (__post_init__ raising RLAnimateError). A field that is itself a settings dataclass gives its fields' options
+    without a prefix (`--epochs`, not `--run.epochs`)."""
+    return tyro.cli(settings_type, args=script_args(argv), prog=prog, description=(doc or "").split("\n\n")[0],
+                    config=(tyro.conf.FlagCreatePairsOff, tyro.conf.OmitArgPrefixes))
 
 
 #: What an experiment that trains its runs as Ray tasks says when it is interrupted.
@@ -29,16 +48,6 @@ def run_main(main, *args, interrupted="interrupted"):
     except KeyboardInterrupt:
         print(interrupted, file=sys.stderr)
         return 130
-
-
-def add_real_capture_arguments(parser, defaults):
-    """--realmocap, --runs, --results and --workers, each defaulting to the field of that name of `defaults` (a
-    real-capture script's settings)."""
-    parser.add_argument("--realmocap", default=defaults.realmocap)
-    parser.add_argument("--runs", default=defaults.runs)
-    parser.add_argument("--results", default=defaults.results)
-    parser.add_argument("--workers", type=int, default=defaults.workers,
-                        help="training runs at a time on a local Ray (default: one per CPU)")
 
 
 def write_results(folder, name, results, page):

@@ -8,14 +8,16 @@ composed on one character (both arms at once, a handover) into docs/results/comp
     nice -n 10 python -m trainer.scripts.contact_sheet --generated [--further] [--agent PATH] [--out PNG]
     nice -n 10 python -m trainer.scripts.contact_sheet --composing [--agent PATH] [--out PNG]
 """
-import argparse
 import tempfile
+from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from trainer.motion.library_plan import DEFAULT_SEED
 from trainer.paths import CONTACT_SHEET, RESULTS_DIR, shown
 from trainer.reporting.contact_sheet import generated_sheet, render
-from trainer.scripts.cli import run_main, script_args
+from trainer.scripts import cli
+from trainer.scripts.cli import run_main
 
 GENERATED_SHEET = RESULTS_DIR / "generated_frames.png"
 FURTHER_SHEET = RESULTS_DIR / "generated_guide_raise_frames.png"
@@ -24,6 +26,22 @@ TARGET_HIGH = (-0.9, -2.0, 1.7)  # ahead, up and to the character's right
 TARGET_ACROSS = (-0.9, -1.8, 0.9)  # low, across the body for the left arm
 TARGET_DOOR = (-2.2, -1.6, 0.9)  # a doorway ahead and out to the character's right, at waist height
 TARGET_FLOOR = (0.6, -2.2, 0.05)  # on the floor ahead, a little to the left
+
+
+@dataclass(frozen=True)
+class SheetSettings:
+    """Which contact sheet to make, and where."""
+    out: Path | None = None  # the PNG to write (None: the sheet's own under docs/)
+    seed: int = DEFAULT_SEED  # library plan seed (library sheet)
+    generated: bool = False  # render Generate Gesture's output with Blender
+    further: bool = False  # with --generated: the guide and raise-hand gestures
+    composing: bool = False  # render gestures composed on one character (both arms, a handover) with Blender
+    agent: Path | None = None  # agent file for the add-on (None: the bundled agent)
+
+
+def parse_settings(argv: Sequence[str] | None = None) -> SheetSettings:
+    """SheetSettings from the command line."""
+    return cli.parse_settings(SheetSettings, argv, prog="python -m trainer.scripts.contact_sheet", doc=__doc__)
 
 
 def generated_requests():
@@ -78,41 +96,31 @@ def compositions():
     ]
 
 
-def _composing(args):
+def _composing(settings):
     from trainer.blender_io.gesture_render import render_compositions
     with tempfile.TemporaryDirectory() as frames:
-        rendered = render_compositions(compositions(), frames, agent_path=args.agent)
-        agent = shown(args.agent) if args.agent else "the bundled agent"
-        return generated_sheet([(c.title, c.frames) for c in rendered], args.out or COMPOSING_SHEET,
+        rendered = render_compositions(compositions(), frames, agent_path=settings.agent)
+        agent = shown(settings.agent) if settings.agent else "the bundled agent"
+        return generated_sheet([(c.title, c.frames) for c in rendered], settings.out or COMPOSING_SHEET,
                                f"Gestures composed on the sample character, {agent}, rendered by Blender (Cycles): "
                                "frame numbers above; red: the point's target", frame_labels=True)
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(
-        prog="python -m trainer.scripts.contact_sheet", description=__doc__.split("\n\n")[0]
-    )
-    parser.add_argument("--out", type=Path)
-    parser.add_argument("--seed", type=int, default=DEFAULT_SEED, help="library plan seed (library sheet)")
-    parser.add_argument("--generated", action="store_true", help="render Generate Gesture's output with Blender")
-    parser.add_argument("--further", action="store_true", help="with --generated: the guide and raise-hand gestures")
-    parser.add_argument("--composing", action="store_true",
-                        help="render gestures composed on one character (both arms, a handover) with Blender")
-    parser.add_argument("--agent", type=Path, help="agent file for the add-on (default: the bundled agent)")
-    args = parser.parse_args(script_args(argv))
-    if args.composing:
-        print(f"wrote {_composing(args)}")
+    settings = parse_settings(argv)
+    if settings.composing:
+        print(f"wrote {_composing(settings)}")
         return 0
-    if not args.generated:
-        print(f"wrote {render(args.out or CONTACT_SHEET, args.seed)}")
+    if not settings.generated:
+        print(f"wrote {render(settings.out or CONTACT_SHEET, settings.seed)}")
         return 0
     from trainer.blender_io.gesture_render import render_requests
     with tempfile.TemporaryDirectory() as frames:
-        requests = render_requests(further_requests() if args.further else generated_requests(), frames,
-                                   agent_path=args.agent)
-        agent = shown(args.agent) if args.agent else "the bundled agent"
+        requests = render_requests(further_requests() if settings.further else generated_requests(), frames,
+                                   agent_path=settings.agent)
+        agent = shown(settings.agent) if settings.agent else "the bundled agent"
         out = generated_sheet([(r.title, r.frames) for r in requests],
-                              args.out or (FURTHER_SHEET if args.further else GENERATED_SHEET),
+                              settings.out or (FURTHER_SHEET if settings.further else GENERATED_SHEET),
                               f"Generate Gesture on the sample character, {agent}, rendered by Blender (Cycles); "
                               f"red: the target")
     print(f"wrote {out}")

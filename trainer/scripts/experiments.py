@@ -19,47 +19,19 @@ requests and a harder split (trainer/evaluation/harder_split.py), and it writes 
     length_flexibility.json/.png           smoothness of the RLAnimate both-agent's held-out gestures
                                            time-scaled 0.3x-1.7x the class average length (first seed)
 """
-import argparse
 import json
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
-from trainer.agent.models import VARIANTS
-from trainer.experiments.paper import COLUMNS, PaperSettings, run_paper
-from trainer.scripts.cli import RUNS_INTERRUPTED, run_main, script_args
-
-DEFAULTS = PaperSettings()
+from trainer.experiments.paper import PaperSettings, run_paper
+from trainer.scripts import cli
+from trainer.scripts.cli import RUNS_INTERRUPTED, run_main
 
 
-def build_parser():
-    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.experiments", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--preset", default=DEFAULTS.preset)
-    parser.add_argument("--epoch-scale", type=float, default=DEFAULTS.epoch_scale,
-                        help="fraction of the paper's 50 / 100 epochs to train (CPU budget)")
-    parser.add_argument("--variants", nargs="+", choices=VARIANTS, default=list(DEFAULTS.variants))
-    parser.add_argument("--columns", nargs="+", choices=COLUMNS, default=list(DEFAULTS.columns))
-    parser.add_argument("--clips", default=DEFAULTS.clips)
-    parser.add_argument("--runs", default=DEFAULTS.runs,
-                        help="seed 0's runs; seed N's go to the sibling folder <runs>_seed<N>")
-    parser.add_argument("--results", default=DEFAULTS.results)
-    parser.add_argument("--eval-every", type=int, default=DEFAULTS.eval_every)
-    parser.add_argument("--seeds", type=int, nargs="+", default=list(DEFAULTS.seeds))
-    parser.add_argument("--workers", type=int, default=DEFAULTS.workers,
-                        help="a local Ray's training runs at a time (default: one per CPU)")
-    parser.add_argument("--address", default=DEFAULTS.address,
-                        help="join a Ray cluster: auto (started on this machine by ray start) or ray://HOST:PORT "
-                             "(default: a local Ray, no set-up)")
-    parser.add_argument("--skip-training", action="store_true", help="report the runs that finished, train none")
-    return parser
-
-
-def parse_settings(argv=None):
+def parse_settings(argv: Sequence[str] | None = None) -> PaperSettings:
     """PaperSettings from the command line."""
-    args = build_parser().parse_args(script_args(argv))
-    return PaperSettings(preset=args.preset, epoch_scale=args.epoch_scale, variants=tuple(args.variants),
-                         columns=tuple(args.columns), clips=args.clips, runs=args.runs, results=args.results,
-                         eval_every=args.eval_every, seeds=tuple(args.seeds), address=args.address,
-                         workers=args.workers, skip_training=args.skip_training)
+    return cli.parse_settings(PaperSettings, argv, prog="python -m trainer.scripts.experiments", doc=__doc__)
 
 
 def main(argv=None):

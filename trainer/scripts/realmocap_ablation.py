@@ -8,36 +8,17 @@ Trains only the experiments named (one agent per preset, the seed's; reused when
 runs/realmocap[_seed<N>]/<name>[_<preset>]/ has it, as trainer.scripts.realmocap reuses it), then plays each with
 every setting of trainer/experiments/realmocap_ablation.py.
 """
-import argparse
+from collections.abc import Sequence
 
-from trainer.experiments.realmocap_ablation import EXPERIMENTS, AblationSettings, run_ablation
+from trainer.experiments.realmocap_ablation import AblationSettings, run_ablation
 from trainer.reporting.realmocap_ablation_report import ablation_markdown
-from trainer.scripts.cli import RUNS_INTERRUPTED, add_real_capture_arguments, run_main, script_args, write_results
-
-DEFAULTS = AblationSettings()
-
-
-def build_parser():
-    parser = argparse.ArgumentParser(prog="python -m trainer.scripts.realmocap_ablation",
-                                     description=__doc__.split("\n\n")[0])
-    parser.add_argument("--experiments", nargs="+", choices=list(EXPERIMENTS), default=list(DEFAULTS.experiments),
-                        help="which agents to train and play: wave (tested on takes 009-010), holdout (unseen styles)")
-    parser.add_argument("--seed", type=int, default=DEFAULTS.seed, help="the agents' training seed")
-    parser.add_argument("--epochs", type=int, default=DEFAULTS.epochs)
-    parser.add_argument("--preset", default=DEFAULTS.preset, help="the agents whose play-time settings vary")
-    parser.add_argument("--compare-presets", nargs="*", default=list(DEFAULTS.compare_presets),
-                        help="agents trained with these presets too, played as trained and asked the tempo")
-    add_real_capture_arguments(parser, DEFAULTS)
-    return parser
+from trainer.scripts import cli
+from trainer.scripts.cli import RUNS_INTERRUPTED, run_main, write_results
 
 
-def parse_settings(argv=None):
+def parse_settings(argv: Sequence[str] | None = None) -> AblationSettings:
     """AblationSettings from the command line."""
-    args = build_parser().parse_args(script_args(argv))
-    return AblationSettings(experiments=tuple(dict.fromkeys(args.experiments)), seed=args.seed, epochs=args.epochs,
-                            preset=args.preset, compare_presets=tuple(dict.fromkeys(args.compare_presets)),
-                            realmocap=args.realmocap, runs=args.runs, results=args.results,
-                            workers=args.workers)
+    return cli.parse_settings(AblationSettings, argv, prog="python -m trainer.scripts.realmocap_ablation", doc=__doc__)
 
 
 def main(argv=None):

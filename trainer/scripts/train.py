@@ -4,8 +4,11 @@
     blender -b -P trainer/train.py -- [ARGS]      (Blender's Python finds torch through a venv of
                                                    the same minor version on PYTHONPATH; see README)
 
-With no arguments it trains the RLAnimate agent of every behaviour of the sample clip library (point and
-wave) into runs/default/. `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
+With no arguments it trains the RLAnimate agent of every behaviour of the sample clip library into
+runs/default/. `--clips FOLDER` on a folder of .bvh/.fbx takes without a manifest labels the takes from their
+names and motion (shown as a table and written to <output>/manifest.json), holds out a share of them, trains,
+and compares the agent with retrieval on the held-out takes in <output>/capture_report.md
+(trainer/experiments/capture.py). `--install` also copies the agent to rlanimate_addon/agents/default.npz and its
 report to docs/results/. Outputs: see trainer/experiments/run.py. `--resume` continues the run in --output
 from its checkpoint with the run's own settings; the continuation equals the uninterrupted run. A new run
 into the folder of another is refused unless `--overwrite`.
@@ -17,7 +20,8 @@ from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.models import VARIANTS
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.import_worker import ImportLimits
-from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, resolve, train
+from trainer.experiments import capture
+from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, check_settings, resolve, train
 from trainer.files import atomic_copy
 from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.scripts.cli import run_main, script_args
@@ -34,8 +38,12 @@ def build_parser():
     parser.add_argument("--behaviour", help="the behaviours to learn: all (every behaviour of the clip library), "
                                              "both (point and wave), one behaviour (point), or several joined by "
                                              f"commas (point,beckon); default {defaults['behaviour']}")
-    parser.add_argument("--clips", help="clip library: a manifest.json or the folder that holds one "
-                                        "(default sample_rigs/clips)")
+    parser.add_argument("--clips", help="clip library: a manifest.json or the folder that holds one (default "
+                                        "sample_rigs/clips); or a folder of .bvh/.fbx takes without one, which is "
+                                        "labelled from the takes' names and motion into <output>/manifest.json")
+    parser.add_argument("--hold-out", type=float, default=capture.capture_folder.HOLD_OUT_SHARE,
+                        help="with a folder of takes: the share of each behaviour and arm's takes held out for "
+                             "the comparison with retrieval (default %(default)s)")
     parser.add_argument("--epochs", type=int,
                         help="iterations of Algorithm 1 (default: the preset's, the paper's 50 for one behaviour "
                              "and 100 for both; on --resume, the run's own)")
@@ -98,7 +106,13 @@ def install(output):
 
 def main(argv=None):
     args = build_parser().parse_args(script_args(argv))
-    settings = resolve(run_settings(args))
+    settings = run_settings(args)
+    labelled = None
+    if not args.resume and capture.is_capture_folder(args.clips):  # a studio's folder of takes, no manifest
+        check_settings(settings)
+        labelled = capture.label_folder(args.clips, args.output, args.hold_out, args.verbose)
+        settings = capture.capture_settings(settings, labelled)
+    settings = resolve(settings)
     limits = import_limits(args)
     session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers,
                              import_limits=limits)
@@ -107,6 +121,10 @@ def main(argv=None):
                      else (report["training"], "no held-out clips; training-clip"))
     print(f"trained: {report['epochs']} epochs, {report['episodes']} episodes, {report['train_seconds'] / 60:.1f} min; "
           f"{split} score {scored['score']:.2f}, smoothness {scored['smoothness']:.2f}; outputs in {args.output}")
+    if labelled is not None:
+        page = capture.write_report(labelled, report, session, args.output, " ".join(["trainer/train.py",
+                                                                                      *script_args(argv)]))
+        print(f"compared with retrieval on the held-out takes: {page}")
     if args.install:
         install(Path(settings.output))
         print(f"installed: {shown(INSTALLED_AGENT)}, and the report in {shown(RESULTS_DIR)}")

@@ -8,7 +8,14 @@ import torch
 from rlanimate_addon.core import spaces
 from tests.trainer.synthetic_library import make_library
 from trainer.agent import checkpoint, pointing
-from trainer.agent.algorithm import Trainer, chunks_per_update, clip_objective, clips_for_behaviour
+from trainer.agent.algorithm import (
+    Trainer,
+    chunks_per_update,
+    clip_objective,
+    clips_for_behaviour,
+    epoch_updates,
+    rollout_actions,
+)
 from trainer.agent.buffer import EPISODE_KEYS, FIRST_FRAME_SHARE, EpisodeBuffer
 from trainer.agent.config import load_preset
 from trainer.agent.models import RLAnimateAgent
@@ -156,6 +163,37 @@ def test_every_behaviour_keeps_the_chunks_and_random_targets_it_has_beside_one_o
             assert side * direction[0] > 0.7
         else:  # the points': ahead
             assert direction[1] < -0.3
+
+
+def test_more_than_two_behaviours_make_fewer_update_steps(env, library):
+    default = load_preset("default")[1]
+    assert [epoch_updates(default, n) for n in (1, 2, 3, 4)] == [(120, 32), (120, 32), (99, 48), (99, 48)]
+    unset = replace(default, update_steps_many=None, chunk_count_many=None)
+    assert [epoch_updates(unset, n) for n in (2, 4)] == [(120, 32), (120, 64)]
+    agent_config, train_config = load_preset("debug")
+    clips = _four_behaviours(library)
+    agent = RLAnimateAgent(agent_config, "rlanimate", library_space(clips))
+    trainer = Trainer(agent, env, clips, replace(train_config, update_steps_many=2, chunk_count_many=5), "all", seed=1)
+    steps = []
+    trainer.optimizer.step = lambda: steps.append(1)  # count the update steps of an epoch
+    trainer.run_epoch()
+    assert trainer.update_steps == 2 and len(steps) == 2 and trainer.chunk_count == 5
+    pair = Trainer(RLAnimateAgent(agent_config), env, library.train, replace(train_config, update_steps_many=2), "both")
+    assert (pair.update_steps, pair.chunk_count) == (3, train_config.chunk_count)
+
+
+def test_a_batched_rollout_is_each_episodes_own_rollout(library):
+    torch.manual_seed(0)
+    agent = RLAnimateAgent(load_preset("debug")[0])
+    objectives = [clip_objective(spaces.PAPER_SPACE, clip) for clip in library.train[:4]]
+    assert len({len(o) for o in objectives}) > 1  # padded to the longest
+    batched = rollout_actions(agent, objectives)
+    for objective, actions in zip(objectives, batched, strict=True):
+        assert actions.shape == (len(objective), spaces.ACTION_SIZE)
+        assert np.allclose(actions, rollout_actions(agent, [objective])[0], atol=1e-6)
+    sampled = [rollout_actions(agent, objectives, deterministic=False, generator=torch.Generator().manual_seed(3))
+               for _ in range(2)]
+    assert all(np.array_equal(a, b) for a, b in zip(*sampled, strict=True))  # reproducible from the generator
 
 
 def test_debug_preset_trains_end_to_end_and_its_loss_falls(env, library):

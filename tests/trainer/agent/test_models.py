@@ -137,7 +137,8 @@ def test_supervised_variant_clones_the_clip_without_kl():
 def test_presets_and_config_round_trip():
     assert set(PRESETS) == {"debug", "default", "paper", "paper_wave_objective", "reference_posterior",
                             "no_random_targets", "no_pointing_term", "velocity_term", "weight_average", "no_wrist_term",
-                            "end_chunks", "end_chunks_wide"}
+                            "end_chunks", "end_chunks_wide", "end_chunks_long", "end_chunks_smooth",
+                            "end_chunks_phase"}
     for name in PRESETS:
         agent_config, train_config = load_preset(name)
         assert AgentConfig.from_dict(agent_config.to_dict()) == agent_config
@@ -145,6 +146,14 @@ def test_presets_and_config_round_trip():
     debug, default = load_preset("debug")[0], load_preset("default")[0]
     assert sum(p.numel() for p in RLAnimateAgent(debug).parameters()) < \
         sum(p.numel() for p in RLAnimateAgent(default).parameters()) / 10
+
+
+def test_train_configs_defaults_are_the_default_preset_and_debug_and_paper_keep_the_first_ones():
+    assert load_preset("default")[1] == TrainConfig()
+    first = {"update_steps_many": None, "chunk_count_many": None, "learning_rate": 1e-3, "learning_rate_final": None,
+             "wrist_scale": 0.0, "random_targets": 1, "random_target_margin_deg": 0.0, "random_target_weight": 1.0}
+    for name in ("debug", "paper"):
+        assert {key: getattr(load_preset(name)[1], key) for key in first} == first
 
 
 def test_unknown_preset_names_the_choices():

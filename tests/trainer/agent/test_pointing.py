@@ -10,8 +10,8 @@ from trainer.motion import synthesis as gs
 
 def test_the_torch_finger_matches_the_numpy_forward_kinematics():
     rotvecs = np.random.default_rng(0).normal(0.0, 0.5, (6, 15, 3))
-    for arm in skeleton.ARMS:
-        base, finger = ARMS.finger(torch.tensor(rotvecs), arm)
+    for side, arm in enumerate(skeleton.ARMS):
+        base, finger = ARMS.finger(torch.tensor(rotvecs), torch.full((len(rotvecs),), side))
         _, expected_base, expected_finger, _ = aim.finger_lines(rotvecs, arm)
         assert np.allclose(base.numpy(), expected_base, atol=1e-9)
         assert np.allclose(finger.numpy(), expected_finger, atol=1e-9)

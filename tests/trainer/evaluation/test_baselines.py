@@ -54,6 +54,24 @@ def test_with_a_tempo_nearest_clip_weighs_the_swing_rate_beside_the_exaggeration
     assert baselines.request_tempo(library[0], False) is None
 
 
+def test_a_take_whose_tempo_cannot_be_read_is_asked_with_its_label_and_named():
+    """A take under a second (or one whose hand does not swing) names no tempo: its request falls back to the
+    label, and the fallback names the take and why, where reading its tempo used to stop the whole set."""
+    library = [make_clip("slow", "WAVE", "RIGHT", 0.5, 150, 1.2), make_clip("fast", "WAVE", "RIGHT", 0.55, 150, 2.5)]
+    short = make_clip("short", "WAVE", "RIGHT", 0.5, 19, 1.2)
+    still = make_clip("still", "WAVE", "RIGHT", 0.5, 90, 1.2)
+    still.rotvecs[:] = still.rotvecs[:1]
+    tempos, fallbacks = baselines.request_tempos([library[0], short, still], True)
+    assert tempos[0] == pytest.approx(1.2, rel=0.05) and tempos[1:] == [None, None]
+    assert set(fallbacks) == {"short", "still"}
+    assert "19 frames, under 1 s" in fallbacks["short"] and "does not swing" in fallbacks["still"]
+    assert baselines.request_tempos([short], False) == ([None], {})
+    nearest = baselines.NearestClip(library + [short])  # a short training take is ranked as one without a tempo
+    motions = baselines.generate_for(nearest, [library[0], short], with_tempo=True)
+    assert [len(m) for m in motions] == [150, 19]
+    assert nearest.nearest("WAVE", "RIGHT", 0.55, tempo=2.4).name == "fast"
+
+
 def test_the_evaluator_scores_baseline_clips():
     env = NumpyFKEnvironment()
     reference, other = _wave(1.0, 80), _wave(0.0, 60)

@@ -1,9 +1,12 @@
 """Auto-labelling: arm, wave exaggeration and pointing direction from motion alone."""
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from rlanimate_addon.core import rotations, skeleton
+from rlanimate_addon.core.errors import RLAnimateError
 from trainer.motion import autolabel
 from trainer.paths import REALMOCAP_DIR
 
@@ -111,3 +114,47 @@ def test_label_clip_fills_an_unlabelled_clip():
         RLAnimateError, match="points and waves only, not DANCE: label the clips of DANCE in a manifest"
     ):
         autolabel.label_clip(clip, "dance")
+
+
+@pytest.mark.parametrize("path, behaviour", [
+    ("capture/wave/dataset-2_wave-left-hand_active_001.bvh", "WAVE"),
+    ("clips/raise_hand_right_003.fbx", "RAISE_HAND"),
+    ("clips/point_left_000.fbx", "POINT"),
+    ("capture/hello/take_001.bvh", "HELLO"),  # no known word: the folder names it
+    ("capture/this_way/pointing_ahead.fbx", "THIS_WAY"),  # "pointing" is not the word point
+])
+def test_a_takes_behaviour_comes_from_a_known_word_of_its_file_name_else_its_folder(path, behaviour):
+    assert autolabel.behaviour_from_name(path) == behaviour
+
+
+def test_a_take_whose_names_name_no_behaviour_is_refused_with_the_fix():
+    with pytest.raises(RLAnimateError, match="folder named for it"):
+        autolabel.behaviour_from_name("capture/2024-takes/take_001.bvh")
+
+
+def test_the_arm_a_file_name_gives_is_read_only_when_it_names_one():
+    assert autolabel.arm_from_name("dataset-2_wave-left-hand_active_001.bvh") == "LEFT"
+    assert autolabel.arm_from_name("wave_right_002.fbx") == "RIGHT"
+    assert autolabel.arm_from_name("wave_003.fbx") is None and autolabel.arm_from_name("left_right.fbx") is None
+
+
+def test_an_intensity_gesture_other_than_a_wave_is_measured_by_how_high_its_arm_goes():
+    low, high = _arm_clip("RIGHT", np.linspace(10, 90, 60)), _arm_clip("RIGHT", np.linspace(10, 160, 60))
+    (arm, lower), (_, higher) = autolabel.arm_elevation(low), autolabel.arm_elevation(high)
+    assert arm == "RIGHT" and lower == pytest.approx(82.0, abs=1.0) and higher == pytest.approx(145.0, abs=1.0)
+
+
+def test_the_free_arm_is_still_when_only_the_gesturing_arm_moves():
+    """free_arm_shift measures the other arm's wrist moved by its own joints: zero for a one-armed wave, the arm's
+    sweep for a two-armed one; a behaviour is still-armed when its median clip's shift is at most 5 cm."""
+    one = _wave("RIGHT", 150, 0.4)
+    two = one + _wave("LEFT", 150, 0.4)  # the left arm waves too (the arms' joints are disjoint)
+    assert autolabel.free_arm_shift(one, "RIGHT") == pytest.approx(0.0, abs=1e-9)
+    assert autolabel.free_arm_shift(two, "RIGHT") > 0.5
+    assert autolabel.free_arm_shift(two, "LEFT") > 0.5
+    spine = one.copy()
+    spine[:, skeleton.ACTION_JOINTS.index("Spine")] = np.linspace(0, 0.5, len(one))[:, None] * [1.0, 0.0, 0.0]
+    assert autolabel.free_arm_shift(spine, "RIGHT") == pytest.approx(0.0, abs=1e-9), "a bow is not the arm's"
+    clips = [SimpleNamespace(behaviour="WAVE", arm="RIGHT", rotvecs=r) for r in (one, one, two)]
+    clips += [SimpleNamespace(behaviour="CLAP", arm="RIGHT", rotvecs=r) for r in (two, two, one)]
+    assert autolabel.still_free_arm(clips) == ["WAVE"]

@@ -2,6 +2,7 @@
 seeds table (each seed, their mean ± sd, and retrieval), and what tempo each test style's label can reach."""
 import numpy as np
 
+from trainer.reporting import realmocap_report
 from trainer.reporting.realmocap_report import per_style_rows, reach_rows, seed_rows, style_summaries
 
 
@@ -100,3 +101,30 @@ def test_reach_rows_give_each_test_style_its_neighbours_in_reach_and_the_rules_r
                        "feminine, normal", "masculine", "1.04-2.04 (27/72)"]
     assert rows[1][:2] == ["unseen styles", "elderly"] and rows[1][5:] == ["0/0, 0/10, 0/20", "feminine, normal",
                                                                           "none", "1.91-2.91 (0/72)"]
+
+
+def _scored(scores, aligned):
+    return {"clips": [{"score": s, "aligned_score": a} for s, a in zip(scores, aligned, strict=True)]}
+
+
+def test_both_requests_sit_side_by_side_with_the_paired_gap_over_the_seeds_mean():
+    """Each set asked both ways on one row each: RLAnimate over its seeds, retrieval, and the gap of the per-take
+    mean over seeds against retrieval on the same takes, with its 95% interval; fallbacks named below."""
+    seeds = {"0": {"score": 70.0, "aligned_score": 80.0, "take_scores": {"score": [60.0, 80.0],
+                                                                          "aligned_score": [70.0, 90.0]}},
+             "1": {"score": 74.0, "aligned_score": 84.0, "take_scores": {"score": [64.0, 84.0],
+                                                                          "aligned_score": [74.0, 94.0]}}}
+    retrieval = _scored([61.0, 81.0], [80.0, 80.0])
+    tempo = {"rlanimate": {**_scored([0.0, 0.0], [0.0, 0.0]), "tempo_fallbacks": {"take_019": "too short"}},
+             "nearest_clip": retrieval}
+    results = {"wave": {"test": {"rlanimate": _scored([0.0, 0.0], [0.0, 0.0]), "nearest_clip": retrieval},
+                        "test_seeds": seeds, "test_tempo": tempo, "test_tempo_seeds": {"0": seeds["0"]}}}
+    rows = realmocap_report.both_request_rows(results)
+    assert [row[:2] for row in rows] == [["takes 009-010", "the paper's (label only)"],
+                                         ["takes 009-010", "tempo asked"]]
+    assert rows[0][2:4] == ["72.0 ± 2.8 / 82.0 ± 2.8", "71.0 / 80.0"]
+    # per take: 62 - 61 and 82 - 81 -> +1.0 exactly; DTW 72 - 80 and 92 - 80 -> +2.0, wide interval
+    assert rows[0][4] == "+1.0 (+1.0 to +1.0)" and rows[0][5].startswith("+2.0 (-") and rows[0][6] == "2"
+    assert rows[1][2] == "70.0 / 80.0" and rows[1][6] == "1"
+    assert realmocap_report.fallback_notes(results) == [
+        "- takes 009-010, tempo asked: 1 take(s) asked with the label alone: take_019 (too short)."]
