@@ -7,6 +7,9 @@ fresh process and compares what they wrote:
   core     the shipped agent through core.gesture (two points, two waves, seeded and not): every array;
   blender  Generate Gesture on the sample character (Point with and without Exact Aim, a seeded Wave):
            every key of every curve written;
+  composed gestures over one another on the sample character (a Point right, a seeded Wave left over
+           it, the point baked again, then the point generated again at another target): every key of
+           every curve written; the pose underneath each is the others' layers;
   trainer  a debug-preset training run (point and wave, seed 2): every weight array of agent.npz and
            every number of metrics.jsonl but the timings.
 The clip import cache of this tree is copied into the base tree, so both read the same imported clips.
@@ -42,7 +45,6 @@ def blender(root, out):
     sys.path.insert(0, str(root / "tests" / "addon"))
     import bpy  # noqa: F401, I001  (before the helpers: a base tree's may import addon_utils first, which needs bpy)
     import addon_helpers
-    from rlanimate_addon.blender import action_adapter, gestures
     settings = addon_helpers.enable_addon()
     rig = addon_helpers.load_sample_rig()
     target = addon_helpers.add_empty("Target", (-1.2, -2.5, 1.7))
@@ -51,6 +53,27 @@ def blender(root, out):
                    dict(behaviour="POINT", arm="LEFT", target=target, exact_aim=False, start_frame=300,
                         frame_count=60)):
         assert addon_helpers.generate(rig, settings, **values) == {"FINISHED"}
+    np.savez(out, **_keys(rig))
+
+
+def composed(root, out):
+    sys.path.insert(0, str(root / "tests" / "addon"))
+    import bpy  # noqa: F401, I001  (before the helpers, as in `blender`)
+    import addon_helpers
+    settings = addon_helpers.enable_addon()
+    rig = addon_helpers.load_sample_rig()
+    first = addon_helpers.add_empty("Target", (-1.2, -2.5, 1.7))
+    second = addon_helpers.add_empty("Other", (1.3, -2.2, 1.5))
+    for values in (dict(behaviour="POINT", arm="RIGHT", target=first, start_frame=1, frame_count=120),
+                   dict(behaviour="WAVE", arm="LEFT", exaggeration=0.7, start_frame=20, frame_count=120, seed=3),
+                   dict(behaviour="POINT", arm="RIGHT", target=second, start_frame=1, frame_count=120)):
+        assert addon_helpers.generate(rig, settings, **values) == {"FINISHED"}
+    np.savez(out, **_keys(rig))
+
+
+def _keys(rig):
+    """{action|data path|index: (2K,) the keys' frames and values} of every curve of the rig's gestures."""
+    from rlanimate_addon.blender import action_adapter, gestures
     keys = {}
     for placed in gestures.placed_gestures(rig):
         # Every action of the gesture: its main and torso layers (a tree from before issue 42 has the one).
@@ -59,7 +82,7 @@ def blender(root, out):
                 co = np.zeros(2 * len(curve.keyframe_points))
                 curve.keyframe_points.foreach_get("co", co)
                 keys[f"{action.name}|{curve.data_path}|{curve.array_index}"] = co
-    np.savez(out, **keys)
+    return keys
 
 
 def trainer(root, out, epochs):
@@ -70,13 +93,21 @@ def trainer(root, out, epochs):
 
 def _child(kind, root, out, epochs):
     sys.path.insert(0, str(root))
-    {"core": lambda: core(root, out), "blender": lambda: blender(root, out),
+    {"core": lambda: core(root, out), "blender": lambda: blender(root, out), "composed": lambda: composed(root, out),
      "trainer": lambda: trainer(root, out, epochs)}[kind]()
 
 
 def _same_npz(a, b):
     with np.load(a) as x, np.load(b) as y:
         return sorted(x.files) == sorted(y.files) and all(np.array_equal(x[k], y[k]) for k in x.files), len(x.files)
+
+
+def _difference(a, b):
+    """How two npz files differ: the arrays of the same name and shape that differ, and by how much at most."""
+    with np.load(a) as x, np.load(b) as y:
+        pairs = [(x[k], y[k]) for k in set(x.files) & set(y.files) if x[k].shape == y[k].shape]
+        gaps = [float(np.abs(u - v).max()) for u, v in pairs if u.size and not np.array_equal(u, v)]
+    return f"{len(gaps)} differ, by at most {max(gaps, default=0.0):.2g}"
 
 
 def _same_run(a, b):
@@ -109,7 +140,7 @@ def main():
         subprocess.run(["tar", "-x", "-C", str(base)], input=archive, check=True)
         if (ROOT / CACHE).is_dir():
             shutil.copytree(ROOT / CACHE, base / CACHE)
-        for kind in ("core", "blender", "trainer"):
+        for kind in ("core", "blender", "composed", "trainer"):
             outs = []
             for name, root in (("base", base), ("this", ROOT)):
                 out = folder / f"{kind}_{name}" if kind == "trainer" else folder / f"{kind}_{name}.npz"
@@ -118,7 +149,8 @@ def main():
                                stderr=subprocess.DEVNULL)
                 outs.append(out)
             same, count = (_same_run if kind == "trainer" else _same_npz)(*outs)
-            print(f"{kind:8s} {count} arrays: {'identical' if same else 'DIFFERENT'} ({args.base} against this tree)")
+            how = "identical" if same else "DIFFERENT" + ("" if kind == "trainer" else f" ({_difference(*outs)})")
+            print(f"{kind:8s} {count} arrays: {how} ({args.base} against this tree)")
 
 
 if __name__ == "__main__":
