@@ -66,10 +66,11 @@ def against_gesture(obj, bone_names):
 
 
 def driven_bones(names, behaviour, arm, still=True):
-    """The rig's names of the bones a gesture keys: the action joints it owns (the other arm only made as on a
-    still rig: gesture.owned_joints), and for Point the pointing hand."""
+    """The rig's names of the bones a gesture of `behaviour` (a behaviours.Behaviour, or None: one not known)
+    keys: the action joints it owns (the other arm only made as on a still rig: gesture.owned_joints), and for
+    a pointing behaviour the pointing hand."""
     canonical = list(gesture.owned_joints(arm, still))
-    if behaviour == "POINT":
+    if behaviour is not None and behaviour.aims:
         canonical += [skeleton.ARM_PREFIX[arm] + bone for bone in gesture.POINTING_HAND]
     return [names[name] for name in canonical if name in names]
 

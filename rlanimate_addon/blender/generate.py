@@ -187,12 +187,13 @@ def _check(obj, settings, start, end, mute_constraints, still):
     check_nla(obj)
     check_inherited_rotation(obj, roles)
     armature_io.check_hips(obj, roles)
-    driven = constraints.driven_bones(roles, settings.behaviour, settings.arm, still)
+    declared = properties.declared_behaviour(bpy.context, settings.behaviour)
+    driven = constraints.driven_bones(roles, declared, settings.arm, still)
     rig_scale.check_nonzero_scale(obj.name, obj.matrix_world, _scales(obj, driven))
     # Eyes the rig already aims with constraints (a Damped Track to an eye target) stay the rig's.
     roles = {role: bone for role, bone in roles.items()
              if not (role.endswith("Eye") and len(obj.pose.bones[bone].constraints))}
-    driven = constraints.driven_bones(roles, settings.behaviour, settings.arm, still)
+    driven = constraints.driven_bones(roles, declared, settings.arm, still)
     constraints.check_drivers(obj, driven)
     overriding = constraints.against_gesture(obj, driven)
     constraints.check(obj, overriding, start, end, mute_constraints)
@@ -610,7 +611,7 @@ def _length_notes(plan, agent, scene, count):
     steps = gesture.rollout_length(span, agent.average_frames[settings.behaviour], agent.kind(settings.behaviour))
     note = f" (time-scaled from the agent's {steps}-frame gesture)" if steps != span else ""
     note += gesture.length_warning(count, agent.average_frames[settings.behaviour])
-    if settings.behaviour == behaviours.POINT and not settings.exact_aim:
+    if agent.space.behaviour(settings.behaviour).aims and not settings.exact_aim:
         note += " (the agent's own aim: Exact Aim is off)"
     return note
 

@@ -39,14 +39,15 @@ def _agent_summary(context, behaviour):
     return f"{name}: learned {average} frames, supported {shortest}-{longest}", None
 
 
-def _overriding_constraints(obj, settings, behaviour):
+def _overriding_constraints(context, obj, settings, behaviour):
     """Constraints of the armature (None: no armature) that would override the gesture."""
     if obj is None:
         return []
     selected = gestures.find(obj, gestures.selected(obj))
     still = selected.still if selected is not None else not action_adapter.is_animated(obj)
+    declared = properties.declared_behaviour(context, behaviour)
     return constraints.against_gesture(obj, constraints.driven_bones(_rig_roles(obj, settings.bone_map_file)[1],
-                                                                     behaviour, settings.arm, still))
+                                                                     declared, settings.arm, still))
 
 
 _roles = {}
@@ -119,7 +120,7 @@ class VIEW3D_PT_rlanimate(bpy.types.Panel):
         selected = gestures.selected(obj) if obj is not None else ""
         layout.operator("rlanimate.generate_gesture", icon="ARMATURE_DATA",
                         text=f"Generate Again: {selected}" if selected else "Generate Gesture")
-        overriding = _overriding_constraints(obj, settings, behaviour)
+        overriding = _overriding_constraints(context, obj, settings, behaviour)
         if overriding:
             box = layout.box()
             box.label(text=f"{constraints.describe(overriding)} would override the gesture", icon="ERROR")
@@ -135,18 +136,19 @@ def _draw_gesture_settings(layout, context, settings):
     layout.prop(settings, "behaviour", expand=True)
     layout.prop(settings, "arm", expand=True)
     behaviour = properties.chosen_behaviour(settings, context)
-    kind = properties.behaviour_kind(context, behaviour)
+    declared = properties.declared_behaviour(context, behaviour)
+    kind = None if declared is None else declared.kind
     if kind == behaviours.TARGET:
         layout.prop(settings, "target")
         if settings.target is None:
             layout.prop(settings, "use_cursor")
         elif settings.target.type == "ARMATURE":
             layout.prop_search(settings, "target_bone", settings.target.data, "bones")
-        if behaviour == behaviours.POINT:
+        if declared.aims:
             layout.prop(settings, "exact_aim")
     elif kind == behaviours.INTENSITY:
         layout.prop(settings, "exaggeration", slider=True)
-        if behaviour == behaviours.WAVE:
+        if declared.oscillates:
             layout.prop(settings, "tempo", text="Tempo (Hz)")
     column = layout.column(align=True)
     row = column.row(align=True)

@@ -169,16 +169,16 @@ def chosen_behaviour(settings, context):
     return next((item[0] for item in behaviour_items(settings, context) if item[3] == number), "")
 
 
-def behaviour_kind(context, behaviour):
-    """The kind (behaviours.TARGET or INTENSITY) of `behaviour` in the selected agent; its known kind, or
-    None, when the agent cannot be loaded or lacks it."""
+def declared_behaviour(context, behaviour):
+    """The declaration (behaviours.Behaviour: its kind and what it does) of `behaviour` in the selected agent;
+    the paper's, or None, when the agent cannot be loaded or lacks it."""
     try:
         agent = preferences.selected_agent(context)
         if behaviour in agent.behaviours:
-            return agent.kind(behaviour)
+            return agent.space.behaviour(behaviour)
     except RLAnimateError:
         pass
-    return KNOWN_KINDS.get(behaviour)
+    return behaviours.Behaviour(behaviour, KNOWN_KINDS[behaviour]) if behaviour in KNOWN_KINDS else None
 
 
 class RLANIMATE_PG_settings(bpy.types.PropertyGroup):

@@ -123,7 +123,7 @@ def objective_space(metadata):
     version 3 file (which declares none)."""
     if metadata["format_version"] == 3:
         return spaces.PAPER_SPACE
-    return spaces.ObjectiveSpace(tuple(behaviours.Behaviour(b["name"], b["kind"]) for b in metadata["behaviours"]))
+    return spaces.ObjectiveSpace(tuple(behaviours.from_dict(b) for b in metadata["behaviours"]))
 
 
 def load_agent_file(path):
@@ -451,13 +451,15 @@ def _checked_space(path, metadata):
         return spaces.PAPER_SPACE
     declared, problem = metadata["behaviours"], None
     if not isinstance(declared, list) or not 0 < len(declared) <= behaviours.MAX_BEHAVIOURS or any(
-            not isinstance(b, dict) or set(b) != {"name", "kind"} or not all(isinstance(v, str) for v in b.values())
+            not isinstance(b, dict) or not {"name", "kind"} <= set(b) <= {"name", "kind", "does"}
+            or not all(isinstance(v, str) for v in b.values())
             for b in declared):
         problem = (f"need a list of 1 to {behaviours.MAX_BEHAVIOURS} behaviours, each "
-                   f'{{"name": ..., "kind": "{behaviours.TARGET}" or "{behaviours.INTENSITY}"}}')
+                   f'{{"name": ..., "kind": "{behaviours.TARGET}" or "{behaviours.INTENSITY}"}} and, optionally, '
+                   f'"does" ({", ".join(behaviours.ACTIONS)})')
     else:
         try:
-            space = spaces.ObjectiveSpace(tuple(behaviours.Behaviour(b["name"], b["kind"]) for b in declared))
+            space = spaces.ObjectiveSpace(tuple(behaviours.from_dict(b) for b in declared))
         except RLAnimateError as error:
             problem = str(error)
         else:

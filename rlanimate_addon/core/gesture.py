@@ -6,7 +6,7 @@ and the target, writing keys):
     targets (N, 3) in the rig's armature space --pointing_directions--> objectives (N, 7)
     --agent.rollout--> actions (M, 45) --decode, time_scale--> canonical rotations (N, 15, 3)
     --fold_missing, retarget--> rig quaternions (N, D, 4) --blend with the pose underneath-->
-    --aim_rig (POINT, exact aim)--> keys
+    --aim_rig (a pointing behaviour, exact aim)--> keys
 
 A rig may differ from the canonical skeleton in many ways, all handled here:
   * bone names: core.rig_roles maps roles (canonical names) to its bones; a role it lacks is left
@@ -168,8 +168,8 @@ def arm_reach(arm, rest_heads):
 def build_objectives(space, behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5,
                      rhythm=None):
     """(N, O) objectives of the ObjectiveSpace `space` for a gesture: a target behaviour needs targets
-    (N, 3) and rest_heads; an intensity behaviour an exaggeration and, for WAVE from an agent trained with
-    them, rhythm signals (N, 2) (GestureAgent.wave_rhythm)."""
+    (N, 3) and rest_heads; an intensity behaviour an exaggeration and, for an oscillating one (a wave) from an
+    agent trained with them, rhythm signals (N, 2) (GestureAgent.wave_rhythm)."""
     check_length(frame_count)
     if space.kind(behaviour) == behaviours.TARGET:
         if targets is None:
@@ -179,7 +179,7 @@ def build_objectives(space, behaviour, arm, frame_count, *, targets=None, rest_h
     else:
         attributes = exaggeration
     return space.make_objective(behaviour, arm, attributes, frame_count,
-                                rhythm if behaviour == behaviours.WAVE else None)
+                                rhythm if space.behaviour(behaviour).oscillates else None)
 
 
 def resample(values, count):
@@ -580,7 +580,7 @@ def _objectives(agent, request, rig):
     """(M, O) objectives of the request at the agent's rate (M: the gesture's seconds at the agent's rate)."""
     span = request.agent_frames
     rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed, request.tempo, request.arm)
-              if request.behaviour == behaviours.WAVE else None)
+              if agent.space.behaviour(request.behaviour).oscillates else None)
     if request.targets is not None:
         check_finite_targets(np.broadcast_to(request.targets, (request.frame_count, 3)))
     asked = None if request.targets is None else resample(
@@ -598,14 +598,14 @@ def _conversions(names, rig, to_character):
             retarget_matrices(names, frames, to_character, np.array(parent_swings)))
 
 
-def _played(request, rig, canonical):
+def _played(request, rig, canonical, pointing):
     """(names of the roles keyed, (N, D, 4) the gesture's rotations of them on the rig, (D, 4) the standing
-    pose, to_character): the owned action joints, then Point's hand shape."""
+    pose, to_character): the owned action joints, then, for a `pointing` behaviour, the pointing hand shape."""
     names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
     kept = [k for k, name in enumerate(names) if name in owned_joints(request.arm, rig.still)]
     names, canonical = [names[k] for k in kept], canonical[:, kept]
     joints = len(names)
-    if request.behaviour == behaviours.POINT:  # one hand shape, held on every frame
+    if pointing:  # one hand shape, held on every frame
         hand_names, hand = pointing_hand_rotations(request.arm, 1)
         present = [i for i, name in enumerate(hand_names) if name in rig.roles]
         names += [hand_names[i] for i in present]
@@ -674,13 +674,15 @@ def gesture_rotations(agent, request, rig):
 class Blended:
     """A gesture before its aim (`blended_gesture`): the roles keyed and their columns in the rig's skeleton, the
     (N, D, 4) rotations keyed and underneath, the agent's (N, 3) finger base the aim's phase follows (None but for
-    a target behaviour) and the rig's character frame. `aimed` finishes it for a target, and for another."""
+    a target behaviour), the rig's character frame, and whether the behaviour aims (Exact Aim applies: a pointing
+    behaviour). `aimed` finishes it for a target, and for another."""
     names: tuple[str, ...]
     columns: tuple[int, ...]
     keyed: npt.NDArray[np.float64]
     under: npt.NDArray[np.float64]
     phase_base: npt.NDArray[np.float64] | None
     to_character: npt.NDArray[np.float64]
+    aims: bool
 
 
 def blended_gesture(agent: Any, request: "GestureRequest", rig: "RigState") -> Blended:
@@ -689,13 +691,13 @@ def blended_gesture(agent: Any, request: "GestureRequest", rig: "RigState") -> B
     check_length(request.frame_count)
     canonical = run_agent(agent, request.behaviour, _objectives(agent, request, rig), seed=request.seed,
                           frame_count=request.frame_count)  # (N, 15, 3)
-    targeted = agent.kind(request.behaviour) == behaviours.TARGET
-    phase_base = played_finger_base(canonical, request.arm) if targeted else None
-    names, played, standing, to_character = _played(request, rig, canonical)
+    declared = agent.space.behaviour(request.behaviour)
+    phase_base = played_finger_base(canonical, request.arm) if declared.kind == behaviours.TARGET else None
+    names, played, standing, to_character = _played(request, rig, canonical, declared.aims)
     columns = [rig.skeleton.index[rig.roles[n]] for n in names]  # the eyes, keyed for Point, come after these
     held = free_arm_columns(names, request.arm) if request.behaviour in agent.still_free_arm else []
     keyed, under = _blended(rig, names, columns, played, standing, held)
-    return Blended(tuple(names), tuple(columns), keyed, under, phase_base, to_character)
+    return Blended(tuple(names), tuple(columns), keyed, under, phase_base, to_character, declared.aims)
 
 
 def aimed(request: "GestureRequest", rig: "RigState",
@@ -707,8 +709,7 @@ def aimed(request: "GestureRequest", rig: "RigState",
     bones = [rig.roles[n] for n in names]
     keyed, under = np.array(blended.keyed), np.array(blended.under)
     if blended.phase_base is not None:
-        bones, keyed, under = _aimed(rig, request, names, columns, keyed, under, blended.phase_base,
-                                     blended.to_character)
+        bones, keyed, under = _aimed(rig, request, names, columns, keyed, under, blended)
     keyed, under = continuous(keyed), continuous(under)
     finite = np.isfinite(keyed).all(axis=(0, 2)) & np.isfinite(under).all(axis=(0, 2))  # (D,)
     broken = [bone for bone, ok in zip(bones, finite, strict=True) if not ok]
@@ -719,9 +720,10 @@ def aimed(request: "GestureRequest", rig: "RigState",
     return tuple(bones), keyed, under
 
 
-def _aimed(rig, request, names, columns, keyed, under, phase_base, to_character):
-    """(bones, keyed, under) of a target behaviour: the eyes look at the target, and Point's finger is aimed
-    exactly on the rig, solved against the pose as it will play."""
+def _aimed(rig, request, names, columns, keyed, under, blended):
+    """(bones, keyed, under) of a target behaviour: the eyes look at the target, and a pointing behaviour's
+    finger is aimed exactly on the rig (Exact Aim), solved against the pose as it will play."""
+    phase_base, to_character = blended.phase_base, blended.to_character
     count = request.frame_count
     bones = [rig.roles[n] for n in names]
     phase = aim.pointing_phase(phase_base)
@@ -730,7 +732,7 @@ def _aimed(rig, request, names, columns, keyed, under, phase_base, to_character)
     basis = under_basis.copy()
     basis[:, columns, :3, :3] = quat_to_matrix(keyed) * each_frame(
         lambda frames: np.linalg.norm(frames[:, columns, :3, :3], axis=-2, keepdims=True), under_basis)
-    if request.exact_aim and request.behaviour == behaviours.POINT:
+    if request.exact_aim and blended.aims:
         arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
         aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
         keyed[:, arm_column] = matrix_to_quat(_rotation_part(aimed))

@@ -8,7 +8,7 @@ Objective o_t (L + 6), laid out by an ObjectiveSpace from the agent's behaviours
     behaviour (point), the attributes are the unit vector from the arm's rest shoulder joint to the
     target, in the character frame, so a finger laid along that line from the shoulder passes through
     the target whatever its distance. For an intensity behaviour (wave), they are the exaggeration in
-    [0, 1] three times, or, for WAVE with its rhythm, the exaggeration and the wave's rhythm
+    [0, 1] three times, or, for an oscillating behaviour (wave) with its rhythm, the exaggeration and its rhythm
     [A_t sin(phi_t), A_t cos(phi_t)] (core/rhythm.py). t/N runs over 0..1 (t = 0..N-1, divided by N-1).
 Description d_t (42), in the character frame in metres:
     [0:12]  unit effector vectors: left eye, right eye, left index, right index (skeleton.EFFECTORS)
@@ -27,7 +27,7 @@ import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from . import behaviours, rhythm, skeleton
-from .behaviours import TARGET, WAVE, Behaviour
+from .behaviours import TARGET, Behaviour
 from .errors import RLAnimateError
 
 DESCRIPTION_SIZE = 42
@@ -82,6 +82,7 @@ class ObjectiveSpace:
         self.names = tuple(b.name for b in self.behaviours)
         if len(set(self.names)) != len(self.names):
             raise RLAnimateError(f"The behaviours {', '.join(self.names)} name one behaviour twice.")
+        self._declared = {b.name: b for b in self.behaviours}
         self._kinds = {b.name: b.kind for b in self.behaviours}
         count = len(self.behaviours)
         #: (N, L) each behaviour's label: Table 2's type code for at most two behaviours, else one-hot.
@@ -103,9 +104,18 @@ class ObjectiveSpace:
         self.check_behaviour(behaviour)
         return self._kinds[behaviour]
 
+    def behaviour(self, behaviour: str) -> Behaviour:
+        """The declaration (kind, and what it does) of the behaviour id `behaviour`."""
+        self.check_behaviour(behaviour)
+        return self._declared[behaviour]
+
     def of_kind(self, kind: str) -> tuple[str, ...]:
         """The ids of the behaviours of `kind`, in objective order."""
         return tuple(name for name in self.names if self._kinds[name] == kind)
+
+    def oscillating(self) -> tuple[str, ...]:
+        """The ids of the behaviours that oscillate (carry a rhythm), in objective order."""
+        return tuple(b.name for b in self.behaviours if b.oscillates)
 
     def check_behaviour(self, behaviour: str) -> None:
         if behaviour not in self._kinds:
@@ -129,10 +139,12 @@ class ObjectiveSpace:
         return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
 
     def phase_features(self, objectives: ArrayLike) -> npt.NDArray[np.float64]:
-        """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): a wave's rhythm signals and their second
-        harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
+        """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): an oscillating behaviour's rhythm signals and
+        their second harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
         objectives = np.asarray(objectives, dtype=np.float64)
-        wave = self.label_mask(objectives, WAVE) if WAVE in self.names else np.zeros(objectives.shape[:-1], bool)
+        wave = np.zeros(objectives.shape[:-1], bool)
+        for name in self.oscillating():
+            wave |= self.label_mask(objectives, name)
         features: npt.NDArray[np.float64] = rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:])
         return features * wave[..., None]
 
@@ -150,7 +162,7 @@ class ObjectiveSpace:
 
         `attributes` is, for a target behaviour, a unit vector (3,) or one per frame (N, 3), so a moving
         target is tracked; for an intensity behaviour, the exaggeration in [0, 1] (scalar or (N,)).
-        `rhythm` (N, 2), WAVE only: the swing signals of core/rhythm.py; None gives the paper's
+        `rhythm` (N, 2), an oscillating behaviour only: the swing signals of core/rhythm.py; None gives the paper's
         objective (the exaggeration three times).
         """
         self.check_request(behaviour, arm, frame_count)
@@ -169,8 +181,9 @@ class ObjectiveSpace:
                 raise RLAnimateError("Exaggeration must be a number between 0 and 1.")
             attrs = np.repeat(exaggeration[:, None], 3, axis=1)
             if rhythm is not None:
-                if behaviour != WAVE:
-                    raise RLAnimateError(f"Only a wave carries a rhythm in its objective, not {behaviour}.")
+                if not self._declared[behaviour].oscillates:
+                    raise RLAnimateError(f"Only an oscillating behaviour (a wave) carries a rhythm in its objective, "
+                                         f"not {behaviour}.")
                 rhythm = np.asarray(rhythm, dtype=np.float64)
                 if rhythm.shape != (n, 2) or not np.all(np.isfinite(rhythm)):
                     raise RLAnimateError(f"The wave rhythm must be finite signals of shape ({n}, 2), got "

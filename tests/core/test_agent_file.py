@@ -82,11 +82,24 @@ def test_a_file_declares_its_behaviours_and_a_version_3_file_loads_as_point_and_
         load_agent_file(rewrite(tmp_path / "v4.npz", weights, old))
 
 
+def test_what_a_behaviour_does_is_read_from_the_file_else_from_its_shipped_name(tmp_path, exported):
+    weights, metadata = load_agent_file(exported)
+    space = agent_file.objective_space(metadata)
+    assert space.behaviour("POINT").aims and space.behaviour("WAVE").oscillates  # written before "does" existed
+    declared = [{"name": "POINT", "kind": "target"}, {"name": "WAVE", "kind": "intensity", "does": "raise"}]
+    _, loaded = load_agent_file(rewrite(tmp_path / "raise.npz", weights, {**metadata, "behaviours": declared}))
+    space = agent_file.objective_space(loaded)
+    assert space.behaviour("WAVE").does == "raise" and not space.behaviour("WAVE").oscillates
+    assert space.oscillating() == () and [b.to_dict() for b in space.behaviours] == declared
+
+
 @pytest.mark.parametrize("declared, message", [
     ([], "a list of 1 to 64 behaviours"),
     ([{"name": "POINT", "kind": "target"}], "invalid average_frames.*among POINT"),  # WAVE is not declared
     ([{"name": "POINT", "kind": "target", "extra": 1}, {"name": "WAVE", "kind": "intensity"}], "a list of 1 to 64"),
     ([{"name": "POINT", "kind": "aim"}, {"name": "WAVE", "kind": "intensity"}], "kind 'aim'"),
+    ([{"name": "POINT", "kind": "target", "does": "wave"}, {"name": "WAVE", "kind": "intensity"}], "cannot do 'wave'"),
+    ([{"name": "POINT", "kind": "target", "does": 1}, {"name": "WAVE", "kind": "intensity"}], "optionally, \"does\""),
     ([{"name": "WAVE", "kind": "intensity"}, {"name": "POINT", "kind": "target"}], "not in objective order"),
     ([{"name": "POINT", "kind": "target"}, {"name": "POINT", "kind": "target"}], "name one behaviour twice"),
     ([{"name": "point", "kind": "target"}, {"name": "WAVE", "kind": "intensity"}], "upper case"),

@@ -44,3 +44,21 @@ def test_training_sets_name_all_both_one_or_several_behaviours_in_the_librarys_o
         behaviours.training_set("both", ("POINT", "BECKON"))
     with pytest.raises(RLAnimateError, match="is not a behaviour name"):
         behaviours.training_set("point;wave", library)
+
+
+def test_what_a_behaviour_does_comes_from_its_declaration_or_the_shipped_names_table():
+    assert [(b.name, b.does) for b in behaviours.PAPER] == [("POINT", "point"), ("WAVE", "wave")]
+    assert Behaviour("GUIDE", TARGET).does == "present" and Behaviour("RAISE_HAND", INTENSITY).does == "raise"
+    assert Behaviour("BECKON", TARGET).does is None and not Behaviour("BECKON", TARGET).aims
+    taught = Behaviour("AIM_AT", TARGET, "point")
+    assert taught.aims and not taught.oscillates and taught.to_dict() == {"name": "AIM_AT", "kind": TARGET,
+                                                                          "does": "point"}
+    assert behaviours.from_dict(taught.to_dict()) == taught
+    assert Behaviour("POINT", TARGET).to_dict() == {"name": "POINT", "kind": TARGET}  # as files already written
+    assert Behaviour("WAVE", TARGET).does is None  # a shipped name of another kind does nothing of the table's
+    with pytest.raises(RLAnimateError, match="BECKON of the kind intensity cannot do 'point'"):
+        Behaviour("BECKON", INTENSITY, "point")
+    with pytest.raises(RLAnimateError, match="given as both doing 'point' and None"):
+        behaviours.ordered([taught, Behaviour("AIM_AT", TARGET)])
+    space = spaces.ObjectiveSpace((Behaviour("POINT", TARGET), Behaviour("SHAKE", INTENSITY, "wave")))
+    assert space.oscillating() == ("SHAKE",) and space.behaviour("SHAKE").oscillates

@@ -3,6 +3,7 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import aim, gesture, skeleton, spaces
+from rlanimate_addon.core.behaviours import POINTING, TARGET, Behaviour
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import (
     matrix_to_quat,
@@ -395,6 +396,31 @@ def test_exact_aim_off_keys_the_agents_own_aim():
     full = int(np.argmax(gesture.blend_weights(50)))
     arm = names.index("RightArm")
     assert abs(np.sum(raw[full, arm] * expected[full, arm])) == pytest.approx(1.0, abs=1e-9)
+
+
+class TaughtAgent(ReplayAgent):
+    """A ReplayAgent of taught target behaviours: AIM_AT declared to point, BECKON declaring nothing."""
+
+    average_frames = {"AIM_AT": 50, "BECKON": 50}
+    space = spaces.ObjectiveSpace((Behaviour("AIM_AT", TARGET, POINTING), Behaviour("BECKON", TARGET)))
+
+
+def test_a_taught_behaviour_of_the_pointing_kind_gets_exact_aim_and_the_pointing_hand():
+    """What Point gets comes from what a behaviour does, not its name: AIM_AT, declared to point, keys what Point
+    keys from the same actions (the hand shape, the exact aim); BECKON, declaring nothing, gets neither."""
+    actions = np.random.default_rng(5).uniform(0.3, 0.7, size=(50, spaces.ACTION_SIZE))
+    rig = _animated(gesture.canonical_rig(), 50, scale=0.1)
+    targets = np.tile([-1.0, -2.0, 1.6], (50, 1))
+    point = gesture.gesture_rotations(ReplayAgent(actions), _request("POINT", frames=50, targets=targets), rig)
+    rotations = {(name, exact): gesture.gesture_rotations(
+        TaughtAgent(actions), _request(name, frames=50, targets=targets, exact_aim=exact), rig)
+        for name in ("AIM_AT", "BECKON") for exact in (True, False)}
+    names, quats, under = rotations["AIM_AT", True]
+    assert names == point[0] and np.allclose(quats, point[1]) and np.allclose(under, point[2])
+    assert "RightHandMiddle2" in names and not np.allclose(quats, rotations["AIM_AT", False][1])
+    beckon_names, beckon, _ = rotations["BECKON", True]
+    assert not any("HandMiddle" in n for n in beckon_names), "no pointing hand for a behaviour that does not point"
+    assert np.array_equal(beckon, rotations["BECKON", False][1]), "no exact aim for it either"
 
 
 def test_a_nan_start_pose_is_refused_before_anything_is_returned():

@@ -112,7 +112,7 @@ def test_labels_tell_the_behaviour_and_kind_and_refuse_a_label_of_none():
     objectives[0, :4] = (0.0, 1.0, 0.0, 1.0)
     with pytest.raises(RLAnimateError, match="label that is none of"):
         space.behaviours_in(objectives)
-    with pytest.raises(RLAnimateError, match="Only a wave carries a rhythm"):
+    with pytest.raises(RLAnimateError, match=r"Only an oscillating behaviour \(a wave\) carries a rhythm"):
         space.make_objective("RAISE_HAND", "LEFT", 0.5, 2, rhythm=np.zeros((2, 2)))
     with pytest.raises(RLAnimateError, match="Unknown behaviour 'BECKON'"):
         space.make_objective("BECKON", "LEFT", 0.5, 2)
