@@ -17,9 +17,10 @@ least half its largest distance from its first position.
 Guide ("this way"), over the same hold: the fingers head towards the target seen from above, the palm
 (`palm_normal`) faces up, the wrist is out from the shoulder. Raise hand: held with the hand up and the
 wrist still, the forearm near vertical, no side-to-side strokes beyond the raise and the lowering, and
-the wrist as high above the shoulder as the reference's. A behaviour without measures of its own (a user's
-gesture) is measured by its kind (`KIND_MEASURES`): an intensity one by the hand's peak height, a target one by
-its aim at the target, each with the other arm's rise.
+the wrist as high above the shoulder as the reference's. Each is a behaviour's by what it does
+(core/behaviours.py: point, wave, present, raise; `MEASURES`). A behaviour that does none of these (a user's
+gesture declaring nothing) is measured by its kind (`KIND_MEASURES`): an intensity one by the hand's peak
+height, a target one by its aim at the target, each with the other arm's rise.
 """
 import numpy as np
 
@@ -438,7 +439,7 @@ def wave_accepted(comparison):
 
 
 def wave_row(generated, reference, arm, target, fps):
-    """WAVE's measures (`compare_wave` and `wave_accepted`) of descriptions (F, 42), as a flat dict."""
+    """A wave's measures (`compare_wave` and `wave_accepted`) of descriptions (F, 42), as a flat dict."""
     waves = compare_wave(spaces.description_joint_positions(generated), spaces.description_joint_positions(reference),
                          arm, fps)
     result = {k: v for k, v in waves.items() if k.endswith("_ratio")}
@@ -449,7 +450,7 @@ def wave_row(generated, reference, arm, target, fps):
 
 
 def point_row(generated, reference, arm, target, fps):
-    """POINT's measures (`point_measures` of both, target (3,) in the character frame) as a flat dict."""
+    """A point's measures (`point_measures` of both, target (3,) in the character frame) as a flat dict."""
     if target is None:
         raise RLAnimateError("Pointing measures need the target position (x, y, z).")
     point, reference_point = (point_measures(spaces.description_joint_positions(d), finger_direction(d, arm), arm,
@@ -459,12 +460,8 @@ def point_row(generated, reference, arm, target, fps):
             "hold_ratio": ratio(point["hold_s"], reference_point["hold_s"])}
 
 
-#: Each behaviour's own measures, by id: measure(generated, reference, arm, target, fps) -> {name: float}
-#: from descriptions (F, 42) of a generated clip and its reference (target: (3,) in the character frame
-#: for a target behaviour, else None). A behaviour without an entry is measured by raise and lower alone;
-#: a new behaviour's metrics plug in here.
 def guide_row(generated, reference, arm, target, fps):
-    """GUIDE's measures (`guide_measures` of both, target (3,) in the character frame, and `guide_accepted`)."""
+    """A guide's measures (`guide_measures` of both, target (3,) in the character frame, and `guide_accepted`)."""
     if target is None:
         raise RLAnimateError("Guiding measures need the target position (x, y, z).")
     guide, reference_guide = (guide_measures(spaces.description_joint_positions(d), finger_direction(d, arm),
@@ -475,7 +472,7 @@ def guide_row(generated, reference, arm, target, fps):
 
 
 def raise_row(generated, reference, arm, target, fps):
-    """RAISE_HAND's measures (`compare_raise` and `raise_accepted`) of descriptions (F, 42), as a flat dict."""
+    """A raised hand's measures (`compare_raise` and `raise_accepted`) of descriptions (F, 42), as a flat dict."""
     raised = compare_raise(spaces.description_joint_positions(generated), spaces.description_joint_positions(reference),
                            arm, fps)
     return {**{k: float(v) for k, v in raised["generated"].items()},
@@ -483,7 +480,11 @@ def raise_row(generated, reference, arm, target, fps):
             "height_error": raised["height_error"], "raise_accepted": float(raise_accepted(raised))}
 
 
-MEASURES = {"WAVE": wave_row, "POINT": point_row, "GUIDE": guide_row, "RAISE_HAND": raise_row}
+#: The measures of what a behaviour does (behaviours.ACTIONS): measure(generated, reference, arm, target, fps) ->
+#: {name: float} from descriptions (F, 42) of a generated clip and its reference (target: (3,) in the character
+#: frame for a target behaviour, else None).
+MEASURES = {behaviours.WAVING: wave_row, behaviours.POINTING: point_row, behaviours.PRESENTING: guide_row,
+            behaviours.RAISING: raise_row}
 
 
 def peak_hand_height(positions, arm):
@@ -523,15 +524,18 @@ def target_row(generated, reference, arm, target, fps):
 KIND_MEASURES = {behaviours.INTENSITY: intensity_row, behaviours.TARGET: target_row}
 
 
-def compare(generated, reference, behaviour, arm, target=None, fps=FPS, kind=None):
+def compare(generated, reference, behaviour, arm, target=None, fps=FPS):
     """The behaviour measures of one request, from descriptions (F, 42) of the generated clip and of
-    its reference (lengths may differ): raise and lower, and the behaviour's own MEASURES, or else those of
-    its `kind` (KIND_MEASURES; a target behaviour's only with its target). A flat dict of floats."""
+    its reference (lengths may differ): raise and lower, and for `behaviour` (a behaviours.Behaviour; None:
+    those alone) the MEASURES of what it does, or else those of its kind (KIND_MEASURES; a target behaviour's
+    only with its target). A flat dict of floats."""
     gen, ref = np.asarray(generated), np.asarray(reference)
     gen_positions, ref_positions = spaces.description_joint_positions(gen), spaces.description_joint_positions(ref)
     result = {f"elevation_{k}": v for k, v in raise_lower(gen_positions, ref_positions, arm).items()}
-    if behaviour in MEASURES:
-        result.update(MEASURES[behaviour](gen, ref, arm, target, fps))
-    elif kind in KIND_MEASURES and (kind != behaviours.TARGET or target is not None):
-        result.update(KIND_MEASURES[kind](gen, ref, arm, target, fps))
+    if behaviour is None:
+        return result
+    if behaviour.does in MEASURES:
+        result.update(MEASURES[behaviour.does](gen, ref, arm, target, fps))
+    elif behaviour.kind != behaviours.TARGET or target is not None:
+        result.update(KIND_MEASURES[behaviour.kind](gen, ref, arm, target, fps))
     return result

@@ -4,6 +4,7 @@ import pytest
 
 from rlanimate_addon.core import behaviour_metrics as bm
 from rlanimate_addon.core import kinematics, metrics, skeleton, spaces
+from rlanimate_addon.core.behaviours import INTENSITY, TARGET, Behaviour
 from rlanimate_addon.core.errors import RLAnimateError
 
 FPS = 30
@@ -236,13 +237,14 @@ def test_compare_reads_descriptions_of_the_canonical_skeleton():
     rotvecs[:, forearm, 2] = -1.6 + 0.5 * np.sin(2 * np.pi * 2.5 * t)  # forearm up, swaying
     wave = kinematics.describe(rotvecs)
     still = kinematics.describe(np.zeros_like(rotvecs))
-    copied = bm.compare(wave, wave, "WAVE", "RIGHT")
+    copied = bm.compare(wave, wave, Behaviour("WAVE", INTENSITY), "RIGHT")
     assert copied["wave_accepted"] == 1.0 and copied["swing_ratio"] == pytest.approx(1.0)
     assert copied["elevation_first_error"] == 0.0
-    assert bm.compare(still, wave, "WAVE", "RIGHT")["wave_accepted"] == 0.0
+    assert bm.compare(still, wave, Behaviour("WAVE", INTENSITY), "RIGHT")["wave_accepted"] == 0.0
+    assert bm.compare(wave, wave, Behaviour("SHAKE", INTENSITY, "wave"), "RIGHT") == copied, "measured as what it does"
     finger = bm.finger_direction(still, "RIGHT")
     base = spaces.description_joint_positions(still)[0, JOINT["right_index_base"]]
-    pointed = bm.compare(still, still, "POINT", "RIGHT", target=base + 2.0 * finger[0])
+    pointed = bm.compare(still, still, Behaviour("POINT", TARGET), "RIGHT", target=base + 2.0 * finger[0])
     assert pointed["pointing_angle"] == pytest.approx(0.0, abs=1e-6) and pointed["hold_ratio"] == 1.0
 
 
@@ -255,16 +257,17 @@ def test_a_behaviour_without_measures_of_its_own_is_measured_by_its_kind():
     rotvecs = np.zeros((frames, len(skeleton.ACTION_JOINTS), 3))
     rotvecs[:, skeleton.ACTION_JOINTS.index("RightArm")] = rise * (1.2, 0.0, 0.0)  # the right arm goes up
     raised, still = kinematics.describe(rotvecs), kinematics.describe(np.zeros_like(rotvecs))
-    copied = bm.compare(raised, raised, "HELLO", "RIGHT", kind="intensity")
+    copied = bm.compare(raised, raised, Behaviour("HELLO", INTENSITY), "RIGHT")
     assert copied["hand_height_error"] == 0.0 and copied["free_arm_rise"] == pytest.approx(0.0, abs=1e-9)
     assert "swing_ratio" not in copied and "pointing_angle" not in copied
-    assert bm.compare(still, raised, "HELLO", "RIGHT", kind="intensity")["hand_height_error"] > 0.3
-    assert set(bm.compare(raised, raised, "HELLO", "RIGHT")) == {f"elevation_{k}" for k in (
+    assert bm.compare(still, raised, Behaviour("HELLO", INTENSITY), "RIGHT")["hand_height_error"] > 0.3
+    assert set(bm.compare(raised, raised, None, "RIGHT")) == {f"elevation_{k}" for k in (
         "first", "last", "reference_first", "reference_last", "first_error", "last_error")}, "no kind: elevation"
     positions = spaces.description_joint_positions(raised)
     shoulder, base = positions[0, JOINT["right_shoulder"]], positions[-1, JOINT["right_index_base"]]
-    aimed = bm.compare(raised, raised, "THIS_WAY", "RIGHT", target=shoulder + 3.0 * (base - shoulder), kind="target")
+    this_way = Behaviour("THIS_WAY", TARGET)
+    aimed = bm.compare(raised, raised, this_way, "RIGHT", target=shoulder + 3.0 * (base - shoulder))
     assert aimed["aim_error"] == pytest.approx(0.0, abs=0.5) and aimed["reference_aim_error"] == aimed["aim_error"]
-    assert bm.compare(still, raised, "THIS_WAY", "RIGHT", target=shoulder + 3.0 * (base - shoulder),
-                      kind="target")["aim_error"] > 30.0
-    assert "aim_error" not in bm.compare(raised, raised, "THIS_WAY", "RIGHT", kind="target"), "no target, no aim"
+    assert bm.compare(still, raised, Behaviour("THIS_WAY", TARGET), "RIGHT",
+                      target=shoulder + 3.0 * (base - shoulder))["aim_error"] > 30.0
+    assert "aim_error" not in bm.compare(raised, raised, Behaviour("THIS_WAY", TARGET), "RIGHT"), "no target, no aim"

@@ -77,8 +77,7 @@ def request_rows(method, clips, references, describe, lengths, exact_aim=False, 
                "smoothness": metrics.smoothness(positions),
                "score_class_length": bm.score_at_length(class_positions, reference_positions),
                "aligned_score": bm.aligned_score(class_positions, reference_positions)}
-        kind = None if behaviour in bm.MEASURES else clip.behaviour_kind  # measured by its kind without its own
-        row.update(bm.compare(own, reference, behaviour, arm, target, kind=kind))
+        row.update(bm.compare(own, reference, clip.declared, arm, target))
         rows.append(row)
     return rows
 

@@ -72,8 +72,7 @@ def clip_row(clip, generated, reference):
            "aligned_score": behaviour_metrics.aligned_score(positions, reference_positions)}
     target = clip_target(clip)
     if target is not None or clip.behaviour_kind == behaviours.INTENSITY:
-        row.update(behaviour_metrics.compare(generated, reference, behaviour, clip.arm, target,
-                                             kind=clip.behaviour_kind))
+        row.update(behaviour_metrics.compare(generated, reference, clip.declared, clip.arm, target))
     else:  # a pointing clip without a target (real capture): its elevation only
         row.update({f"elevation_{k}": v for k, v in behaviour_metrics.raise_lower(
             positions, reference_positions, clip.arm).items()})

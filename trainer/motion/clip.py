@@ -17,6 +17,7 @@ class MotionClip:
     fingers: dict = field(default_factory=dict)  # {canonical finger bone: (F, 3)}; empty without fingers
     behaviour: str | None = None  # the behaviour's id: "POINT", "WAVE", or a user's own ("BECKON")
     kind: str | None = None  # behaviours.TARGET or INTENSITY; None for POINT and WAVE is their known kind
+    does: str | None = None  # one of behaviours.ACTIONS ("point"); None: the shipped name's, or nothing
     arm: str | None = None  # "LEFT" or "RIGHT"
     attributes: object = None  # target kind: unit vector (3,) from the arm's shoulder; intensity: exaggeration
     target: tuple[float, ...] | None = None
@@ -34,15 +35,20 @@ class MotionClip:
 
     @property
     def behaviour_kind(self):
-        """The clip's behaviours.TARGET or INTENSITY."""
-        return self.kind or behaviours.KNOWN_KINDS[self.behaviour]
+        """The clip's behaviours.TARGET or INTENSITY: its own, else its shipped name's."""
+        return self.kind or behaviours.ACTIONS[behaviours.SHIPPED[self.behaviour]]
+
+    @property
+    def declared(self) -> behaviours.Behaviour:
+        """The clip's behaviour: its name, kind and what it does."""
+        return behaviours.Behaviour(self.behaviour, self.behaviour_kind, self.does)
 
 
 def library_space(clips):
     """The ObjectiveSpace of every behaviour among labelled `clips` (an agent trained on them declares it):
     the paper's (point and wave, Table 2's codes) for clips of point or wave alone, so that a one-behaviour
     run labels its behaviour as the paper does and its agent plays beside the others."""
-    declared = behaviours.ordered(behaviours.Behaviour(c.behaviour, c.behaviour_kind) for c in clips)
+    declared = behaviours.ordered(c.declared for c in clips)
     return spaces.PAPER_SPACE if set(declared) <= set(behaviours.PAPER) else spaces.ObjectiveSpace(declared)
 
 

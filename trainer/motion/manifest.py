@@ -9,9 +9,11 @@ imported, and putting an entry's labels on its clip.
 the user's own ("beckon"). Its kind (core/behaviours.py) is the entry's "kind" ("target" or "intensity")
 when given, POINT's target and WAVE's intensity, else what the entry gives: a target behaviour's clip a
 "target" or "direction", an intensity behaviour's an "exaggeration" in [0, 1]. Every clip of one behaviour
-has the same kind. `frames`, `fps` and `split` may be left out (a clip without a split is a training
-clip). An entry with a field of the wrong type or out of range is skipped with a note naming the
-manifest, the entry and the field, as a clip file that does not import is.
+has the same kind. A user's behaviour may say what it does ("does": "point", "wave", "present" or "raise",
+behaviours.ACTIONS): "point" gets Exact Aim and the pointing hand, "wave" a rhythm and a tempo. `frames`,
+`fps` and `split` may be left out (a clip without a split is a training clip). An entry with a field of the
+wrong type or out of range is skipped with a note naming the manifest, the entry and the field, as a clip
+file that does not import is.
 """
 import json
 import reprlib
@@ -45,6 +47,7 @@ class ManifestEntry:
     frames: int = None
     fps: float = None  # the entry's own, or the manifest's
     split: str = "train"
+    does: str | None = None  # behaviours.ACTIONS, or None: the shipped name's
 
     def describe(self, manifest):
         return f"{manifest}: entry {self.number} ({self.file!r})"
@@ -199,8 +202,12 @@ def _checked(number, raw, default_fps):
             raise _field("exaggeration", exaggeration, f"a {behaviours.key(behaviour)} clip (an intensity behaviour) "
                                                        "needs its exaggeration, a number from 0 to 1")
         exaggeration = float(exaggeration)
+    does = raw.get("does")
+    if does is not None and behaviours.ACTIONS.get(does) != kind:
+        raise _field("does", does, f"use one of {', '.join(a for a, k in behaviours.ACTIONS.items() if k == kind)} "
+                                   f"(a behaviour of the {kind} kind), or leave it out")
     return ManifestEntry(number, file, behaviour, kind, arm, target, direction, exaggeration, frames, float(fps),
-                         split)
+                         split, does)
 
 
 def _kind(raw, behaviour):
@@ -226,6 +233,7 @@ def labelled(clip, entry, manifest_path):
                              f"but the clip {clip.source} has {clip.frames} frames. Correct 'frames' in the manifest, "
                              "or regenerate the clip library.")
     clip.behaviour, clip.kind, clip.arm, clip.split = entry.behaviour, entry.kind, entry.arm, entry.split
+    clip.does = entry.does
     clip.target = entry.target
     if entry.kind == behaviours.TARGET:
         clip.attributes = np.asarray(entry.direction) if entry.direction is not None \

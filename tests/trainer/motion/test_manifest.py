@@ -8,7 +8,7 @@ import pytest
 
 from rlanimate_addon.core import spaces
 from rlanimate_addon.core.errors import RLAnimateError
-from trainer.motion.clip import MotionClip
+from trainer.motion.clip import MotionClip, library_space
 from trainer.motion.manifest import checked_entries, labelled, read_manifest
 
 POINT = {"file": "point_left_000.fbx", "behaviour": "POINT", "arm": "LEFT", "target": [0.8, -1.5, 1.6],
@@ -48,6 +48,7 @@ def check(path):
     ({**WAVE, "exaggeration": None}, "exaggeration", "null", "a number from 0 to 1"),
     ({**WAVE, "behaviour": "2 hands"}, "behaviour", "'2 hands'", "a letter followed by letters, digits or underscores"),
     ({**WAVE, "behaviour": "DANCE", "kind": "rhythm"}, "kind", "'rhythm'", "use 'target' or 'intensity'"),
+    ({**WAVE, "behaviour": "SHAKE", "does": "point"}, "does", "'point'", "wave, raise (a behaviour of the intensity"),
     ({**WAVE, "arm": 1}, "arm", "1", "use LEFT or RIGHT"),
     ({**WAVE, "split": "validation"}, "split", "'validation'", 'use "train" or "test"'),
     ({**WAVE, "file": 7}, "file", "7", "give the clip's file name"),
@@ -129,3 +130,12 @@ def test_a_frame_count_the_clip_does_not_have_names_the_manifest_field(tmp_path)
                                              r"'frames' says 40, but the clip clips/point_left_000.fbx has 37 frames\. "
                                              r"Correct 'frames' in the manifest"):
         labelled(clip, entry, tmp_path / "manifest.json")
+
+
+def test_a_users_behaviour_says_what_it_does_and_its_agent_declares_it(tmp_path):
+    aim_at = {**POINT, "behaviour": "AIM_AT", "kind": "target", "does": "point"}
+    entries, problems = check(write(tmp_path, [POINT, WAVE, aim_at]))
+    assert problems == [] and [e.does for e in entries] == [None, None, "point"]
+    clips = [labelled(MotionClip(e.file, e.file, 30.0, np.zeros((40, 15, 3))), e, "m") for e in entries]
+    space = library_space(clips)
+    assert space.behaviour("AIM_AT").aims and space.behaviour("POINT").aims and space.oscillating() == ("WAVE",)
