@@ -76,7 +76,7 @@ def clip_objective(space, clip, frame_count=None, rhythm_model=None, with_rhythm
     """
     frames = len(clip.rotvecs) if frame_count is None else frame_count
     signals = None
-    if clip.behaviour == behaviours.WAVE and with_rhythm:
+    if space.behaviour(clip.behaviour).oscillates and with_rhythm:
         signals = (wave_rhythm.clip_signals(clip, frames) if rhythm_model is None
                    else rhythm.signals(rhythm_model.draw(clip.attributes, arm=clip.arm), frames))
     return space.make_objective(clip.behaviour, clip.arm, clip.attributes, frames, signals)
@@ -122,7 +122,8 @@ class Trainer:
         self.clip_groups = clips_for_behaviour(clips, behaviour, self.space)
         #: The ids of the behaviours trained, in objective order.
         self.trained = tuple(group[0].behaviour for group in self.clip_groups)
-        waves = [clip for group in self.clip_groups for clip in group if clip.behaviour == behaviours.WAVE]
+        waves = [clip for group in self.clip_groups for clip in group
+                 if self.space.behaviour(clip.behaviour).oscillates]
         #: The training waves' rhythms, from which requests draw theirs (None: the paper's objective).
         self.rhythm_model = None
         if waves and train_config.wave_rhythm:

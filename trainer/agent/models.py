@@ -33,7 +33,6 @@ from torch import nn
 from torch.distributions import Beta, Independent, Normal
 
 from rlanimate_addon.core import agent_file, spaces
-from rlanimate_addon.core.behaviours import WAVE
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import losses as loss_terms
 from trainer.agent import unroll
@@ -106,17 +105,20 @@ class RLAnimateAgent(nn.Module):
         return torch.cat([states, self.phase_features(objectives)], -1) if self.config.phase_input else states
 
     def phase_features(self, objectives):
-        """(B, T, O) -> (B, T, 4): the wave's phase and second harmonic, zeros for other behaviours
+        """(B, T, O) -> (B, T, 4): an oscillating behaviour's phase and second harmonic, zeros for other behaviours
         (core.spaces.ObjectiveSpace.phase_features, in torch)."""
         signals = objectives[..., spaces.OBJECTIVE_ATTRIBUTES][..., 1:]  # (B, T, 2) A sin, A cos
         sine, cosine = signals.unbind(-1)
         amplitude = torch.clamp(torch.hypot(sine, cosine), min=1e-9)
         features = torch.stack([sine, cosine, 2.0 * sine * cosine / amplitude,
                                 (cosine ** 2 - sine ** 2) / amplitude], -1)
-        if WAVE not in self.space.names:
+        if not self.space.oscillating():
             return torch.zeros_like(features)
-        label = objectives.new_tensor(self.space.labels[self.space.names.index(WAVE)])
-        return features * (objectives[..., :self.space.label_size] == label).all(-1, keepdim=True)
+        waving = torch.zeros_like(features[..., :1], dtype=torch.bool)
+        for name in self.space.oscillating():
+            label = objectives.new_tensor(self.space.labels[self.space.names.index(name)])
+            waving |= (objectives[..., :self.space.label_size] == label).all(-1, keepdim=True)
+        return features * waving
 
     def transition(self, e_prev, z_prev, a_prev, task):
         """f2: e_{t-1} (B, E), z_{t-1} (B, Z), a_{t-1} (B, 45), h_t (B, K) -> e_t (B, E)."""

@@ -106,7 +106,7 @@ class ProceduralIK:
         spaces.PAPER_SPACE.check_request(behaviour, arm, frame_count)
         self._set_pose(self.neutral)
         side = skeleton.ARM_PREFIX[arm]
-        if behaviour == "POINT":
+        if spaces.PAPER_SPACE.behaviour(behaviour).aims:
             direction = np.asarray(attributes, dtype=np.float64)
             direction = direction / np.linalg.norm(direction)
             self._constrain(side + "HandIndex1", 4)

@@ -162,7 +162,7 @@ def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=Non
     if tempo is not None and agent.tempo_range() is not None:
         tempo = float(np.clip(tempo, *agent.tempo_range()))
     signals = rhythm_signals
-    if signals is None and behaviour == behaviours.WAVE:
+    if signals is None and agent.space.behaviour(behaviour).oscillates:
         signals = agent.wave_rhythm(attributes, frame_count, rhythm_seed, tempo, arm)
     objectives = agent.space.make_objective(behaviour, arm, attributes, frame_count, signals)
     return spaces.decode_action(agent.rollout(objectives, seed=state_seed), np.asarray(agent.action_bounds))
@@ -190,6 +190,6 @@ def request_tempo(clip: MotionClip, with_tempo: bool) -> float | None:
 
 def request_tempo_reading(clip: MotionClip, with_tempo: bool) -> tuple[float | None, str | None]:
     """(tempo in Hz or None, why a wave's request asked for a tempo names none, else None)."""
-    if not with_tempo or clip.behaviour != behaviours.WAVE:
+    if not with_tempo or not clip.declared.oscillates:
         return None, None
     return tempo_reading(clip)

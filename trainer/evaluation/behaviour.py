@@ -52,9 +52,10 @@ def clip_target(clip):
 
 
 def _answer(method, behaviour, arm, attributes, frames, target, exact_aim, seed=None):
+    """(F, 15, 3) the method's answer to the request, aimed at `target` when `exact_aim` (a pointing behaviour's)."""
     rotvecs = (method.generate(behaviour, arm, attributes, frames) if seed is None
                else method.generate(behaviour, arm, attributes, frames, seed=seed))
-    if exact_aim and behaviour == behaviours.POINT:
+    if exact_aim:
         rotvecs = aim.aim_at(rotvecs, arm, target)
     return rotvecs
 
@@ -66,9 +67,9 @@ def request_rows(method, clips, references, describe, lengths, exact_aim=False, 
     rows = []
     for clip in clips:
         behaviour, arm, target = clip.behaviour, clip.arm, clip_target(clip)
-        own = describe(_answer(method, behaviour, arm, clip.attributes, len(clip.rotvecs), target, exact_aim, seed))
-        at_class = describe(_answer(method, behaviour, arm, clip.attributes, lengths[behaviour], target, exact_aim,
-                                    seed))
+        aimed = exact_aim and clip.declared.aims
+        own = describe(_answer(method, behaviour, arm, clip.attributes, len(clip.rotvecs), target, aimed, seed))
+        at_class = describe(_answer(method, behaviour, arm, clip.attributes, lengths[behaviour], target, aimed, seed))
         reference, reference_positions = references.get(clip)
         positions = spaces.description_joint_positions(own)
         class_positions = spaces.description_joint_positions(at_class)
@@ -199,7 +200,7 @@ def summarise(rows):
                 entry[key] = float(values(key).mean())
         for key in ("elevation_first_error", "elevation_last_error"):
             entry[f"{key}_median"], entry[f"{key}_max"] = float(np.median(values(key))), float(values(key).max())
-        if behaviour == behaviours.key(behaviours.WAVE):
+        if "wave_accepted" in group[0]:  # a wave's measures (behaviour_metrics.MEASURES)
             for key in ("swing_ratio", "frequency_ratio", "hand_height_ratio"):
                 entry[f"{key}_median"] = float(np.nanmedian(values(key)))
             entry["swing_ratio_min"], entry["swing_ratio_max"] = (float(values("swing_ratio").min()),

@@ -69,11 +69,11 @@ def harder_clips(seed=SEED):
     for k, spec in enumerate(specs):
         rotvecs = synthesise(spec).action_rotvecs()
         scale = LENGTH_SCALES[k % len(LENGTH_SCALES)]
-        point = spec.behaviour == behaviours.POINT
         clips.append(MotionClip(
             name=f"harder_{behaviours.key(spec.behaviour)}_{spec.arm.lower()}_{k:02d}_x{scale:g}", source="synthesised",
             fps=float(FPS), rotvecs=time_warp(rotvecs, max(2, int(round(scale * len(rotvecs))))),
             behaviour=spec.behaviour, arm=spec.arm,
-            attributes=spaces.pointing_direction(spec.arm, spec.target) if point else spec.exaggeration,
+            attributes=(spec.exaggeration if spec.target is None  # a target behaviour's clip has a target
+                        else spaces.pointing_direction(spec.arm, spec.target)),
             target=spec.target, exaggeration=spec.exaggeration, split="harder"))
     return clips

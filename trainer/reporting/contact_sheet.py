@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from rlanimate_addon.core import skeleton  # noqa: E402
+from rlanimate_addon.core import behaviours, skeleton  # noqa: E402
 from trainer.motion import fk  # noqa: E402
 from trainer.motion.library_plan import DEFAULT_SEED, plan_library  # noqa: E402
 from trainer.motion.synthesis import synthesise  # noqa: E402
@@ -36,10 +36,9 @@ def pick_clips(seed=DEFAULT_SEED):
     """(title, PlannedClip) for point high, point across, small wave, big wave, guide out to the side and
     big raised hand (training clips)."""
     plan = [p for p in plan_library(seed) if p.split == "train"]
-    points = [p for p in plan if p.spec.behaviour == "POINT"]
-    waves = [p for p in plan if p.spec.behaviour == "WAVE"]
-    guides = [p for p in plan if p.spec.behaviour == "GUIDE"]
-    raises = [p for p in plan if p.spec.behaviour == "RAISE_HAND"]
+    points, waves, guides, raises = ([p for p in plan if behaviours.SHIPPED[p.spec.behaviour] == action]
+                                     for action in (behaviours.POINTING, behaviours.WAVING, behaviours.PRESENTING,
+                                                    behaviours.RAISING))
 
     def across(p):  # how far across the body the target lies
         return -p.spec.target[0] if p.spec.arm == "LEFT" else p.spec.target[0]

@@ -5,9 +5,11 @@ from trainer.reporting.tables import markdown_table
 
 LABELS = {**VARIANT_LABELS, **BASELINE_LABELS, "rlanimate": "RLAnimate"}
 SHARED = (("score", "score", 2), ("aligned_score", "score, DTW", 2), ("smoothness", "smoothness", 2))
-WAVE = (("swing_ratio_median", "swing ratio", 2), ("frequency_ratio_median", "frequency ratio", 2),
-        ("cycles_min", "full cycles (min)", 1), ("accepted_share", "waves accepted (share)", 2))
-POINT = (("pointing_angle_median", "own aim (deg, median)", 1), ("pointing_angle_max", "own aim (deg, max)", 1))
+WAVE_FIELDS = (("swing_ratio_median", "swing ratio", 2), ("frequency_ratio_median", "frequency ratio", 2),
+               ("cycles_min", "full cycles (min)", 1), ("accepted_share", "waves accepted (share)", 2))
+POINT_FIELDS = (("pointing_angle_median", "own aim (deg, median)", 1), ("pointing_angle_max", "own aim (deg, max)", 1))
+#: The rows of each behaviour key, with the fields of its own measures.
+OWN_FIELDS = {"wave": WAVE_FIELDS, "point": POINT_FIELDS}
 ELEVATION = (("elevation_first_error_max", "elevation error, first frame (deg, max)", 1),
              ("elevation_last_error_max", "last frame", 1))
 SPLITS = {"held-out": "Held-out requests of the sample library (the paper's test set)",
@@ -32,11 +34,11 @@ def table4_markdown(report):
     for split, columns in report["table"].items():
         lines += [f"## {SPLITS.get(split, split)}", ""]
         for column, methods in columns.items():
-            for behaviour in ("wave", "point"):
+            for behaviour, own in OWN_FIELDS.items():
                 rows = {m: entry[behaviour] for m, entry in methods.items() if behaviour in entry}
                 if not rows:
                     continue
-                fields = SHARED + (WAVE if behaviour == "wave" else POINT) + ELEVATION
+                fields = SHARED + own + ELEVATION
                 count = next(iter(rows.values()))["requests"]["mean"]
                 lines += [f"### {COLUMN_LABELS[column]} agents: {behaviour} requests ({count:.0f})", ""]
                 lines += markdown_table(("method", "n") + tuple(title for _, title, _ in fields),

@@ -12,6 +12,7 @@ from rlanimate_addon.core.errors import RLAnimateError
 from trainer.scripts import (
     agent_ablation,
     baselines,
+    behaviour,
     cli,
     clip_library,
     contact_sheet,
@@ -26,6 +27,7 @@ from trainer.scripts import (
 ROOT = Path(__file__).resolve().parents[3]
 #: (script, its settings dataclass)
 SCRIPTS = ((agent_ablation, agent_ablation.AblationSettings), (baselines, baselines.BaselinesSettings),
+           (behaviour, behaviour.BehaviourSettings),
            (clip_library, clip_library.LibrarySettings), (contact_sheet, contact_sheet.SheetSettings),
            (experiments, experiments.PaperSettings), (realmocap, realmocap.RealMocapSettings),
            (realmocap_ablation, realmocap_ablation.AblationSettings),
@@ -94,6 +96,9 @@ def test_the_options_the_docs_use_parse_as_before():
         baselines.BaselinesSettings(agent="a.npz", clips="m.json", results="r")
     library = clip_library.parse_settings(["x", "--only", "wave_left_006.fbx", "--out", "/tmp/x", "--seed", "7"])
     assert library == clip_library.LibrarySettings(seed=7, out=Path("/tmp/x"), only=("wave_left_006.fbx",))
+    measured = behaviour.parse_settings(["x", "--agent", "a.npz", "--targets", "20", "--seeds", "1", "2",
+                                         "--target-seed", "7"])
+    assert measured == behaviour.BehaviourSettings(agent="a.npz", targets=20, seeds=(1, 2), target_seed=7)
     sheet = contact_sheet.parse_settings(["x", "--generated", "--further", "--agent", "runs/four/agent.npz",
                                           "--out", "x.png"])
     assert sheet == contact_sheet.SheetSettings(out=Path("x.png"), generated=True, further=True,
@@ -117,6 +122,8 @@ def test_bad_values_are_refused_with_a_message(capsys):
         realmocap.parse_settings(["x", "--seeds"])
     with pytest.raises(RLAnimateError, match="--variants given no value"):
         experiments.parse_settings(["x", "--variants"])
+    with pytest.raises(RLAnimateError, match="--seeds needs at least two different seeds, none of them 0"):
+        behaviour.parse_settings(["x", "--seeds", "0", "1"])
 
 
 def test_the_extension_never_imports_the_trainers_command_line_library():
