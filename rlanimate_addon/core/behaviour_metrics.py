@@ -26,8 +26,8 @@ import numpy as np
 
 from . import behaviours, metrics, skeleton, spaces
 from .errors import RLAnimateError
+from .frame_rate import AGENT_FPS
 
-FPS = 30
 #: The hand is up while the wrist is at most this many arm lengths below its shoulder joint.
 HAND_UP_DROP = 0.25
 #: A stroke moves the wrist side to side by at least this share of the shoulder width (the issue's 8%).
@@ -143,7 +143,7 @@ def _refined(signal, frames):
     return times
 
 
-def wave_measures(positions, arm, fps=FPS):
+def wave_measures(positions, arm, fps=AGENT_FPS):
     """What a wave shows, in absolute units:
     {'hand_up_s', 'strokes', 'cycles', 'swing' (m, the median stroke between two turning points, of
     any stroke with fewer than 3; the run's side-to-side range when there is no stroke), 'frequency'
@@ -173,7 +173,7 @@ def ratio(value, reference):
     return float(value) / float(reference) if reference else float("nan")
 
 
-def compare_wave(generated, reference, arm, fps=FPS):
+def compare_wave(generated, reference, arm, fps=AGENT_FPS):
     """Wave measures of both clips and the generated one's ratios to the reference:
     {'generated': {...}, 'reference': {...}, 'swing_ratio', 'stroke_ratio', 'frequency_ratio',
     'hand_height_ratio'}."""
@@ -196,7 +196,7 @@ def pointing_angles(finger_base, finger_direction, target):
     return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
-def hold_frames(base, width, fps=FPS):
+def hold_frames(base, width, fps=AGENT_FPS):
     """(first, last) frame of the pointing hold of index-base positions (F, 3) on a character whose
     shoulders are `width` apart (any units, the positions'), or None for a finger that never slows down
     past half its travel; a still arm holds throughout."""
@@ -206,14 +206,14 @@ def hold_frames(base, width, fps=FPS):
     return longest_run((speed <= HOLD_SPEED * width) & (travel >= 0.5 * travel.max()))
 
 
-def hold_run(positions, arm, fps=FPS):
+def hold_run(positions, arm, fps=AGENT_FPS):
     """(first, last) frame of the pointing hold (see the module docstring) of a gesture's description
     joint positions, or None."""
     p, side = _positions(positions), _side(arm)
     return hold_frames(p[:, _JOINT[f"{side}_index_base"]], shoulder_width(p), fps)
 
 
-def point_measures(positions, finger_direction, arm, target, fps=FPS):
+def point_measures(positions, finger_direction, arm, target, fps=AGENT_FPS):
     """{'angle' (degrees, median over the hold of `pointing_angles`), 'hold_s'} of a pointing
     gesture; finger_direction (F, 3): the arm's index-finger direction (base to tip) per frame."""
     p, side = _positions(positions), _side(arm)
@@ -268,7 +268,7 @@ def _hold_or_apex(p, arm, fps):
     return np.arange(hold[0], hold[1] + 1), (hold[1] - hold[0] + 1) / fps
 
 
-def guide_measures(positions, finger_direction, palm, arm, target, fps=FPS):
+def guide_measures(positions, finger_direction, palm, arm, target, fps=AGENT_FPS):
     """What a "this way" gesture shows, as medians over its hold (the apex without one):
     {'heading_error' (degrees between the finger's and the target's directions seen from above, the
     target's from the first frame's shoulder joint), 'palm_up' (degrees of the palm normal from
@@ -305,7 +305,7 @@ def guide_accepted(measures):
                 and measures["free_arm_rise"] <= FREE_ARM_RISE)
 
 
-def raise_measures(positions, arm, fps=FPS):
+def raise_measures(positions, arm, fps=AGENT_FPS):
     """What a raised hand shows: {'height' (m of the wrist above the shoulder joint, median over the
     raised hold; the highest frame's without one), 'height_arm' (the same in arm lengths),
     'forearm_from_vertical' (degrees of elbow-to-wrist from straight up, over the same frames),
@@ -339,7 +339,7 @@ RAISE_MAX_STROKES = 3
 RAISE_HEIGHT_ERROR = 0.1
 
 
-def compare_raise(generated, reference, arm, fps=FPS):
+def compare_raise(generated, reference, arm, fps=AGENT_FPS):
     """Raise measures of both clips and the generated one's height error (arm lengths, absolute):
     {'generated': {...}, 'reference': {...}, 'height_error'}."""
     gen, ref = raise_measures(generated, arm, fps), raise_measures(reference, arm, fps)
@@ -502,7 +502,7 @@ def intensity_row(generated, reference, arm, target, fps):
             "free_arm_rise": free_arm_rise(gen, arm), "reference_free_arm_rise": free_arm_rise(ref, arm)}
 
 
-def aim_error(positions, arm, target, fps=FPS):
+def aim_error(positions, arm, target, fps=AGENT_FPS):
     """Degrees between the shoulder joint's line to the index base and its line to `target` (3,), median over the
     hold (the apex without one)."""
     p, side = _positions(positions), _side(arm)
@@ -524,7 +524,7 @@ def target_row(generated, reference, arm, target, fps):
 KIND_MEASURES = {behaviours.INTENSITY: intensity_row, behaviours.TARGET: target_row}
 
 
-def compare(generated, reference, behaviour, arm, target=None, fps=FPS):
+def compare(generated, reference, behaviour, arm, target=None, fps=AGENT_FPS):
     """The behaviour measures of one request, from descriptions (F, 42) of the generated clip and of
     its reference (lengths may differ): raise and lower, and for `behaviour` (a behaviours.Behaviour; None:
     those alone) the MEASURES of what it does, or else those of its kind (KIND_MEASURES; a target behaviour's

@@ -8,17 +8,17 @@ import numpy as np
 import numpy.typing as npt
 from numpy.typing import ArrayLike
 
-from .rotations import matrix_to_euler, matrix_to_quat, quat_multiply, quat_to_axis_angle, quat_to_matrix  # noqa: F401
+from .rotations import (  # noqa: F401
+    continuous,
+    matrix_to_euler,
+    matrix_to_quat,
+    quat_multiply,
+    quat_to_axis_angle,
+    quat_to_matrix,
+)
 
 MODES = ("QUATERNION", "AXIS_ANGLE", "XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 BLEND_TYPES = ("REPLACE", "COMBINE")
-
-
-def _continuous(quats: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    """(N, 4) quaternions with each on the same hemisphere as the frame before."""
-    steps = np.where(np.sum(quats[1:] * quats[:-1], axis=-1) < 0.0, -1.0, 1.0)
-    signs: npt.NDArray[np.float64] = np.concatenate([[1.0], np.cumprod(steps)])  # (N,)
-    return quats * signs[:, None]
 
 
 def rotation_keys(mode: str, keyed: ArrayLike, below: ArrayLike, below_values: ArrayLike,
@@ -34,12 +34,12 @@ def rotation_keys(mode: str, keyed: ArrayLike, below: ArrayLike, below_values: A
     if mode == "QUATERNION":
         if blend_type == "COMBINE":
             inverse = below * np.array([1.0, -1.0, -1.0, -1.0])
-            return _continuous(quat_multiply(inverse, keyed))
+            return continuous(quat_multiply(inverse, keyed))
         aligned = np.where(np.sum(keyed[:1] * below_values[:1]) < 0.0, -keyed, keyed)
-        return _continuous(aligned)
+        return continuous(aligned)
     if mode == "AXIS_ANGLE":
         start = np.where(np.sum(keyed[:1] * below[:1]) < 0.0, -keyed, keyed)
-        values = quat_to_axis_angle(_continuous(start))
+        values = quat_to_axis_angle(continuous(start))
     else:
         # Euler continuity from the animation's own angles at the first frame on.
         values = matrix_to_euler(quat_to_matrix(keyed), mode, previous=below_values[0])

@@ -35,6 +35,7 @@ from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
 from .rig import RigSkeleton, each_frame, inverse
 from .rotations import (
+    continuous,
     matrix_to_quat,
     matrix_to_rotvec,
     quat_multiply,
@@ -405,18 +406,6 @@ def blend_from_pose(under_quats, gesture_quats, weights):
     """Blend (N, B, 4) gesture quaternions with the pose underneath ((B, 4) or (N, B, 4)) by (N,) weights."""
     under = np.broadcast_to(under_quats, np.shape(gesture_quats))
     return slerp(under, gesture_quats, np.broadcast_to(np.asarray(weights)[:, None], np.shape(gesture_quats)[:2]))
-
-
-def continuous(quats):
-    """(N, B, 4) quaternions with signs flipped so each is on the same hemisphere as the previous frame.
-
-    Keys are interpolated channel by channel; without this a sign flip between two frames would
-    swing the bone the long way round.
-    """
-    q = np.asarray(quats, dtype=np.float64)
-    steps = np.where(np.sum(q[1:] * q[:-1], axis=-1) < 0.0, -1.0, 1.0)  # (N-1, B)
-    signs = np.concatenate([np.ones((1,) + q.shape[1:-1]), np.cumprod(steps, axis=0)])  # (N, B)
-    return q * signs[..., None]
 
 
 def pointing_hand_rotations(arm, count):

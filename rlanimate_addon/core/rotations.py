@@ -67,6 +67,29 @@ def quat_multiply(a: ArrayLike, b: ArrayLike) -> npt.NDArray[np.float64]:
     return product
 
 
+def continuous(quats: ArrayLike) -> npt.NDArray[np.float64]:
+    """(N, ..., 4) quaternions with signs flipped so each is on the same hemisphere as the one the frame before.
+
+    Keys are interpolated channel by channel; without this a sign flip between two frames would swing the bone
+    the long way round.
+    """
+    q = np.asarray(quats, dtype=np.float64)
+    steps = np.where(np.sum(q[1:] * q[:-1], axis=-1) < 0.0, -1.0, 1.0)  # (N-1, ...)
+    signs = np.concatenate([np.ones((1,) + q.shape[1:-1]), np.cumprod(steps, axis=0)])  # (N, ...)
+    flipped: npt.NDArray[np.float64] = q * signs[..., None]
+    return flipped
+
+
+def quat_mean(quats: ArrayLike) -> npt.NDArray[np.float64]:
+    """(C, ..., 4) -> (..., 4): the normalised mean of C quaternions, each first put on the first one's hemisphere
+    (close rotations' mean; rotations far apart, such as out-of-phase waves, average to a nearly still pose)."""
+    q = np.asarray(quats, dtype=np.float64)
+    q = np.where(np.sum(q * q[:1], axis=-1, keepdims=True) < 0.0, -q, q)
+    mean = q.mean(axis=0)
+    normalised: npt.NDArray[np.float64] = mean / np.linalg.norm(mean, axis=-1, keepdims=True)
+    return normalised
+
+
 def quat_to_matrix(quat: ArrayLike) -> npt.NDArray[np.float64]:
     """(..., 4) quaternions -> (..., 3, 3) rotation matrices (columns are the rotated axes)."""
     q = np.asarray(quat, dtype=np.float64)

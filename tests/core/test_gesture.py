@@ -6,6 +6,7 @@ from rlanimate_addon.core import aim, gesture, skeleton, spaces
 from rlanimate_addon.core.behaviours import POINTING, TARGET, Behaviour
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import (
+    continuous,
     matrix_to_quat,
     quat_multiply,
     quat_to_matrix,
@@ -118,7 +119,7 @@ def test_slerp_ends_and_midpoint_and_blend_from_pose():
 def test_continuous_removes_sign_flips_without_changing_rotations():
     quats = rotvec_to_quat(np.cumsum(RNG.normal(scale=0.2, size=(40, 3, 3)), axis=0))
     flipped = quats * RNG.choice([-1.0, 1.0], size=(40, 3, 1))
-    fixed = gesture.continuous(flipped)
+    fixed = continuous(flipped)
     assert np.all(np.sum(fixed[1:] * fixed[:-1], axis=-1) > 0)
     assert np.allclose(quat_to_matrix(fixed), quat_to_matrix(quats), atol=1e-12)
 

@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 
 from rlanimate_addon.core import rotations
 
@@ -35,3 +36,15 @@ def test_small_angles_are_stable():
 def test_negative_w_gives_the_short_arc():
     q = -rotations.rotvec_to_quat(np.array([0.3, 0.0, 0.0]))
     np.testing.assert_allclose(rotations.quat_to_rotvec(q), [0.3, 0.0, 0.0], atol=1e-12)
+
+
+def test_quat_mean_of_close_rotations_whatever_their_signs_and_of_opposite_swings():
+    rng = np.random.default_rng(3)
+    centre = rotations.rotvec_to_quat(np.array([0.3, -0.2, 0.5]))
+    spread = rotations.quat_multiply(centre, rotations.rotvec_to_quat(rng.normal(scale=0.05, size=(50, 3))))
+    signed = spread * rng.choice([-1.0, 1.0], size=(50, 1))
+    mean = rotations.quat_mean(signed)
+    assert np.linalg.norm(mean) == pytest.approx(1.0)
+    assert abs(np.sum(mean * centre)) > np.cos(np.radians(2.0) / 2), "within 2 degrees of the centre"
+    swings = rotations.rotvec_to_quat(np.array([[[0.0, 0.0, 0.8]], [[0.0, 0.0, -0.8]]]))  # (2, 1, 4)
+    assert np.allclose(rotations.quat_mean(swings), [[1.0, 0.0, 0.0, 0.0]]), "opposite swings average to still"

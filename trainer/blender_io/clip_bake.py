@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from rlanimate_addon.core import skeleton
-from rlanimate_addon.core.rotations import rotvec_to_quat
+from rlanimate_addon.core.rotations import continuous, rotvec_to_quat
 from trainer.blender_io import rig_session
 from trainer.files import atomic_write_text
 from trainer.motion.library_plan import DEFAULT_SEED, manifest_entry, plan_library
@@ -14,14 +14,6 @@ from trainer.motion.synthesis import FPS, synthesise
 from trainer.paths import CLIP_DIR, SAMPLE_RIG_BLEND
 
 SIMPLIFY = 0.1  # FBX curve simplification: keeps joints within 0.3 mm, drops static keys (~125 KB a clip)
-
-def _continuous_quaternions(rotvecs):
-    """(F, 3) rotation vectors -> (F, 4) quaternions with no sign flips between frames."""
-    quats = rotvec_to_quat(rotvecs)
-    signs = np.sign(np.einsum("fi,fi->f", quats[1:], quats[:-1]))
-    signs[signs == 0] = 1.0
-    return quats * np.concatenate([[1.0], np.cumprod(signs)])[:, None]
-
 
 def bake_clip(rig, clip, name):
     """A new action on `rig` with quaternion keys for every bone the clip animates, frames 0..F-1
@@ -32,7 +24,7 @@ def bake_clip(rig, clip, name):
     frames = np.arange(clip.frames)
     for bone, rotvecs in clip.rotvecs.items():
         path = f'pose.bones["{skeleton.PREFIX}{bone}"].rotation_quaternion'
-        quats = _continuous_quaternions(rotvecs)
+        quats = continuous(rotvec_to_quat(rotvecs))
         for index in range(4):
             action_adapter.write_keys(target.new_fcurve(path, index, skeleton.PREFIX + bone), frames, quats[:, index])
     action_adapter.assign(rig, target)

@@ -27,7 +27,7 @@ from typing import IO
 import numpy as np
 from tqdm import tqdm
 
-from rlanimate_addon.core import bone_maps, rotations, skeleton
+from rlanimate_addon.core import bone_maps, frame_rate, rotations, skeleton
 from rlanimate_addon.core.errors import RLAnimateError, operator_error_reason
 from trainer.blender_io import import_worker, rig_session
 from trainer.blender_io.import_worker import ImportLimits
@@ -36,7 +36,8 @@ from trainer.motion.clip import ClipSet, MotionClip
 from trainer.motion.hands import with_hand
 from trainer.motion.manifest import ManifestEntry, checked_entries, labelled, read_manifest
 
-EXPECTED_FPS = 30.0
+#: The frame rate a clip is read at when neither the call nor the manifest gives one: the agent's.
+EXPECTED_FPS = frame_rate.AGENT_FPS
 CLIP_SUFFIXES = (".fbx", ".bvh")
 _FINGER_BONES = tuple(b.name for b in skeleton.BONES
                       if "Hand" in b.name and b.name not in skeleton.ACTION_JOINTS)

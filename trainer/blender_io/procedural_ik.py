@@ -12,14 +12,13 @@ the constraint's influence follows the raise, so the clip starts and ends in the
 """
 import numpy as np
 
-from rlanimate_addon.core import rotations, skeleton, spaces
+from rlanimate_addon.core import frame_rate, rotations, skeleton, spaces
 from rlanimate_addon.core.easing import minimum_jerk
 from rlanimate_addon.core.gesture import slerp
 from trainer.blender_io import rig_session
 from trainer.motion import autolabel
 from trainer.paths import SAMPLE_RIG_BLEND
 
-FPS = 30.0
 #: Where the IK target sits along the requested pointing direction, metres from the rest shoulder.
 POINT_TARGET_DISTANCE = 2.5
 #: Pointing timing as fractions of the clip: stroke from..to, hold until, return until.
@@ -129,7 +128,7 @@ class ProceduralIK:
         elevation = np.radians(WAVE_ELEVATION[0] + WAVE_ELEVATION[1] * exaggeration)
         up = shoulder + WAVE_REACH * length * np.array([sign * np.sin(elevation) * 0.7,
                                                         -np.sin(elevation) * 0.7, -np.cos(elevation)])
-        t = np.arange(frame_count) / FPS
+        t = np.arange(frame_count) / frame_rate.AGENT_FPS
         frequency = WAVE_FREQUENCY if tempo is None else tempo
         swing = (WAVE_SWING[0] + WAVE_SWING[1] * exaggeration) * length * np.sin(2 * np.pi * frequency * t)
         positions = hang + raised[:, None] * (up - hang)  # (F, 3)

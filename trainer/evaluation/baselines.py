@@ -39,9 +39,7 @@ def mean_start_pose(clips: Sequence[MotionClip]) -> np.ndarray:
     if not clips:
         raise RLAnimateError("No training clips: a baseline needs at least one clip to start from.")
     quats = rotations.rotvec_to_quat(np.stack([np.asarray(c.rotvecs[0]) for c in clips]))  # (C, 15, 4)
-    quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
-    mean = quats.mean(axis=0)
-    return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
+    return rotations.quat_to_rotvec(rotations.quat_mean(quats))
 
 
 def time_warp(rotvecs: ArrayLike, frame_count: int) -> np.ndarray:
@@ -132,9 +130,7 @@ class ClassMean:
         spaces.check_arm_and_length(arm, frame_count)
         group = clips_of(self.clips, behaviour, arm, "class-mean")
         quats = rotations.rotvec_to_quat(np.stack([time_warp(c.rotvecs, frame_count) for c in group]))  # (C, F, 15, 4)
-        quats = np.where(np.sum(quats * quats[:1], axis=-1, keepdims=True) < 0.0, -quats, quats)
-        mean = quats.mean(axis=0)
-        return rotations.quat_to_rotvec(mean / np.linalg.norm(mean, axis=-1, keepdims=True))
+        return rotations.quat_to_rotvec(rotations.quat_mean(quats))
 
 
 class AgentMethod:

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, kinematics, skeleton, spaces
+from rlanimate_addon.core import behaviours, frame_rate, kinematics, skeleton, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.motion import fk
 
@@ -123,7 +123,7 @@ def moving_arm(rotvecs):
     return max(vectors, key=lambda arm: _travel(vectors[arm]))
 
 
-def label_wave(rotvecs, fps=30.0):
+def label_wave(rotvecs, fps=frame_rate.AGENT_FPS):
     """WaveLabel of a (F, 15, 3) waving clip (see the module docstring for the formula)."""
     vectors = _arm_vectors(rotvecs)
     travel = {arm: _travel(v) for arm, v in vectors.items()}

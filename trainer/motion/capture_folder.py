@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours, skeleton
+from rlanimate_addon.core import behaviours, frame_rate, skeleton
 from trainer.motion import autolabel, realmocap_takes, wave_rhythm
 from trainer.motion.clip import MotionClip
 
@@ -144,7 +144,8 @@ def manifest(labels: list[TakeLabel], folder) -> dict:
         if label.notes:
             entry["notes"] = label.notes
         entries.append(entry)
-    return {"source": str(Path(folder).resolve()), "labelled_by": "trainer/motion/autolabel.py", "fps": 30,
+    return {"source": str(Path(folder).resolve()), "labelled_by": "trainer/motion/autolabel.py",
+            "fps": int(frame_rate.AGENT_FPS),
             "clips": entries}
 
 

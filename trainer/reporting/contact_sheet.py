@@ -14,7 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from rlanimate_addon.core import behaviours, skeleton  # noqa: E402
+from rlanimate_addon.core import behaviours, frame_rate, skeleton  # noqa: E402
 from trainer.motion import fk  # noqa: E402
 from trainer.motion.library_plan import DEFAULT_SEED, plan_library  # noqa: E402
 from trainer.motion.synthesis import synthesise  # noqa: E402
@@ -130,7 +130,7 @@ def render(out=CONTACT_SHEET, seed=DEFAULT_SEED):
                       "green dots = finger line)", 0.98, out)
 
 
-def generated_sheet(rows, out, title, fps=30, frame_labels=False):
+def generated_sheet(rows, out, title, fps=frame_rate.AGENT_FPS, frame_labels=False):
     """One PNG of rendered frames: rows [(row title, [(frame offset, png path)])], a column per key frame, each
     titled with its time (or, with frame_labels, its frame number)."""
     columns = max(len(frames) for _, frames in rows)

@@ -2,10 +2,11 @@
 
 import numpy as np
 
-from rlanimate_addon.core import skeleton
+from rlanimate_addon.core import frame_rate, skeleton
 from rlanimate_addon.core.rotations import matrix_to_rotvec, rotvec_to_matrix
 
-FPS = 30
+#: The clips' frame rate, the agent's, in whole frames (Blender's scene rate and the manifest's "fps").
+FPS = int(frame_rate.AGENT_FPS)
 
 FINGERS = ("Thumb", "Index", "Middle", "Ring", "Pinky")
 #: Finger bones each clip animates besides the action joints (Index2/3 stay at rest: the agent
