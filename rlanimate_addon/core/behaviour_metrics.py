@@ -483,8 +483,8 @@ def raise_row(generated, reference, arm, target, fps):
 #: The measures of what a behaviour does (behaviours.ACTIONS): measure(generated, reference, arm, target, fps) ->
 #: {name: float} from descriptions (F, 42) of a generated clip and its reference (target: (3,) in the character
 #: frame for a target behaviour, else None).
-MEASURES = {behaviours.WAVING: wave_row, behaviours.POINTING: point_row, behaviours.PRESENTING: guide_row,
-            behaviours.RAISING: raise_row}
+MEASURES = {behaviours.OSCILLATES: wave_row, behaviours.AIMS: point_row, behaviours.PRESENTS: guide_row,
+            behaviours.RAISES: raise_row}
 
 
 def peak_hand_height(positions, arm):

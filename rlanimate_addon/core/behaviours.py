@@ -29,15 +29,15 @@ INTENSITY = "intensity"
 KINDS = (TARGET, INTENSITY)
 
 #: What a behaviour does, each with the kind it needs.
-POINTING, WAVING, PRESENTING, RAISING = "point", "wave", "present", "raise"
-ACTIONS = {POINTING: TARGET, WAVING: INTENSITY, PRESENTING: TARGET, RAISING: INTENSITY}
+AIMS, OSCILLATES, PRESENTS, RAISES = "point", "wave", "present", "raise"
+ACTIONS = {AIMS: TARGET, OSCILLATES: INTENSITY, PRESENTS: TARGET, RAISES: INTENSITY}
 
 POINT = "POINT"
 WAVE = "WAVE"
 GUIDE = "GUIDE"
 RAISE_HAND = "RAISE_HAND"
 #: The one table from the shipped behaviours' names to what they do.
-SHIPPED = {POINT: POINTING, WAVE: WAVING, GUIDE: PRESENTING, RAISE_HAND: RAISING}
+SHIPPED = {POINT: AIMS, WAVE: OSCILLATES, GUIDE: PRESENTS, RAISE_HAND: RAISES}
 
 #: An id: a letter, then letters, digits or underscores, 32 characters at most.
 _ID = re.compile(r"[A-Z][A-Z0-9_]{0,31}")
@@ -99,12 +99,12 @@ class Behaviour:
     @property
     def aims(self) -> bool:
         """Whether it points: Exact Aim solves its finger onto the target, and it holds the pointing hand."""
-        return self.does == POINTING
+        return self.does == AIMS
 
     @property
     def oscillates(self) -> bool:
         """Whether it waves: its objective carries a rhythm (core/rhythm.py) and a request may ask a tempo."""
-        return self.does == WAVING
+        return self.does == OSCILLATES
 
     def to_dict(self) -> dict[str, str]:
         """The agent file's declaration: its name and kind, and what it does where the name does not say."""

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from rlanimate_addon.core import aim, gesture, skeleton, spaces
-from rlanimate_addon.core.behaviours import POINTING, TARGET, Behaviour
+from rlanimate_addon.core.behaviours import AIMS, TARGET, Behaviour
 from rlanimate_addon.core.errors import RLAnimateError
 from rlanimate_addon.core.rotations import (
     continuous,
@@ -403,7 +403,7 @@ class TaughtAgent(ReplayAgent):
     """A ReplayAgent of taught target behaviours: AIM_AT declared to point, BECKON declaring nothing."""
 
     average_frames = {"AIM_AT": 50, "BECKON": 50}
-    space = spaces.ObjectiveSpace((Behaviour("AIM_AT", TARGET, POINTING), Behaviour("BECKON", TARGET)))
+    space = spaces.ObjectiveSpace((Behaviour("AIM_AT", TARGET, AIMS), Behaviour("BECKON", TARGET)))
 
 
 def test_a_taught_behaviour_of_the_pointing_kind_gets_exact_aim_and_the_pointing_hand():

@@ -108,7 +108,7 @@ def compare_held_out(agent_path: Path, session: Any) -> dict:
         held = [clip for clip in session.test_clips if clip.behaviour == behaviour]
         if not held:
             continue
-        requests = REQUESTS if behaviour == behaviours.WAVE else {"": False}
+        requests = REQUESTS if agent.agent.space.behaviour(behaviour).oscillates else {"": False}
         results[behaviours.key(behaviour)] = {suffix[1:] or "paper": compare(methods, held, session.env,
                                                                              session.references, with_tempo)
                                               for suffix, with_tempo in requests.items()}
@@ -134,13 +134,13 @@ def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
                        key=lambda c: float(np.ravel(c.attributes)[0]))
         for clip in [takes[k] for k in sorted({round(x) for x in np.linspace(0, len(takes) - 1, PATH_TAKES)})] \
                 if takes else []:
-            tempo = baselines.request_tempo(clip, behaviour == behaviours.WAVE)
+            tempo = baselines.request_tempo(clip, clip.declared.oscillates)
             played = {"the take": clip.rotvecs, **{name: method.generate(clip.behaviour, clip.arm, clip.attributes,
                                                                           clip.frames, tempo=tempo)
                                                    for name, method in methods.items()}}
             positions = {name: spaces.description_joint_positions(session.describe(r)) for name, r in played.items()}
             title = f"{clip.name[-TITLE_CHARACTERS:]} ({'tempo asked' if tempo else 'label only'})"
-            (waves if behaviour == behaviours.WAVE else held).append((title, clip.arm, positions, clip_target(clip)))
+            (waves if clip.declared.oscillates else held).append((title, clip.arm, positions, clip_target(clip)))
     if waves:
         wave_hand_paths([panel[:3] for panel in waves], path)
     elif held:

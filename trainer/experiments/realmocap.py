@@ -230,7 +230,7 @@ def compare(methods, clips, env, references, with_tempo=False):
     for name, method in methods.items():
         motions = baselines.generate_for(method, clips, with_tempo)
         result = scoring.score_motions(env, motions, clips, references)
-        if all(c.behaviour == behaviours.WAVE for c in clips):
+        if all(c.declared.oscillates for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)
                                                    for m, c in zip(motions, clips, strict=True)]))
         if fallbacks:
@@ -301,7 +301,7 @@ def point_agent_and_library(point_agent, runs, epochs, seed):
     `point_agent` None: the add-on's installed default agent when it is trained, else a point agent
     trained here on the sample library (runs/realmocap/sample_point/)."""
     library = LibrarySession(DEFAULT_MANIFEST)
-    clips = [c for c in library.train_clips if c.behaviour == behaviours.POINT]
+    clips = [c for c in library.train_clips if c.declared.aims]
     if point_agent is None:
         try:
             installed = baselines.AgentMethod(INSTALLED_AGENT)

@@ -160,7 +160,7 @@ def rhythm_with_phases(model, train_clips):
     which must give the file's examples back."""
     if model.phases is not None:
         return model
-    refit = wave_rhythm.fit_rhythm_model([clip for clip in train_clips if clip.behaviour == behaviours.WAVE])
+    refit = wave_rhythm.fit_rhythm_model([clip for clip in train_clips if clip.declared.oscillates])
     if refit.examples.shape != model.examples.shape or not np.allclose(refit.examples, model.examples):
         raise RLAnimateError("The agent's training waves read differently now than when it was trained: retrain "
                              "it (delete its run folder under runs/realmocap/).")
@@ -231,7 +231,7 @@ def run_ablation(settings: AblationSettings) -> dict:
         agents = {key: baselines.AgentMethod(Path(runs[name, key].settings.output) / "agent.npz") for key in presets}
         methods = variant_methods(agents, train, variants)
         retrieval = baselines.NearestClip(train)
-        read = wave_rhythm.swinging([clip for clip in train if clip.behaviour == behaviours.WAVE])  # read once
+        read = wave_rhythm.swinging([clip for clip in train if clip.declared.oscillates])  # read once
         own = OwnRhythm(agents[None], test)
         scored = {**compare({**{v.name: methods[v.name] for v in variants if not v.tempo}, OWN_RHYTHM: own,
                              RETRIEVAL: retrieval}, test, env, references),

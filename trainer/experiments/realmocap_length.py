@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 
-from rlanimate_addon.core import behaviours
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.evaluation import baselines
 from trainer.evaluation.rhythm_leave_one_out import swinging_check
@@ -144,7 +143,7 @@ def rhythm_rule_results(splits, runs, length, bandwidths, factors, env, referenc
                for by_arm in (False, True) for bandwidth in bandwidths for factor in factors}
     for name, (train, validation) in splits.items():
         agent = baselines.AgentMethod(Path(runs[name, length].settings.output) / "agent.npz")
-        read = wave_rhythm.swinging([clip for clip in train if clip.behaviour == behaviours.WAVE])  # read once
+        read = wave_rhythm.swinging([clip for clip in train if clip.declared.oscillates])  # read once
         for entry in results.values():
             rule = {"bandwidth": entry["exaggeration_kernel"], "tempo_bandwidth": math.log(entry["tempo_kernel"]),
                     "by_arm": entry["by_arm"]}

@@ -227,7 +227,7 @@ def label_clip(clip, behaviour):
     if behaviour not in behaviours.KNOWN_KINDS:
         raise RLAnimateError(f"Auto-labels read points and waves only, not {behaviour}: label the clips of "
                              f"{behaviour} in a manifest (docs/TRAINING.md, \"Teach it a new gesture\").")
-    if behaviour == behaviours.WAVE:
+    if behaviours.SHIPPED[behaviour] == behaviours.OSCILLATES:
         label = label_wave(clip.rotvecs, clip.fps)
         clip.behaviour, clip.arm = behaviours.WAVE, label.arm
         clip.exaggeration = clip.attributes = label.exaggeration

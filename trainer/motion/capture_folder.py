@@ -85,7 +85,7 @@ def label_take(path, clip: MotionClip) -> TakeLabel:
         read = autolabel.label_point(clip.rotvecs)
         x, y, z = (float(v) for v in read.direction)
         label.arm, label.direction = read.arm, (x, y, z)
-    elif behaviour == behaviours.WAVE:
+    elif behaviours.SHIPPED.get(behaviour) == behaviours.OSCILLATES:
         read = autolabel.label_wave(clip.rotvecs, clip.fps)
         label.arm, label.exaggeration = read.arm, read.exaggeration
         label.tempo, why = wave_rhythm.tempo_reading(MotionClip(clip.name, clip.source, clip.fps, clip.rotvecs,

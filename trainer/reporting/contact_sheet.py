@@ -37,8 +37,8 @@ def pick_clips(seed=DEFAULT_SEED):
     big raised hand (training clips)."""
     plan = [p for p in plan_library(seed) if p.split == "train"]
     points, waves, guides, raises = ([p for p in plan if behaviours.SHIPPED[p.spec.behaviour] == action]
-                                     for action in (behaviours.POINTING, behaviours.WAVING, behaviours.PRESENTING,
-                                                    behaviours.RAISING))
+                                     for action in (behaviours.AIMS, behaviours.OSCILLATES, behaviours.PRESENTS,
+                                                    behaviours.RAISES))
 
     def across(p):  # how far across the body the target lies
         return -p.spec.target[0] if p.spec.arm == "LEFT" else p.spec.target[0]

@@ -29,7 +29,7 @@ from trainer.scripts.cli import run_main
 WAVE_PATHS = "behaviour_wave_paths.png"
 POINT_PATHS = "behaviour_point_paths.png"
 #: The hand-path figure of the held-out requests of the behaviours that present and that raise.
-HELD_PATHS = {behaviours.PRESENTING: "behaviour_guide_paths.png", behaviours.RAISING: "behaviour_raise_hand_paths.png"}
+HELD_PATHS = {behaviours.PRESENTS: "behaviour_guide_paths.png", behaviours.RAISES: "behaviour_raise_hand_paths.png"}
 
 
 @dataclass(frozen=True)
@@ -117,11 +117,11 @@ def _further_sweeps(agent, session, lengths, settings):
     """The agent's guides at random targets and raised hands over exaggerations, where the library trains them."""
     trained = {c.declared.does: c.behaviour for c in session.train_clips}
     extra = {}
-    if behaviours.PRESENTING in trained:
-        extra["guide_targets"] = behaviour.guide_sweeps(agent, lengths[trained[behaviours.PRESENTING]],
+    if behaviours.PRESENTS in trained:
+        extra["guide_targets"] = behaviour.guide_sweeps(agent, lengths[trained[behaviours.PRESENTS]],
                                                         session.describe, settings.targets, seed=settings.target_seed)
-    if behaviours.RAISING in trained:
-        extra["raise_sweep"] = {arm.lower(): behaviour.raise_sweep(agent, arm, lengths[trained[behaviours.RAISING]],
+    if behaviours.RAISES in trained:
+        extra["raise_sweep"] = {arm.lower(): behaviour.raise_sweep(agent, arm, lengths[trained[behaviours.RAISES]],
                                                                    session.describe) for arm in ("LEFT", "RIGHT")}
     return extra
 
