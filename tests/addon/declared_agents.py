@@ -33,10 +33,10 @@ def listed_titles(names):
 
 def widened_agent(path, added, average_frames=75.0):
     """Write at `path` a format-4 agent of the shipped weights declaring the shipped behaviours and `added`
-    ([(id, kind)]); returns its ObjectiveSpace."""
+    ([(id, kind)] or [(id, kind, does)]: behaviours.Behaviour's fields); returns its ObjectiveSpace."""
     weights, metadata = agent_file.load_agent_file(SHIPPED)
     shipped = runtime.load_agent(SHIPPED).space
-    space = spaces.ObjectiveSpace(behaviours.ordered([*shipped.behaviours, *(Behaviour(n, k) for n, k in added)]))
+    space = spaces.ObjectiveSpace(behaviours.ordered([*shipped.behaviours, *(Behaviour(*spec) for spec in added)]))
     assert space.label_size > 1, "a one-hot label: more than two behaviours"
     widened = dict(weights)
     for name in _OBJECTIVE_INPUTS:
@@ -51,6 +51,6 @@ def widened_agent(path, added, average_frames=75.0):
     metadata = {**metadata, "format_version": agent_file.FORMAT_VERSION,
                 "spaces": {**metadata["spaces"], "objective_size": space.size},
                 "behaviours": [b.to_dict() for b in space.behaviours],
-                "average_frames": {**metadata["average_frames"], **dict.fromkeys(dict(added), average_frames)}}
+                "average_frames": {**metadata["average_frames"], **dict.fromkeys((spec[0] for spec in added), average_frames)}}
     np.savez(path, **widened, **{agent_file.METADATA_KEY: np.array(json.dumps(metadata))})
     return space

@@ -8,7 +8,7 @@ import pytest
 
 import addon_helpers
 import declared_agents
-from rlanimate_addon.blender import gestures, preferences, properties
+from rlanimate_addon.blender import action_adapter, gestures, preferences, properties
 from test_registration import RecordingLayout, _draw
 
 ADDED = [("BECKON", "target"), ("SHRUG", "intensity")]
@@ -118,3 +118,34 @@ def test_generate_bakes_the_agents_own_behaviours_and_follows_a_target_behaviour
     raised = gestures.placed_gestures(rig)[-1]  # the topmost
     assert (raised.record["behaviour"], raised.record["kind"]) == ("SHRUG", "intensity")
     assert gestures.last_targeted(rig).action == beckon.action, "Follow Target follows the target behaviour"
+
+
+def _arm_and_hand_keys(rig, arm="Right"):
+    """({bone: keyed values} of the upper arm's rotation, whether the pointing hand's fingers are keyed) of the
+    armature's topmost gesture."""
+    curves = action_adapter.all_fcurves(gestures.placed_gestures(rig)[-1].action)
+    upper = addon_helpers.rig_bone(rig, f"{arm}Arm")
+    values = np.array([[p.co[1] for p in c.keyframe_points] for c in curves if f'"{upper}"' in c.data_path])
+    middle = addon_helpers.rig_bone(rig, f"{arm}HandMiddle1")
+    return values, any(f'"{middle}"' in c.data_path for c in curves)
+
+
+def test_a_taught_behaviour_declared_to_point_gets_exact_aim_and_the_pointing_hand(settings, tmp_path):
+    """What Point gets comes from what a behaviour does: AIM_AT, declared "does": "point", shows Exact Aim, keys
+    the pointing hand, and Exact Aim turns its arm; BECKON, declaring nothing, gets neither."""
+    path = tmp_path / "aim_at.npz"
+    declared_agents.widened_agent(path, [("AIM_AT", "target", "point"), ("BECKON", "target")])
+    addon_helpers.addon_preferences().agent_path = str(path)
+    rig = addon_helpers.load_sample_rig()
+    target = addon_helpers.add_empty("Target", (-1.5, -2.0, 1.6))
+    for behaviour, points in (("AIM_AT", True), ("BECKON", False)):
+        settings.behaviour = behaviour
+        assert ("exact_aim" in _shown(settings)) == points
+        keys = {}
+        for exact in (True, False):  # made, then made again in place with Exact Aim off
+            assert addon_helpers.generate(rig, settings, behaviour=behaviour, arm="RIGHT", target=target,
+                                          exact_aim=exact, start_frame=1, frame_count=90) == {"FINISHED"}
+            keys[exact], hand = _arm_and_hand_keys(rig)
+            assert hand == points, f"{behaviour}: the pointing hand only for a behaviour that points"
+        assert np.allclose(keys[True], keys[False]) != points, f"{behaviour}: Exact Aim turns a pointing arm alone"
+        assert len(gestures.placed_gestures(rig)) == 1, "each bake made the selected gesture again in place"
