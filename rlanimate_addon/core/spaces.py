@@ -142,7 +142,7 @@ class ObjectiveSpace:
         """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): an oscillating behaviour's rhythm signals and
         their second harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
         objectives = np.asarray(objectives, dtype=np.float64)
-        wave = np.zeros(objectives.shape[:-1], bool)
+        wave: npt.NDArray[np.bool_] = np.zeros(objectives.shape[:-1], bool)
         for name in self.oscillating():
             wave |= self.label_mask(objectives, name)
         features: npt.NDArray[np.float64] = rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:])

@@ -40,8 +40,8 @@ class MotionClip:
 
     @property
     def declared(self) -> behaviours.Behaviour:
-        """The clip's behaviour: its name, kind and what it does."""
-        return behaviours.Behaviour(self.behaviour, self.behaviour_kind, self.does)
+        """The clip's behaviour: its name, kind and what it does (a labelled clip's)."""
+        return behaviours.Behaviour(str(self.behaviour), self.behaviour_kind, self.does)
 
 
 def library_space(clips):
