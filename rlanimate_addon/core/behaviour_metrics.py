@@ -22,7 +22,12 @@ the wrist as high above the shoulder as the reference's. Each is a behaviour's b
 gesture declaring nothing) is measured by its kind (`KIND_MEASURES`): an intensity one by the hand's peak
 height, a target one by its aim at the target, each with the other arm's rise.
 """
+from collections.abc import Callable, Sequence
+from typing import Any
+
 import numpy as np
+import numpy.typing as npt
+from numpy.typing import ArrayLike
 
 from . import behaviours, metrics, skeleton, spaces
 from .errors import RLAnimateError
@@ -39,14 +44,22 @@ DTW_BAND = 0.15
 
 _JOINT = {name: k for k, (name, _) in enumerate(skeleton.DESCRIPTION_JOINTS)}
 
+Array = npt.NDArray[np.float64]
+#: (first, last) frame of a run, end inclusive, or None.
+Run = tuple[int, int] | None
+#: A measure's figures by name.
+Measures = dict[str, Any]
+#: A behaviour's measures: (generated, reference descriptions (F, 42), arm, target (3,) or None, fps) -> figures.
+Measure = Callable[[ArrayLike, ArrayLike, str, ArrayLike | None, float], dict[str, float]]
 
-def _side(arm):
+
+def _side(arm: str) -> str:
     if arm not in skeleton.ARMS:
         raise RLAnimateError(f"Unknown arm {arm!r}: use LEFT or RIGHT.")
     return arm.lower()
 
 
-def _positions(positions, name="The clip"):
+def _positions(positions: ArrayLike, name: str = "The clip") -> Array:
     p = np.asarray(positions, dtype=np.float64)
     if p.ndim != 3 or p.shape[1:] != (len(skeleton.DESCRIPTION_JOINTS), 3) or len(p) < 2:
         raise RLAnimateError(f"{name} must be description-joint positions of shape (frames >= 2, "
@@ -56,41 +69,42 @@ def _positions(positions, name="The clip"):
     return p
 
 
-def finger_direction(descriptions, arm):
+def finger_direction(descriptions: ArrayLike, arm: str) -> Array:
     """(F, 3) unit index-finger direction (base to tip) of the arm, from descriptions (F, 42)."""
     effectors = np.asarray(descriptions)[..., spaces.DESCRIPTION_EFFECTORS]
     row = [name for name, _, _ in skeleton.EFFECTORS].index(f"{_side(arm)}_index")
     return effectors[..., 3 * row:3 * row + 3]
 
 
-def joint(positions, name):
+def joint(positions: ArrayLike, name: str) -> Array:
     """(F, 3) path of one description joint, e.g. 'right_wrist'."""
     return _positions(positions)[:, _JOINT[name]]
 
 
-def shoulder_width(positions):
+def shoulder_width(positions: ArrayLike) -> float:
     """Distance (m) between the two shoulder joints in the first frame: the scale of the thresholds."""
     p = _positions(positions)
     return float(np.linalg.norm(p[0, _JOINT["left_shoulder"]] - p[0, _JOINT["right_shoulder"]]))
 
 
-def arm_length(positions, arm):
+def arm_length(positions: ArrayLike, arm: str) -> float:
     """Shoulder-elbow plus elbow-wrist length (m) in the first frame."""
     p, side = _positions(positions), _side(arm)
     shoulder, elbow, wrist = (p[0, _JOINT[f"{side}_{j}"]] for j in ("shoulder", "elbow", "wrist"))
     return float(np.linalg.norm(elbow - shoulder) + np.linalg.norm(wrist - elbow))
 
 
-def elevation(positions, arm):
+def elevation(positions: ArrayLike, arm: str) -> Array:
     """(F,) arm elevation in degrees: the angle of the upper arm (shoulder to elbow) from straight
     down; 0 hanging, 90 horizontal, 180 straight up."""
     p, side = _positions(positions), _side(arm)
     upper = p[:, _JOINT[f"{side}_elbow"]] - p[:, _JOINT[f"{side}_shoulder"]]
     cosine = -upper[:, 2] / np.linalg.norm(upper, axis=1)
-    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    result: Array = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    return result
 
 
-def longest_run(mask):
+def longest_run(mask: ArrayLike) -> Run:
     """(first, last) frame of the longest run of True in a (F,) mask, end inclusive; None if none."""
     mask = np.asarray(mask, dtype=bool)
     if not mask.any():
@@ -101,14 +115,14 @@ def longest_run(mask):
     return int(starts[k]), int(stops[k] - 1)
 
 
-def hand_up_run(positions, arm):
+def hand_up_run(positions: ArrayLike, arm: str) -> Run:
     """(first, last) frame of the hand-up run (see the module docstring), or None."""
     p, side = _positions(positions), _side(arm)
     drop = p[:, _JOINT[f"{side}_shoulder"], 2] - p[:, _JOINT[f"{side}_wrist"], 2]  # (F,) m below shoulder
     return longest_run(drop <= HAND_UP_DROP * arm_length(p, arm))
 
 
-def turning_points(signal, threshold):
+def turning_points(signal: ArrayLike, threshold: float) -> list[int]:
     """Frame indices of the pivots of a zig-zag through a (F,) signal with hysteresis `threshold`:
     the start of the first leg, every turning point, and the end of the last leg. Consecutive pivots
     differ by at least `threshold`; fewer than 2 pivots (an empty list) means no leg that long."""
@@ -131,7 +145,7 @@ def turning_points(signal, threshold):
     return pivots + [extreme] if direction else []
 
 
-def _refined(signal, frames):
+def _refined(signal: Array, frames: Sequence[int]) -> Array:
     """Sub-frame times of extrema at interior `frames` of a (F,) signal: the vertex of the parabola
     through each extremum and its two neighbours (the frame itself at the signal's ends)."""
     times = np.asarray(frames, dtype=np.float64)
@@ -143,7 +157,7 @@ def _refined(signal, frames):
     return times
 
 
-def wave_measures(positions, arm, fps=AGENT_FPS):
+def wave_measures(positions: ArrayLike, arm: str, fps: float = AGENT_FPS) -> Measures:
     """What a wave shows, in absolute units:
     {'hand_up_s', 'strokes', 'cycles', 'swing' (m, the median stroke between two turning points, of
     any stroke with fewer than 3; the run's side-to-side range when there is no stroke), 'frequency'
@@ -168,12 +182,12 @@ def wave_measures(positions, arm, fps=AGENT_FPS):
             "frequency": float(0.5 / half_period_s), "hand_height": hand_height}
 
 
-def ratio(value, reference):
+def ratio(value: float, reference: float) -> float:
     """value / reference; NaN when the reference is 0 (nothing to compare with)."""
     return float(value) / float(reference) if reference else float("nan")
 
 
-def compare_wave(generated, reference, arm, fps=AGENT_FPS):
+def compare_wave(generated: ArrayLike, reference: ArrayLike, arm: str, fps: float = AGENT_FPS) -> Measures:
     """Wave measures of both clips and the generated one's ratios to the reference:
     {'generated': {...}, 'reference': {...}, 'swing_ratio', 'stroke_ratio', 'frequency_ratio',
     'hand_height_ratio'}."""
@@ -185,7 +199,7 @@ def compare_wave(generated, reference, arm, fps=AGENT_FPS):
             "hand_height_ratio": ratio(gen["hand_height"], ref["hand_height"])}
 
 
-def pointing_angles(finger_base, finger_direction, target):
+def pointing_angles(finger_base: ArrayLike, finger_direction: ArrayLike, target: ArrayLike) -> Array:
     """(F,) degrees between the finger line (base (F, 3), direction (F, 3)) and the line from the base
     to the target (3,) or (F, 3): 0 when the finger points straight at the target."""
     base = np.asarray(finger_base, dtype=np.float64)
@@ -193,10 +207,11 @@ def pointing_angles(finger_base, finger_direction, target):
     to_target = np.asarray(target, dtype=np.float64) - base
     cosine = np.sum(direction * to_target, axis=-1) / (
         np.linalg.norm(direction, axis=-1) * np.linalg.norm(to_target, axis=-1))
-    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    result: Array = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    return result
 
 
-def hold_frames(base, width, fps=AGENT_FPS):
+def hold_frames(base: Array, width: float, fps: float = AGENT_FPS) -> Run:
     """(first, last) frame of the pointing hold of index-base positions (F, 3) on a character whose
     shoulders are `width` apart (any units, the positions'), or None for a finger that never slows down
     past half its travel; a still arm holds throughout."""
@@ -206,14 +221,15 @@ def hold_frames(base, width, fps=AGENT_FPS):
     return longest_run((speed <= HOLD_SPEED * width) & (travel >= 0.5 * travel.max()))
 
 
-def hold_run(positions, arm, fps=AGENT_FPS):
+def hold_run(positions: ArrayLike, arm: str, fps: float = AGENT_FPS) -> Run:
     """(first, last) frame of the pointing hold (see the module docstring) of a gesture's description
     joint positions, or None."""
     p, side = _positions(positions), _side(arm)
     return hold_frames(p[:, _JOINT[f"{side}_index_base"]], shoulder_width(p), fps)
 
 
-def point_measures(positions, finger_direction, arm, target, fps=AGENT_FPS):
+def point_measures(positions: ArrayLike, finger_direction: ArrayLike, arm: str, target: ArrayLike,
+                   fps: float = AGENT_FPS) -> Measures:
     """{'angle' (degrees, median over the hold of `pointing_angles`), 'hold_s'} of a pointing
     gesture; finger_direction (F, 3): the arm's index-finger direction (base to tip) per frame."""
     p, side = _positions(positions), _side(arm)
@@ -227,7 +243,7 @@ def point_measures(positions, finger_direction, arm, target, fps=AGENT_FPS):
     return {"angle": float(np.median(angles)), "hold_s": (last - first + 1) / fps}
 
 
-def palm_normal(descriptions, arm):
+def palm_normal(descriptions: ArrayLike, arm: str) -> Array:
     """(F, 3) unit normal out of the arm's palm, from descriptions (F, 42): the palm's plane holds the
     wrist, the index base and the index direction (on a human hand the index base sits to the thumb
     side of the wrist's line, 14 degrees off the finger on the sample rig), so no hand rotation is needed."""
@@ -235,17 +251,19 @@ def palm_normal(descriptions, arm):
     side, sign = _side(arm), 1.0 if arm == "LEFT" else -1.0
     across = positions[..., _JOINT[f"{side}_index_base"], :] - positions[..., _JOINT[f"{side}_wrist"], :]
     normal = -sign * np.cross(across, finger_direction(descriptions, arm))
-    return normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+    result: Array = normal / np.linalg.norm(normal, axis=-1, keepdims=True)
+    return result
 
 
-def _degrees_between(a, b):
+def _degrees_between(a: ArrayLike, b: ArrayLike) -> Array:
     """(F,) degrees between the vectors a (F, 3) and b ((F,) 3)."""
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     cosine = np.sum(a * b, axis=-1) / (np.linalg.norm(a, axis=-1) * np.linalg.norm(b, axis=-1))
-    return np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    result: Array = np.degrees(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    return result
 
 
-def free_arm_rise(positions, arm):
+def free_arm_rise(positions: ArrayLike, arm: str) -> float:
     """How far (in its own arm lengths) the *other* arm's wrist rises above its first frame at its highest:
     near 0 when only `arm` gestures, about 1 when both hands go up."""
     p = _positions(positions)
@@ -258,7 +276,7 @@ def free_arm_rise(positions, arm):
 FREE_ARM_RISE = 0.1
 
 
-def _hold_or_apex(p, arm, fps):
+def _hold_or_apex(p: Array, arm: str, fps: float) -> tuple[npt.NDArray[np.int_], float]:
     """(frames, hold_s): the frames of the pointing hold (hold_run) and its length in seconds, or the apex
     alone (the finger base farthest from its start) and 0 when there is no hold."""
     hold = hold_run(p, arm, fps)
@@ -268,7 +286,8 @@ def _hold_or_apex(p, arm, fps):
     return np.arange(hold[0], hold[1] + 1), (hold[1] - hold[0] + 1) / fps
 
 
-def guide_measures(positions, finger_direction, palm, arm, target, fps=AGENT_FPS):
+def guide_measures(positions: ArrayLike, finger_direction: ArrayLike, palm: ArrayLike, arm: str, target: ArrayLike,
+                   fps: float = AGENT_FPS) -> Measures:
     """What a "this way" gesture shows, as medians over its hold (the apex without one):
     {'heading_error' (degrees between the finger's and the target's directions seen from above, the
     target's from the first frame's shoulder joint), 'palm_up' (degrees of the palm normal from
@@ -298,14 +317,14 @@ GUIDE_REACH = 0.5
 GUIDE_MIN_HOLD_S = 0.4
 
 
-def guide_accepted(measures):
+def guide_accepted(measures: Measures) -> bool:
     """Whether `guide_measures` show a "this way" towards the target (the bounds above)."""
     return bool(measures["heading_error"] <= GUIDE_HEADING_DEG and measures["palm_up"] <= GUIDE_PALM_UP_DEG
                 and measures["reach"] >= GUIDE_REACH and measures["hold_s"] >= GUIDE_MIN_HOLD_S
                 and measures["free_arm_rise"] <= FREE_ARM_RISE)
 
 
-def raise_measures(positions, arm, fps=AGENT_FPS):
+def raise_measures(positions: ArrayLike, arm: str, fps: float = AGENT_FPS) -> Measures:
     """What a raised hand shows: {'height' (m of the wrist above the shoulder joint, median over the
     raised hold; the highest frame's without one), 'height_arm' (the same in arm lengths),
     'forearm_from_vertical' (degrees of elbow-to-wrist from straight up, over the same frames),
@@ -339,14 +358,14 @@ RAISE_MAX_STROKES = 3
 RAISE_HEIGHT_ERROR = 0.1
 
 
-def compare_raise(generated, reference, arm, fps=AGENT_FPS):
+def compare_raise(generated: ArrayLike, reference: ArrayLike, arm: str, fps: float = AGENT_FPS) -> Measures:
     """Raise measures of both clips and the generated one's height error (arm lengths, absolute):
     {'generated': {...}, 'reference': {...}, 'height_error'}."""
     gen, ref = raise_measures(generated, arm, fps), raise_measures(reference, arm, fps)
     return {"generated": gen, "reference": ref, "height_error": abs(gen["height_arm"] - ref["height_arm"])}
 
 
-def raise_accepted(comparison):
+def raise_accepted(comparison: Measures) -> bool:
     """Whether a `compare_raise` result raises the hand like its reference (the bounds above)."""
     gen = comparison["generated"]
     return bool(gen["hold_s"] >= RAISE_MIN_HOLD_S and gen["height"] > 0.0
@@ -354,7 +373,7 @@ def raise_accepted(comparison):
                 and comparison["height_error"] <= RAISE_HEIGHT_ERROR and gen["free_arm_rise"] <= FREE_ARM_RISE)
 
 
-def raise_lower(generated, reference, arm):
+def raise_lower(generated: ArrayLike, reference: ArrayLike, arm: str) -> dict[str, float]:
     """Arm elevation (degrees) at the first and last frames of both clips, and the generated clip's
     differences from the reference: {'first', 'last', 'reference_first', 'reference_last',
     'first_error', 'last_error'} (errors are absolute)."""
@@ -364,7 +383,7 @@ def raise_lower(generated, reference, arm):
             "first_error": float(abs(gen[0] - ref[0])), "last_error": float(abs(gen[-1] - ref[-1]))}
 
 
-def variation(outputs):
+def variation(outputs: Sequence[ArrayLike]) -> float:
     """Mean distance (m) between outputs for the same request: over all pairs, the mean over frames
     and joints of the Euclidean distance. outputs: a list of (F, J, 3) of one shape, at least two."""
     clips = [np.asarray(o, dtype=np.float64) for o in outputs]
@@ -375,7 +394,7 @@ def variation(outputs):
     return float(np.mean(distances))
 
 
-def resample(positions, frame_count):
+def resample(positions: ArrayLike, frame_count: int) -> Array:
     """(frame_count, ...) positions linearly interpolated in time over the same span."""
     p = np.asarray(positions, dtype=np.float64)
     source = np.linspace(0.0, 1.0, len(p))
@@ -385,13 +404,14 @@ def resample(positions, frame_count):
     return out.reshape((int(frame_count),) + p.shape[1:])
 
 
-def score_at_length(generated, reference):
+def score_at_length(generated: ArrayLike, reference: ArrayLike) -> float:
     """The paper's score of a clip generated at its own length (e.g. the class-average length) against
     the reference time-scaled to that length."""
+    generated = np.asarray(generated, dtype=np.float64)
     return metrics.score(generated, resample(reference, len(generated)))
 
 
-def dtw_path(generated, reference, band=DTW_BAND):
+def dtw_path(generated: ArrayLike, reference: ArrayLike, band: float = DTW_BAND) -> npt.NDArray[np.int_]:
     """Dynamic time warping of two (F, J, 3) clips under the score's per-frame L1 error -> (P, 2) frame
     pairs from (0, 0) to (F_g - 1, F_r - 1), within a band of `band` x the longer clip around the
     diagonal of normalised time."""
@@ -414,7 +434,7 @@ def dtw_path(generated, reference, band=DTW_BAND):
     return np.array(path[::-1])
 
 
-def aligned_score(generated, reference, band=DTW_BAND):
+def aligned_score(generated: ArrayLike, reference: ArrayLike, band: float = DTW_BAND) -> float:
     """The paper's score over the DTW-matched frame pairs (its per-frame errors and penalties, divided
     by the number of pairs): timing differences within the band cost nothing, shape differences do."""
     gen, ref = _positions(generated, "The generated clip"), _positions(reference, "The reference clip")
@@ -430,7 +450,7 @@ WAVE_FREQUENCY_ERROR = 0.2
 WAVE_MIN_CYCLES = 2
 
 
-def wave_accepted(comparison):
+def wave_accepted(comparison: Measures) -> bool:
     """Whether a `compare_wave` result waves like its reference (the bounds above)."""
     low, high = WAVE_SWING_RATIO
     return bool(low <= comparison["swing_ratio"] <= high
@@ -438,7 +458,8 @@ def wave_accepted(comparison):
                 and comparison["generated"]["cycles"] >= WAVE_MIN_CYCLES)
 
 
-def wave_row(generated, reference, arm, target, fps):
+def wave_row(generated: ArrayLike, reference: ArrayLike, arm: str, target: ArrayLike | None,
+             fps: float) -> dict[str, float]:
     """A wave's measures (`compare_wave` and `wave_accepted`) of descriptions (F, 42), as a flat dict."""
     waves = compare_wave(spaces.description_joint_positions(generated), spaces.description_joint_positions(reference),
                          arm, fps)
@@ -449,7 +470,8 @@ def wave_row(generated, reference, arm, target, fps):
     return result
 
 
-def point_row(generated, reference, arm, target, fps):
+def point_row(generated: ArrayLike, reference: ArrayLike, arm: str, target: ArrayLike | None,
+              fps: float) -> dict[str, float]:
     """A point's measures (`point_measures` of both, target (3,) in the character frame) as a flat dict."""
     if target is None:
         raise RLAnimateError("Pointing measures need the target position (x, y, z).")
@@ -460,7 +482,8 @@ def point_row(generated, reference, arm, target, fps):
             "hold_ratio": ratio(point["hold_s"], reference_point["hold_s"])}
 
 
-def guide_row(generated, reference, arm, target, fps):
+def guide_row(generated: ArrayLike, reference: ArrayLike, arm: str, target: ArrayLike | None,
+              fps: float) -> dict[str, float]:
     """A guide's measures (`guide_measures` of both, target (3,) in the character frame, and `guide_accepted`)."""
     if target is None:
         raise RLAnimateError("Guiding measures need the target position (x, y, z).")
@@ -471,7 +494,8 @@ def guide_row(generated, reference, arm, target, fps):
             "guide_accepted": float(guide_accepted(guide))}
 
 
-def raise_row(generated, reference, arm, target, fps):
+def raise_row(generated: ArrayLike, reference: ArrayLike, arm: str, target: ArrayLike | None,
+              fps: float) -> dict[str, float]:
     """A raised hand's measures (`compare_raise` and `raise_accepted`) of descriptions (F, 42), as a flat dict."""
     raised = compare_raise(spaces.description_joint_positions(generated), spaces.description_joint_positions(reference),
                            arm, fps)
@@ -483,17 +507,18 @@ def raise_row(generated, reference, arm, target, fps):
 #: The measures of what a behaviour does (behaviours.ACTIONS): measure(generated, reference, arm, target, fps) ->
 #: {name: float} from descriptions (F, 42) of a generated clip and its reference (target: (3,) in the character
 #: frame for a target behaviour, else None).
-MEASURES = {behaviours.OSCILLATES: wave_row, behaviours.AIMS: point_row, behaviours.PRESENTS: guide_row,
-            behaviours.RAISES: raise_row}
+MEASURES: dict[str, Measure] = {behaviours.OSCILLATES: wave_row, behaviours.AIMS: point_row,
+                                behaviours.PRESENTS: guide_row, behaviours.RAISES: raise_row}
 
 
-def peak_hand_height(positions, arm):
+def peak_hand_height(positions: ArrayLike, arm: str) -> float:
     """Arm lengths: how high the arm's wrist goes above its shoulder joint, at its highest frame."""
     p, side = _positions(positions), _side(arm)
     return float((p[:, _JOINT[f"{side}_wrist"], 2] - p[:, _JOINT[f"{side}_shoulder"], 2]).max() / arm_length(p, arm))
 
 
-def intensity_row(generated, reference, arm, target, fps):
+def intensity_row(generated: ArrayLike, reference: ArrayLike, arm: str, target: ArrayLike | None,
+                  fps: float) -> dict[str, float]:
     """An intensity behaviour's measures where it has none of its own (a user's gesture, such as a raised hand
     named "hello"): what its exaggeration scales, the hand's peak height ('hand_height_error', arm lengths,
     absolute, against the reference's), and the other arm's rise ('free_arm_rise', and the reference's)."""
@@ -502,7 +527,7 @@ def intensity_row(generated, reference, arm, target, fps):
             "free_arm_rise": free_arm_rise(gen, arm), "reference_free_arm_rise": free_arm_rise(ref, arm)}
 
 
-def aim_error(positions, arm, target, fps=AGENT_FPS):
+def aim_error(positions: ArrayLike, arm: str, target: ArrayLike, fps: float = AGENT_FPS) -> float:
     """Degrees between the shoulder joint's line to the index base and its line to `target` (3,), median over the
     hold (the apex without one)."""
     p, side = _positions(positions), _side(arm)
@@ -512,19 +537,23 @@ def aim_error(positions, arm, target, fps=AGENT_FPS):
     return float(np.median(_degrees_between(base - shoulder, np.asarray(target, dtype=np.float64) - shoulder)))
 
 
-def target_row(generated, reference, arm, target, fps):
+def target_row(generated: ArrayLike, reference: ArrayLike, arm: str, target: ArrayLike | None,
+               fps: float) -> dict[str, float]:
     """A target behaviour's measures where it has none of its own: how far off its target it reaches
     ('aim_error', degrees, and the reference's), and the other arm's rise."""
+    if target is None:
+        raise RLAnimateError("Aim measures need the target position (x, y, z).")
     gen, ref = spaces.description_joint_positions(generated), spaces.description_joint_positions(reference)
     return {"aim_error": aim_error(gen, arm, target, fps), "reference_aim_error": aim_error(ref, arm, target, fps),
             "free_arm_rise": free_arm_rise(gen, arm), "reference_free_arm_rise": free_arm_rise(ref, arm)}
 
 
 #: The measures of a behaviour without MEASURES of its own, by its kind (a target one needs the target).
-KIND_MEASURES = {behaviours.INTENSITY: intensity_row, behaviours.TARGET: target_row}
+KIND_MEASURES: dict[str, Measure] = {behaviours.INTENSITY: intensity_row, behaviours.TARGET: target_row}
 
 
-def compare(generated, reference, behaviour, arm, target=None, fps=AGENT_FPS):
+def compare(generated: ArrayLike, reference: ArrayLike, behaviour: behaviours.Behaviour | None, arm: str,
+            target: ArrayLike | None = None, fps: float = AGENT_FPS) -> dict[str, float]:
     """The behaviour measures of one request, from descriptions (F, 42) of the generated clip and of
     its reference (lengths may differ): raise and lower, and for `behaviour` (a behaviours.Behaviour; None:
     those alone) the MEASURES of what it does, or else those of its kind (KIND_MEASURES; a target behaviour's

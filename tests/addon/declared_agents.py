@@ -51,6 +51,7 @@ def widened_agent(path, added, average_frames=75.0):
     metadata = {**metadata, "format_version": agent_file.FORMAT_VERSION,
                 "spaces": {**metadata["spaces"], "objective_size": space.size},
                 "behaviours": [b.to_dict() for b in space.behaviours],
-                "average_frames": {**metadata["average_frames"], **dict.fromkeys((spec[0] for spec in added), average_frames)}}
+                "average_frames": {**metadata["average_frames"],
+                                   **dict.fromkeys((spec[0] for spec in added), average_frames)}}
     np.savez(path, **widened, **{agent_file.METADATA_KEY: np.array(json.dumps(metadata))})
     return space
