@@ -250,6 +250,7 @@ def _trainer(settings: RunSettings, session: Any, saved: dict | None) -> tuple[T
     """(Trainer, planned epochs) of the resolved `settings` on `session`, from the checkpoint `saved` when
     resuming; a new run with "all" first says which of the library's behaviours it leaves out, and refuses
     a new behaviour that fewer than 3 clips name (library_checks)."""
+    assert settings.behaviour is not None and settings.seed is not None, "resolved settings (resolve) fill both"
     agent_config, train_config = load_preset(settings.preset)
     trained = trained_behaviours(session.train_clips, settings.behaviour)
     if settings.behaviour == behaviours.ALL:
