@@ -39,7 +39,7 @@ from trainer.motion.autolabel import still_free_arm
 from trainer.motion.clip import trained_behaviours, training_space
 from trainer.motion.library_checks import check_new_behaviours, left_out
 from trainer.motion.manifest import manifest_path
-from trainer.paths import DEFAULT_MANIFEST, DEFAULT_OUTPUT
+from trainer.paths import DEFAULT_MANIFEST
 from trainer.reporting import plots
 from trainer.reporting.run_report import write_run_report
 
@@ -51,7 +51,7 @@ RESUMED_SETTINGS = ("behaviour", "clips", "preset", "variant", "seed", "eval_eve
 class RunSettings:
     """What a run is (train.py's command line). A setting left out (None) takes the default its help names,
     or on --resume the run's own value."""
-    output: str = str(DEFAULT_OUTPUT)  # the run's folder: its agent, checkpoint, metrics, report and plots
+    output: str  # the run's folder: its agent, checkpoint, metrics, report and plots
     # the behaviours to learn: all (every behaviour of the clip library), both (point and wave), one
     # behaviour (point), or several joined by commas (point,beckon) (None: all; on --resume, the run's own)
     behaviour: str | None = None

@@ -26,7 +26,7 @@ from trainer.blender_io.import_worker import ImportLimits
 from trainer.experiments import capture
 from trainer.experiments.run import RunSettings, check_settings, resolve, train
 from trainer.files import atomic_copy
-from trainer.paths import INSTALLED_AGENT, RESULTS_DIR, shown
+from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
 from trainer.scripts import cli
 from trainer.scripts.cli import run_main, script_args
 
@@ -37,7 +37,7 @@ INTERRUPTED = "interrupted: the run's checkpoint holds every epoch it finished; 
 @dataclass(frozen=True)
 class TrainSettings:
     """The train command: a run (its options unprefixed: --epochs, --output), and what to do around it."""
-    run: RunSettings = RunSettings()
+    run: RunSettings = RunSettings(output=str(DEFAULT_OUTPUT))
     # with a folder of takes: the share of each behaviour and arm's takes held out for the comparison with retrieval
     hold_out: float = capture.capture_folder.HOLD_OUT_SHARE
     install: bool = False  # install the agent as the add-on's default and its report into docs/results/

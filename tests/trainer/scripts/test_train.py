@@ -1,6 +1,7 @@
 """trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its
 outputs exist and load without torch."""
 import json
+import re
 import subprocess
 import sys
 
@@ -11,7 +12,7 @@ from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_import import load_clip_set
-from trainer.experiments.run import RunSettings
+from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings
 from trainer.paths import REPO_ROOT
 from trainer.scripts import cli, train
 
@@ -38,6 +39,22 @@ def test_every_option_train_had_parses_with_its_meaning(capsys):
     with pytest.raises(SystemExit) as exit_:
         train.parse_settings(["train.py", "--variant", "rlanimat"])
     assert exit_.value.code == 2 and "rlanimat" in capsys.readouterr().err
+
+
+def test_the_help_names_the_defaults_a_new_run_takes(capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "1000")  # one line per option, its help on it or on the next
+    with pytest.raises(SystemExit):
+        train.parse_settings(["train.py", "--help"])
+    entries = []
+    for line in capsys.readouterr().out.splitlines():
+        text = line.strip("│ ")
+        if text.startswith("-"):
+            entries.append(text)
+        elif entries and text:
+            entries[-1] += " " + text
+    for name in ("behaviour", "seed", "preset", "variant", "eval_every"):
+        entry = next(entry for entry in entries if entry.startswith("--" + name.replace("_", "-") + " "))
+        assert re.search(rf"\(.*None: {NEW_RUN_DEFAULTS[name]}[;)]", entry), entry
 
 
 def test_train_cli_writes_an_agent_report_and_plots_that_load(tiny_library, tmp_path):
