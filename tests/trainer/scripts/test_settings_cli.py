@@ -46,19 +46,26 @@ def option_fields(settings_type):
             yield field
 
 
-def options_without_help(settings_type, capsys, monkeypatch):
-    """The options of `settings_type`'s command line whose --help line says nothing but the default."""
+def help_entries(settings_type, capsys, monkeypatch):
+    """The --help of `settings_type`'s command line, one entry per option: its lines joined, its name and metavar,
+    then its help (on its line or the next)."""
     monkeypatch.setenv("COLUMNS", "1000")  # one line per option
     with pytest.raises(SystemExit) as exit_:
         cli.parse_settings(settings_type, ["prog", "--help"], prog="prog", doc="A script.")
     assert exit_.value.code == 0
-    entries = []  # each option's lines joined: its name and metavar, then its help (on its line or the next)
+    entries = []
     for line in capsys.readouterr().out.splitlines():
         text = line.strip("│ ")
         if text.startswith("-"):
             entries.append(text)
         elif entries and text:
             entries[-1] += "  " + text
+    return entries
+
+
+def options_without_help(settings_type, capsys, monkeypatch):
+    """The options of `settings_type`'s command line whose --help line says nothing but the default."""
+    entries = help_entries(settings_type, capsys, monkeypatch)
     missing = []
     for field in option_fields(settings_type):
         option = "--" + field.name.replace("_", "-")

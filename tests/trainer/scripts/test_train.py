@@ -7,6 +7,7 @@ import sys
 
 import numpy as np
 import pytest
+from test_settings_cli import help_entries
 
 from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
@@ -42,16 +43,7 @@ def test_every_option_train_had_parses_with_its_meaning(capsys):
 
 
 def test_the_help_names_the_defaults_a_new_run_takes(capsys, monkeypatch):
-    monkeypatch.setenv("COLUMNS", "1000")  # one line per option, its help on it or on the next
-    with pytest.raises(SystemExit):
-        train.parse_settings(["train.py", "--help"])
-    entries = []
-    for line in capsys.readouterr().out.splitlines():
-        text = line.strip("│ ")
-        if text.startswith("-"):
-            entries.append(text)
-        elif entries and text:
-            entries[-1] += " " + text
+    entries = help_entries(train.TrainSettings, capsys, monkeypatch)
     for name in ("behaviour", "seed", "preset", "variant", "eval_every"):
         entry = next(entry for entry in entries if entry.startswith("--" + name.replace("_", "-") + " "))
         assert re.search(rf"\(.*None: {NEW_RUN_DEFAULTS[name]}[;)]", entry), entry
