@@ -1,13 +1,16 @@
 """The docs as a manual: every relative link and every docs/ path they name exists, and the pages under docs/
 (outside docs/history/) carry no dated log."""
 import re
+import subprocess
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 MANUAL = sorted((ROOT / "docs").glob("*.md"))  # the manual's pages; docs/history/ holds the dated notes
-LINKED = [ROOT / "README.md", ROOT / "trainer" / "README.md", *MANUAL, *sorted((ROOT / "docs" / "history").glob("*.md"))]
+READMES = [ROOT / "README.md", ROOT / "trainer" / "README.md", ROOT / "rlanimate_addon" / "README.md",
+           ROOT / "sample_rigs" / "README.md"]
+LINKED = [*READMES, *MANUAL, *sorted((ROOT / "docs" / "history").glob("*.md"))]
 
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)\)")  # [text](target) and ![alt](target)
 DOCS_PATH = re.compile(r"\bdocs/[\w./{},-]*[\w}]")  # docs/results/table4.{json,md}, docs/TRAINING.md
@@ -52,7 +55,7 @@ def test_every_relative_link_resolves(page):
     assert not missing, f"{page.relative_to(ROOT)} links to what does not exist: {missing}"
 
 
-@pytest.mark.parametrize("page", LINKED[:2] + MANUAL, ids=lambda p: str(p.relative_to(ROOT)))
+@pytest.mark.parametrize("page", READMES + MANUAL, ids=lambda p: str(p.relative_to(ROOT)))
 def test_every_docs_path_named_exists(page):
     named = {p for m in DOCS_PATH.finditer(page.read_text(encoding="utf-8")) for p in _expanded(m.group(0))}
     missing = sorted(p for p in named if not (ROOT / p.rstrip(".,")).exists())
@@ -65,6 +68,30 @@ def test_the_manual_has_no_dated_log(page):
     found = [f"line {text.count(chr(10), 0, m.start()) + 1}: {what} ({m.group(0).strip()!r})"
              for what, marker in DATED_LOG.items() for m in marker.finditer(text)]
     assert not found, f"{page.name} reads as a journal (move it to docs/history/): " + "; ".join(found)
+
+
+def _layout_table() -> str:
+    """The README's "Layout" section."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    return readme[readme.index("## Layout"):].split("\n## ", 1)[0]
+
+
+def test_the_readme_layout_names_every_top_level_path():
+    tracked = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True)
+    if tracked.returncode != 0:
+        pytest.skip(f"not a git checkout ({tracked.stderr.strip()}): the tracked paths are unknown")
+    top = {line.split("/")[0] for line in tracked.stdout.splitlines()} - {"README.md", ".gitignore"}
+    layout = _layout_table()
+    missing = sorted(name for name in top if f"`{name}" not in layout)
+    assert not missing, f"README.md's layout table leaves out {missing}"
+
+
+def test_the_trainer_readme_names_every_module():
+    listed = (ROOT / "trainer" / "README.md").read_text(encoding="utf-8")
+    modules = [f.relative_to(ROOT / "trainer").as_posix() for f in sorted((ROOT / "trainer").rglob("*.py"))
+               if f.name != "__init__.py"]
+    missing = [m for m in modules if f"`{m}`" not in listed]
+    assert not missing, f"trainer/README.md does not list {missing}"
 
 
 def test_the_markers_catch_a_journal_and_pass_a_manual():
