@@ -84,7 +84,7 @@ def further_requests():
     ]
 
 
-def overview_requests():
+def overview_requests() -> list:
     """The requests of the overview sheet: one gesture of each shipped behaviour, right arm."""
     from trainer.blender_io.gesture_render import RenderRequest
     return [
@@ -97,7 +97,7 @@ def overview_requests():
     ]
 
 
-def _generated(settings):
+def _generated(settings: SheetSettings) -> tuple[list, Path]:
     """Which requests --generated renders, and the sheet they go to."""
     if settings.overview:
         return overview_requests(), OVERVIEW_SHEET
