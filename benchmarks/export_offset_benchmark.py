@@ -81,7 +81,7 @@ def _from_time_zero(first, last):
 
 
 #: How the take is timed: Export FBX's context for its scene take, or the ones it is compared with.
-TIMINGS = {"(F - 1) / fps (Export FBX)": None, "from 0 (Export FBX before issue 44)": _from_time_zero,
+TIMINGS = {"(F - 1) / fps (Export FBX)": None, "from 0 (the range's first frame at time 0)": _from_time_zero,
            "F / fps (Blender's exporter alone)": lambda first, last: contextlib.nullcontext()}
 
 
@@ -136,9 +136,9 @@ def main():
         "imports a file): distance of the right hand from where it was baked, on every frame that moves (the idle's",
         "and the wave's), in cm; and the frames the re-imported action spans (the scene's range, 1-250 unless",
         "said, and the rig's animation). Export FBX writes frame F at time (F - 1) / fps, so the",
-        "importer puts every key back on its own frame whatever the scene's start. Timed from 0, as before, a take",
-        "starting on another frame than 1 moved (and frames below 0, which a scene's range cannot hold, were",
-        "lost); timed as Blender's exporter times a scene's take, every key came back one frame late.", "",
+        "importer puts every key back on its own frame whatever the scene's start. Timed from 0, a take",
+        "starting on another frame than 1 moves (and frames below 0, which a scene's range cannot hold, are",
+        "lost); timed as Blender's exporter times a scene's take, every key comes back one frame late.", "",
         f"Regenerate: `{COMMAND}`", "",
         f"Blender {bpy.app.version_string}.", "",
         "| character | take timed | median (cm) | worst (cm) | re-imported frames |",

@@ -89,7 +89,7 @@ def _accept(rig, settings, name, folder):
         settings.bone_map_file = real_rigs.write_bone_map(_bone_map(name), folder)
         try:
             real_rigs.wave(rig, settings, "RIGHT", 5000)
-            return "with a user bone map (refused before, naming the fix)", False
+            return "with a user bone map (without one, refused naming the fix)", False
         except RuntimeError as error:
             refusal = str(error).removeprefix("Error: ")
     return "refused: " + refusal[:150].replace("|", "/") + "...", None

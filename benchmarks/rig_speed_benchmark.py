@@ -408,7 +408,7 @@ Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other engi
 
 {table(rows)}
 
-Targets (issue 43): at most 1.0 on every rig at 120 frames, 0.75 on the sample character at rest, the Rigify
+Targets: at most 1.0 on every rig at 120 frames, 0.75 on the sample character at rest, the Rigify
 rig under 1 s a click.
 
 Follow Target, on the same files: Generate with Follow Target on, then a scripted drag of {DRAG_MOVES} target
@@ -424,7 +424,7 @@ read again, its dependants baked again), and its keys are Generate's for that po
 
 {drag_table(drags)}
 
-Targets (issue 43): at least 20 re-bakes a second on the sample character, 5 on the Rigify rig.
+Targets: at least 20 re-bakes a second on the sample character, 5 on the Rigify rig.
 
 Where a click's time goes: CPU milliseconds per click in Generate's stages, on the same files (the mean of
 {args.rounds} clicks after a warm-up, the instrumented functions' inclusive time; "dependants" is the gestures

@@ -56,8 +56,8 @@ def main():
 
 Wall seconds of `python -m pytest -q` (the whole suite on Blender 5.0) in one process and as
 `scripts/run_tests.sh` runs it, with test files spread over every core (pytest-xdist, `--dist loadfile`,
-so each file's module fixtures are built once); {args.pairs} interleaved pairs. "Faster" is against the
-90 s the single-process suite took when issue 9 was filed.
+so each file's module fixtures are built once); {args.pairs} interleaved pairs. "Faster" is against a 90 s
+baseline (the single-process suite of an early tree).
 
 Regenerate: `{COMMAND}`
 

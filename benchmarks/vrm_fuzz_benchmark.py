@@ -82,8 +82,8 @@ def section(args, counts, measures, per_seed, elapsed, peak):
         "exception, or any other map: the target is 0). Median and worst ms: one read;",
         f"worst MB: its peak memory by tracemalloc, in a second read (the bounds: {MAX_READ_SECONDS:g} s and "
         f"{MAX_READ_MB:g} MB). The reader caps the", f"JSON chunk at {vrm.MAX_JSON_BYTES:,} bytes and its "
-        f"nesting at {vrm.MAX_NESTING} (before, a 32 MB chunk took 6-12 s and 1.14 GB, and 1,000 deep",
-        "raised RecursionError).", "",
+        f"nesting at {vrm.MAX_NESTING} (uncapped, a 32 MB chunk takes 6-12 s and 1.14 GB, and 1,000 deep",
+        "raises RecursionError).", "",
         f"Regenerate: `{COMMAND} --mutations {args.mutations} --seeds {seeds}`", "",
         f"Machine: {platform.machine()}, {os.cpu_count()} CPU cores shared with other jobs, Python "
         f"{platform.python_version()}, numpy {np.__version__}. {elapsed:.1f} s in all, peak memory of the run "

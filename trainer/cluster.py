@@ -39,7 +39,7 @@ def connect(address: str | None = None, workers: int | None = None) -> None:
     import ray
     if ray.is_initialized():
         return
-    options = {"log_to_driver": False, "logging_level": logging.ERROR}
+    options: dict[str, Any] = {"log_to_driver": False, "logging_level": logging.ERROR}
     if address is None:  # the local workers inherit this environment
         os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, (str(REPO_ROOT), os.environ.get("PYTHONPATH"))))
         options.update(num_cpus=workers, include_dashboard=False)
@@ -66,7 +66,12 @@ def _watch(interval: float = 0.5, grace: float = 1.0) -> None:
     then SIGKILL any left after `grace` seconds."""
     driver, started = os.getppid(), {}
     gone = threading.Event()
-    threading.Thread(target=lambda: (sys.stdin.buffer.read(), gone.set()), daemon=True).start()
+
+    def wait_for_the_driver() -> None:
+        sys.stdin.buffer.read()
+        gone.set()
+
+    threading.Thread(target=wait_for_the_driver, daemon=True).start()
     while not gone.wait(interval):
         started.update(process_tree(driver))
     started.pop(os.getpid(), None)
@@ -85,14 +90,16 @@ def _watch(interval: float = 0.5, grace: float = 1.0) -> None:
 
 def process_tree(root: int) -> dict[int, int]:
     """{pid: start time} of the running processes descended from `root` (Linux /proc), `root` not among them."""
-    children, starts = {}, {}
+    children: dict[int, list[int]] = {}
+    starts: dict[int, int] = {}
     for entry in os.scandir("/proc"):
         if entry.name.isdigit():
             fields = _stat_fields(int(entry.name))
             if fields is not None and fields[0] != "Z":
                 children.setdefault(int(fields[1]), []).append(int(entry.name))
                 starts[int(entry.name)] = int(fields[19])
-    tree, stack = {}, list(children.get(root, []))
+    tree: dict[int, int] = {}
+    stack = list(children.get(root, []))
     while stack:
         pid = stack.pop()
         tree[pid] = starts[pid]
@@ -131,7 +138,8 @@ def run_tasks(function: Callable[[Any], Any], arguments: Iterable[Any],
         except ray.exceptions.RayError as error:
             for reference in pending:
                 ray.cancel(reference, force=True)
-            if isinstance(getattr(error, "cause", None), RLAnimateError):
-                raise RLAnimateError(f"{name(argument)}: {error.cause}") from None
+            cause = getattr(error, "cause", None)
+            if isinstance(cause, RLAnimateError):
+                raise RLAnimateError(f"{name(argument)}: {cause}") from None
             raise RuntimeError(f"The task for {name(argument)} failed: {error}") from error
         yield argument, result

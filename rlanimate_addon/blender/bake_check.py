@@ -137,8 +137,9 @@ def _rest_matrices(obj, names):
 def verify(scene, plan):
     """RLAnimateError when the baked plan does not play: the deformed hand or finger off the plan, or the
     target of a target behaviour (Point) that moves with the gesture. plan: generate._Plan after its write."""
-    obj, rig, arm = plan.obj, plan.rig, plan.settings.arm
-    pose = bake_measure.planned_pose(rig, arm, plan.bones, plan.keyed)  # (N, B, 4, 4)
+    obj, made, arm = plan.obj, plan.gesture, plan.settings.arm
+    rig = made.rig
+    pose = bake_measure.planned_pose(rig, arm, made.bones, made.keyed)  # (N, B, 4, 4)
     planned = bake_measure.planned_points(rig, arm, pose)  # (N, 3, 3)
     measured = bake_measure.measured_bones(rig.roles, arm)
     deformed = deformed_bones(obj)
@@ -146,28 +147,28 @@ def verify(scene, plan):
     scale = float(np.cbrt(abs(np.linalg.det(np.array(obj.matrix_world.to_3x3())))))
     rest_points, carrier_rests = bake_measure.rest_points(rig, arm), _rest_matrices(obj, carriers)
     start = int(plan.settings.start_frame)
-    for index in bake_measure.check_frames(len(plan.keyed), planned[:, 0], plan.shown):
+    for index in bake_measure.check_frames(len(made.keyed), planned[:, 0], plan.request.shown):
         frame = start + index
         scene.frame_set(frame)
         played = bake_measure.carried(_armature_matrices(obj, carriers)[None], carrier_rests, rest_points)
         distance, angle = (float(v[0]) for v in bake_measure.misses(planned[index:index + 1], played, scale))
         if distance > bake_measure.HAND_TOLERANCE or angle > bake_measure.FINGER_TOLERANCE_DEG:
-            cause = _cause(obj, rig, pose[index], measured, carriers, plan.bones)
+            cause = _cause(obj, rig, pose[index], measured, carriers, made.bones)
             raise RLAnimateError(
                 f"The bake of {obj.name!r} would not play, so it was undone: at frame {frame} the hand the mesh "
                 f"deforms with ({carriers[0]}) is {100 * distance:.1f} cm from where the gesture puts it and its "
                 f"finger {angle:.1f} degrees off. {cause}")
-        if plan.targets is not None:
-            _check_target(obj, plan, frame, plan.targets[index], scale)
+        if made.targets is not None:
+            _check_target(obj, made, frame, made.targets[index], scale)
 
 
-def _check_target(obj, plan, frame, sampled, scale):
+def _check_target(obj, made, frame, sampled, scale):
     """RLAnimateError when the target (of Point or another target behaviour), evaluated at frame after the
     bake, left where it was read."""
-    now = armature_io.target_point(obj, plan.target, plan.target_bone, bpy.context.scene)
+    now = armature_io.target_point(obj, made.target, made.target_bone, bpy.context.scene)
     moved = float(np.linalg.norm(now - sampled)) * scale
     if moved > bake_measure.HAND_TOLERANCE:
-        what = repr(plan.target.name) + (f" bone {plan.target_bone!r}" if plan.target_bone else "")
+        what = repr(made.target.name) + (f" bone {made.target_bone!r}" if made.target_bone else "")
         raise RLAnimateError(
             f"The bake of {obj.name!r} was undone: the target {what} moves with the gesture ({100 * moved:.1f} cm at "
             f"frame {frame}; it is, or hangs from, a bone the gesture turns), so the finger would point where the "

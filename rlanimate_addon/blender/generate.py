@@ -8,7 +8,10 @@ gestures that depend on the one it changed (their aim, their start pose) are bak
 unless edited by hand. blender/gestures.py describes how a gesture's keys are laid out.
 """
 import contextlib
+import dataclasses
 import types
+from collections.abc import Sequence
+from typing import Any
 
 import bpy
 import numpy as np
@@ -144,41 +147,86 @@ def selected_armatures(context, settings):
     return found
 
 
-class _Plan:
-    """One armature's checked settings, and then its gesture, ready to write."""
+@dataclasses.dataclass(frozen=True)
+class _Armature:
+    """The armature checked for the gesture: its bones' roles, and the constraints the gesture mutes."""
+    obj: Any
+    family: str  # its bone naming (rig_roles)
+    roles: dict[str, str]  # {role: bone}
+    overriding: list  # the constraints that would override the gesture (constraints.against_gesture)
+    ik_share: Any  # a Rigify arm in IK: its IK_FK value, switched to FK over the gesture; else None
 
-    def __init__(self, obj, family, roles, overriding, ik_share=None):
-        self.obj, self.family, self.roles, self.overriding = obj, family, roles, overriding
-        self.ik_share = ik_share  # a Rigify arm in IK: its IK_FK value, switched to FK over the gesture
-        self.from_ik = False  # ... and whether it stands in IK (IK_FK below 1) on any of the gesture's frames
-        self.properties = None
-        self.settings = self.rig = self.bones = self.keyed = self.keys = self.blend_type = self.action = None
-        self.target, self.target_bone, self.targets = None, "", None  # Point's target and where it was read
-        self.previous = self.before = None  # the gesture it bakes again in place, and its Span before
-        self.taken = None  # the earlier gesture on its arm it takes over from (trimmed at its start)
-        self.taking = None  # the Span of the later gesture on its arm that takes over from it
-        self.still = False  # made as on a still rig: the rig's base (blender/gestures.py)
-        self.under = {}  # {bone: channel values} of keyed bones that stand still underneath
-        self.worst = 0.0
-        self.hold = False  # the constraints it mutes stay muted beyond its frames (constraints.follow_rest)
-        self.preview = ""  # baked while Follow Target drags its target: GESTURE or AIM (`bake`)
+
+@dataclasses.dataclass(frozen=True)
+class _Request:
+    """What Generate is asked, and what it does to the armature's other gestures."""
+    settings: Any  # the panel's settings (properties.settings_for) or a gesture's recorded ones
+    still: bool  # made as on a still rig: the rig's base (blender/gestures.py)
+    previous: Any = None  # the gesture it bakes again in place (gestures.Placed), or None: a new one
+    before: Any = None  # ... and that gesture's Span before
+    taken: Any = None  # the earlier gesture on its arm it takes over from (trimmed at its start), or None
+    taking: Any = None  # the Span of the later gesture on its arm that takes over from it, or None
+    preview: str = ""  # baked while Follow Target drags its target: GESTURE or AIM (`bake`)
 
     @property
-    def frames(self):
+    def frames(self) -> tuple[int, int]:
         """(first, last) frame of the gesture."""
         start = int(self.settings.start_frame)
         return start, start + int(self.settings.frame_count) - 1
 
     @property
-    def shown(self):
+    def shown(self) -> int:
         """Frames from its start the gesture plays at full influence: all, or up to where a later one on its
         arm takes over."""
         start, end = self.frames
         return end - start + 1 if self.taking is None else min(end, self.taking.start) - start + 1
 
 
+@dataclasses.dataclass(frozen=True)
+class _Gesture:
+    """The gesture made for a request on an armature, ready to write."""
+    rig: gesture.RigState  # the rig as the gesture is made over it
+    bones: Sequence[str]  # the bones it keys, in the columns of `keyed`
+    keyed: np.ndarray  # (N, B, 4) their local quaternions as the gesture plays them
+    keys: dict  # {MAIN: keys, TORSO: keys} (key_layers.key_action's)
+    blend_type: str  # of its main layer
+    worst: float  # editable keys: the worst deviation of the reduced keys (degrees)
+    hold: bool  # the constraints it mutes stay muted beyond its frames (constraints.follow_rest)
+    under: dict  # {bone: channel values} of keyed bones that stand still underneath
+    from_ik: bool  # a Rigify arm standing in IK (IK_FK below 1) on any of the gesture's frames
+    properties: Any = None  # a Rigify arm in IK: its IK_FK switch keys (rigify.switch_keys)
+    target: Any = None  # a target behaviour's target object, or None (none, or the 3D cursor)
+    target_bone: str = ""  # ... its bone
+    targets: Any = None  # ... (N, 3) where it was read on each frame
+
+
+@dataclasses.dataclass(frozen=True)
+class _Checked:
+    """A request checked on an armature."""
+    request: _Request
+    armature: _Armature
+
+    @property
+    def obj(self) -> Any:
+        return self.armature.obj
+
+    @property
+    def settings(self) -> Any:
+        return self.request.settings
+
+    @property
+    def frames(self) -> tuple[int, int]:
+        return self.request.frames
+
+
+@dataclasses.dataclass(frozen=True)
+class _Plan(_Checked):
+    """A checked request and the gesture made for it, ready to write."""
+    gesture: _Gesture
+
+
 def _check(obj, settings, start, end, mute_constraints, still):
-    """The armature's _Plan; RLAnimateError when it cannot take the gesture."""
+    """The checked _Armature; RLAnimateError when it cannot take the gesture."""
     check_not_editing(obj)
     family, roles = armature_io.rig_roles_of(obj, settings.bone_map_file)
     rig_roles.check_roles(obj.name, roles, settings.arm, family)
@@ -197,13 +245,13 @@ def _check(obj, settings, start, end, mute_constraints, still):
     constraints.check_drivers(obj, driven)
     overriding = constraints.against_gesture(obj, driven)
     constraints.check(obj, overriding, start, end, mute_constraints)
-    return _Plan(obj, family, roles, overriding, ik_share)
+    return _Armature(obj, family, roles, overriding, ik_share)
 
 
-def _plan(obj, settings, selected, mute_constraints):
-    """The checked _Plan of a gesture on an armature, and what it does to the armature's other gestures: the
-    one it bakes again (`selected`: a gesture's name, else the one on its arm starting on its frame), the one it
-    takes over from and the one taking over from it (none with Keep Previous: it layers)."""
+def _plan(obj, settings, selected, mute_constraints, preview):
+    """The request of a gesture on an armature checked (_Checked), and what it does to the armature's other
+    gestures: the one it bakes again (`selected`: a gesture's name, else the one on its arm starting on its frame),
+    the one it takes over from and the one taking over from it (none with Keep Previous: it layers)."""
     start = int(settings.start_frame)
     end = start + int(settings.frame_count) - 1
     placed = gestures.placed_gestures(obj)
@@ -212,22 +260,20 @@ def _plan(obj, settings, selected, mute_constraints):
     match = composition.regenerated(spans, settings.arm, start, selected, settings.keep_previous)
     previous = None if match is None else named[match.id]
     still = previous.still if previous is not None else not action_adapter.is_animated(obj)
-    plan = _check(obj, settings, start, end, mute_constraints, still)
-    plan.settings, plan.previous, plan.still = settings, previous, still
+    armature = _check(obj, settings, start, end, mute_constraints, still)
+    request = _Request(settings, still, previous, previous.span if previous is not None else None, preview=preview)
     if previous is not None:
-        plan.before = previous.span
         _check_unedited(previous, settings, "bake it again")
-    if previous is not None and previous.span.layered:
-        return plan
-    if not settings.keep_previous:
-        exclude = () if previous is None else (previous.name,)
-        taken = composition.taken_over(spans, settings.arm, start, exclude)
-        plan.taken = None if taken is None else named[taken.id]
-        plan.taking = composition.taking_over(spans, settings.arm, start, end, exclude)
-        if plan.taken is not None and plan.taken.still:  # a base fades its own keys: its edits would be lost
-            _check_unedited(plan.taken, settings, "take over from it at frame {start}, fading its keys",
-                            skip=plan.taken.other_arm_curves())
-    return plan
+    if (previous is not None and previous.span.layered) or settings.keep_previous:
+        return _Checked(request, armature)
+    exclude = () if previous is None else (previous.name,)
+    taken = composition.taken_over(spans, settings.arm, start, exclude)
+    request = dataclasses.replace(request, taken=None if taken is None else named[taken.id],
+                                  taking=composition.taking_over(spans, settings.arm, start, end, exclude))
+    if request.taken is not None and request.taken.still:  # a base fades its own keys: its edits would be lost
+        _check_unedited(request.taken, settings, "take over from it at frame {start}, fading its keys",
+                        skip=request.taken.other_arm_curves())
+    return _Checked(request, armature)
 
 
 def _check_unedited(placed, settings, doing, skip=()):
@@ -256,10 +302,10 @@ def _scales(obj, names):
 
 
 def _compute(context, plan, agent, frames):
-    """Fill in the plan's gesture and keys (nothing written), on one BLAS thread: every product here is
-    small, and on a machine with busy cores BLAS threads only wait (core/blas_threads.py)."""
+    """The checked plan with its gesture and keys made (_Plan; nothing written), on one BLAS thread: every product
+    here is small, and on a machine with busy cores BLAS threads only wait (core/blas_threads.py)."""
     with blas_threads.single_blas_thread():
-        obj, scene, settings = plan.obj, context.scene, plan.settings
+        scene, settings = context.scene, plan.settings
         original_frame = scene.frame_current
         targeted = agent.kind(settings.behaviour) == behaviours.TARGET
         target = settings.target if targeted else None
@@ -274,24 +320,32 @@ def _compute(context, plan, agent, frames):
                                          exaggeration=settings.exaggeration, seed=settings.seed or None,
                                          tempo=settings.tempo or None, exact_aim=settings.exact_aim,
                                          fps=properties.scene_fps(scene))
-        plan.bones, plan.keyed, below = _rotations(agent, request, rig, plan, frames)
-        if target is not None:
-            plan.target, plan.target_bone, plan.targets = target, bone, targets
-        plan.rig, plan.blend_type = rig, "REPLACE" if plan.still else settings.blend_type
-        # A still rig held at rest by its constraints stands as any still rig does: they stay muted.
-        plan.hold = bool(plan.overriding) and plan.still and constraints.follow_rest(obj, plan.overriding)
-        if plan.ik_share is not None:
-            plan.properties = rigify.switch_keys(obj, settings.arm, switch, plan.blend_type, rig.animated)
-        plan.under = {bone: below_values[bone][0] for bone in plan.bones
-                      if not np.ptp(below_values[bone], axis=0).any()}
-        if rig.resting:  # a base keeps where its bones first stood, whatever gestures above move them since
-            plan.under.update({bone: values for bone, values in plan.previous.record["under"].items()
-                               if bone in rig.resting and bone in plan.bones})
-        plan.keys = _keys(plan, below, below_values)
+        bones, keyed, below = _rotations(agent, request, rig, plan, frames)
+        aim = {"target": target, "target_bone": bone, "targets": targets} if target is not None else {}
+        return _made(plan, rig, bones, keyed, below, below_values, switch, aim)
+
+
+def _made(plan, rig, bones, keyed, below, below_values, switch, aim):
+    """The _Plan of the checked plan and its gesture's rotations over the rig: its keys and what they mute."""
+    obj, still, overriding = plan.obj, plan.request.still, plan.armature.overriding
+    blend_type = "REPLACE" if still else plan.settings.blend_type
+    # A still rig held at rest by its constraints stands as any still rig does: they stay muted.
+    hold = bool(overriding) and still and constraints.follow_rest(obj, overriding)
+    switch_keys = None
+    if plan.armature.ik_share is not None:
+        switch_keys = rigify.switch_keys(obj, plan.settings.arm, switch, blend_type, rig.animated)
+    under = {bone: below_values[bone][0] for bone in bones if not np.ptp(below_values[bone], axis=0).any()}
+    if rig.resting:  # a base keeps where its bones first stood, whatever gestures above move them since
+        under.update({bone: values for bone, values in plan.request.previous.record["under"].items()
+                      if bone in rig.resting and bone in bones})
+    keys, worst = _keys(plan, bones, keyed, blend_type, below, below_values)
+    made = _Gesture(rig, bones, keyed, keys, blend_type, worst, hold, under,
+                    from_ik=switch is not None and bool(np.any(switch < 1.0)), properties=switch_keys, **aim)
+    return _Plan(plan.request, plan.armature, made)
 
 
 #: The rig as a Follow Target drag's first re-bake read it, for the drag's other re-bakes (`bake`'s preview):
-#: {_read_key: (RigState, rotation values, IK_FK or None, from_ik)}; and the gesture it last baked before its aim
+#: {_read_key: (RigState, rotation values, IK_FK or None)}; and the gesture it last baked before its aim
 #: ({_read_key: gesture.Blended}), which a preview of the aim alone aims again.
 _reads: dict = {}
 _blends: dict = {}
@@ -307,33 +361,33 @@ def _rotations(agent, request, rig, plan, frames):
     """gesture.gesture_rotations' result; in a preview of the aim alone, the gesture the drag baked last, aimed
     at the request's targets (the agent not run again)."""
     key = _read_key(plan, frames)
-    blended = _blends.get(key) if plan.preview == AIM else None
+    blended = _blends.get(key) if plan.request.preview == AIM else None
     if blended is None:
         blended = gesture.blended_gesture(agent, request, rig)
-    if plan.preview:
+    if plan.request.preview:
         _blends[key] = blended
     return gesture.aimed(request, rig, blended)
 
 
 def _read_key(plan, frames):
-    previous = plan.previous.name if plan.previous is not None else ""
+    previous = plan.request.previous.name if plan.request.previous is not None else ""
     return (plan.obj.as_pointer(), previous, int(frames[0]), len(frames), plan.settings.arm, plan.settings.behaviour,
-            tuple(sorted(plan.roles.items())), tuple(bone for bone, _ in plan.overriding))
+            tuple(sorted(plan.armature.roles.items())), tuple(bone for bone, _ in plan.armature.overriding))
 
 
 def _read_once(context, plan, frames, target, bone):
     """`_read_rig`'s result (the caller sets the gesture baked again aside). In a preview, the rig as the drag's
     first re-bake read it, the target where it is now, where neither the rig nor the target can move."""
     obj, key = plan.obj, _read_key(plan, frames)
-    if plan.preview and key in _reads:  # kept only where neither moves
-        rig, values, switch, plan.from_ik = _reads[key]
+    if plan.request.preview and key in _reads:  # kept only where neither moves
+        rig, values, switch = _reads[key]
         point = armature_io.target_point(obj, target, bone, context.scene)
         return rig, values, np.broadcast_to(point, (len(frames), 3)), switch
     rig, values, targets, switch = _read_rig(context, plan, frames, target, bone)
     still = not armature_io.may_move(obj) and (target is None or not armature_io.may_move(target)) and not (
         bone and action_adapter.is_animated(target))
-    if plan.preview and still:
-        _reads[key] = (rig, values, switch, plan.from_ik)
+    if plan.request.preview and still:
+        _reads[key] = (rig, values, switch)
     return rig, values, targets, switch
 
 
@@ -342,19 +396,19 @@ def _read_rig(context, plan, frames, target, bone):
     Rigify arm's (N,) IK_FK underneath or None): each frame played once, with the constraints the gesture mutes
     off (the pose it plays over, which Exact Aim solves on). A Rigify arm's ORG- bones are read in the same pass,
     unless constraints are muted: then as the rig plays with them, in a pass of their own."""
-    obj, arm = plan.obj, plan.settings.arm
-    rigify_arm = rigify.arm_reads(arm) if plan.ik_share is not None else ((), ())
-    alongside = rigify_arm if not plan.overriding else ((), ())
-    with constraints.muted(context.view_layer, plan.overriding):
-        rig, values, targets, played = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, target,
-                                                              bone, *alongside)
+    obj, arm, armature = plan.obj, plan.settings.arm, plan.armature
+    rigify_arm = rigify.arm_reads(arm) if armature.ik_share is not None else ((), ())
+    alongside = rigify_arm if not armature.overriding else ((), ())
+    with constraints.muted(context.view_layer, armature.overriding):
+        rig, values, targets, played = armature_io.sample_rig(context, obj, armature.roles, armature.family, frames,
+                                                              target, bone, *alongside)
     rig = _as_made(plan, rig, values, frames)
-    if plan.ik_share is None:
+    if armature.ik_share is None:
         return rig, values, targets, None
-    if plan.overriding:
-        played = armature_io.sample_rig(context, obj, plan.roles, plan.family, frames, None, "", *rigify_arm)[3]
+    if armature.overriding:
+        played = armature_io.sample_rig(context, obj, armature.roles, armature.family, frames, None, "",
+                                        *rigify_arm)[3]
     controls, switch = rigify.played_arm(arm, played)
-    plan.from_ik = bool(np.any(switch < 1.0))
     return rig_rigify.snap_fk(rig, rig_rigify.fk_controls(arm), controls), values, targets, switch
 
 
@@ -365,46 +419,46 @@ def _as_made(plan, rig, values, frames):
     start frame, over its blend in; the spine, neck and head as the animation plays them without the turns
     other gestures add. values: {bone: (N, C) rotation channel values underneath}."""
     animated, resting, count = rig.animated, {}, len(frames)
-    pose_bones = plan.obj.pose.bones
-    if plan.previous is not None and plan.previous.still:
+    pose_bones, previous = plan.obj.pose.bones, plan.request.previous
+    if previous is not None and previous.still:
         animated, moved = gestures.animator_bones(plan.obj)
         resting = {bone: armature_io.rotation_basis(pose_bones[bone], kept)
-                   for bone, kept in plan.previous.record["under"].items()
+                   for bone, kept in previous.record["under"].items()
                    if bone in rig.skeleton.index and bone not in moved}
     torso = {rig.roles[role]: values[rig.roles[role]] for role in gesture.TORSO if role in rig.roles}
-    own = plan.previous.torso.track if plan.previous is not None and plan.previous.torso is not None else None
+    own = previous.torso.track if previous is not None and previous.torso is not None else None
     animation, above = gestures.torso_layers(plan.obj, torso, frames, own)
     bare = {}
     for bone, kept in animation.items():
         bare[bone] = np.tile(np.eye(4), (count, 1, 1))
         bare[bone][:, :3, :3] = pose_underneath.rotation_matrices(pose_bones[bone].rotation_mode, kept)
-    held = gesture.blend_ramp(count) + 1 if plan.taken is not None else 0
+    held = gesture.blend_ramp(count) + 1 if plan.request.taken is not None else 0
     return gesture.RigState(rig.name, rig.skeleton, rig.roles, rig.family, rig.under, animated, rig.under_pose,
-                            still=plan.still, held=held, resting=resting, bare=bare, above=above)
+                            still=plan.request.still, held=held, resting=resting, bare=bare, above=above)
 
 
-def _keys(plan, below, below_values):
-    """{MAIN: keys, TORSO: keys} (key_layers.key_action's) of the plan's bones in their own rotation modes: the
-    spine, neck and head on the Combine torso layer, the others on the main one, of the plan's blend type. A
-    torso bone in axis-angle goes on the main layer: the NLA adds axis-angle channels over nothing below as
-    over zeros, not over the mode's rest (0, 0, 1, 0), so a Combine key of it would not play as planned."""
-    settings = plan.settings
-    torso = {plan.roles[role] for role in gesture.TORSO
-             if role in plan.roles and plan.obj.pose.bones[plan.roles[role]].rotation_mode != "AXIS_ANGLE"}
-    keys = {MAIN: {}, TORSO: {}}
-    for column, bone in enumerate(plan.bones):
+def _keys(plan, bones, keyed, main_blend_type, below, below_values):
+    """({MAIN: keys, TORSO: keys} (key_layers.key_action's), the worst deviation of editable keys in degrees) of
+    the bones in their own rotation modes: the spine, neck and head on the Combine torso layer, the others on the
+    main one, of `main_blend_type`. A torso bone in axis-angle goes on the main layer: the NLA adds axis-angle
+    channels over nothing below as over zeros, not over the mode's rest (0, 0, 1, 0), so a Combine key of it would
+    not play as planned."""
+    settings, roles, pose_bones = plan.settings, plan.armature.roles, plan.obj.pose.bones
+    torso = {roles[role] for role in gesture.TORSO
+             if role in roles and pose_bones[roles[role]].rotation_mode != "AXIS_ANGLE"}
+    keys, worst = {MAIN: {}, TORSO: {}}, 0.0
+    for column, bone in enumerate(bones):
         layer = TORSO if bone in torso else MAIN
-        blend_type = "COMBINE" if layer == TORSO else plan.blend_type
-        mode = plan.obj.pose.bones[bone].rotation_mode
-        values = channels.rotation_keys(mode, plan.keyed[:, column], below[:, column], below_values[bone],
-                                        blend_type)
+        blend_type = "COMBINE" if layer == TORSO else main_blend_type
+        mode = pose_bones[bone].rotation_mode
+        values = channels.rotation_keys(mode, keyed[:, column], below[:, column], below_values[bone], blend_type)
         kept = None
         if settings.editable_keys:
             added = below_values[bone] if blend_type == "COMBINE" and mode != "QUATERNION" else None
             kept, deviation = key_reduction.reduce_keys(mode, values, settings.key_tolerance, offset=added)
-            plan.worst = max(plan.worst, deviation)
+            worst = max(worst, deviation)
         keys[layer][bone] = (mode, values, kept)
-    return keys
+    return keys, worst
 
 
 def generate(context, settings, progress=lambda step: None, mute_constraints=False):
@@ -458,9 +512,7 @@ def baking():
 
 
 def _bake(context, requests, progress, mute_constraints, cascade, preview):
-    plans = [_plan(obj, own, selected, mute_constraints) for obj, own, selected in requests]
-    for plan in plans:
-        plan.preview = preview
+    plans = [_plan(obj, own, selected, mute_constraints, preview) for obj, own, selected in requests]
     agent = preferences.selected_agent(context)
     for plan in plans:
         gesture.check_length(int(plan.settings.frame_count))
@@ -490,19 +542,20 @@ def _evaluated(plans):
 def _bake_plans(context, plans, agent, progress, cascade):
     """Compute, write and verify the checked plans, then bake their dependants again; returns the summary lines."""
     # Backups of the gestures it changes (rewritten in place, trimmed), made before BakeUndo records the file.
-    trimmed = [key_layers.Backup(plan.taken) for plan in plans if plan.taken is not None]
-    rewritten = [key_layers.Backup(plan.previous) for plan in plans if plan.previous is not None]
+    trimmed = [key_layers.Backup(plan.request.taken) for plan in plans if plan.request.taken is not None]
+    rewritten = [key_layers.Backup(plan.request.previous) for plan in plans if plan.request.previous is not None]
+    made = []
     try:
         for plan in plans:
             start, count = plan.frames[0], int(plan.settings.frame_count)
-            if plan.taken is not None:  # its pose at the handover is where this one starts
-                key_layers.trim(plan.taken, start, gesture.blend_ramp(count))
+            if plan.request.taken is not None:  # its pose at the handover is where this one starts
+                key_layers.trim(plan.request.taken, start, gesture.blend_ramp(count))
             # The gesture baked again set aside while the rig is read (unless a preview reads it no more), and put
             # back as it stood should the bake be refused.
-            previous = [plan.previous] if plan.previous is not None else []
-            reread = not (plan.preview and _read_key(plan, start + np.arange(count)) in _reads)
+            previous = [plan.request.previous] if plan.request.previous is not None else []
+            reread = not (plan.request.preview and _read_key(plan, start + np.arange(count)) in _reads)
             with gestures.detached(previous, context.view_layer) if reread else contextlib.nullcontext():
-                _compute(context, plan, agent, start + np.arange(count))
+                made.append(_compute(context, plan, agent, start + np.arange(count)))
     except BaseException:
         for backup in trimmed:
             backup.restore()
@@ -510,21 +563,21 @@ def _bake_plans(context, plans, agent, progress, cascade):
             backup.discard()
         raise
     progress(3)
-    lines = _write_and_verify(context, plans, agent, trimmed + rewritten)
+    written = _write_and_verify(context, made, agent, trimmed + rewritten)
     progress(4)
-    if cascade and not any(plan.preview for plan in plans):
-        lines = [line + _cascade(context, plan) for line, plan in zip(lines, plans, strict=True)]
-    return lines
+    if cascade and not any(plan.request.preview for plan in plans):
+        return [line + _cascade(context, plan, action) for (line, action), plan in zip(written, plans, strict=True)]
+    return [line for line, _ in written]
 
 
 def _write_and_verify(context, plans, agent, backups):
     """Write every plan, then play each and verify it (blender/bake_check.py): a bake that does not play is
-    undone, every plan's, the gestures it changed put back. Returns the summary lines."""
-    undo = [bake_check.BakeUndo(plan.obj, plan.overriding, rigify.switches(plan.obj, plan.properties))
+    undone, every plan's, the gestures it changed put back. Returns (summary line, action written) per plan."""
+    undo = [bake_check.BakeUndo(plan.obj, plan.armature.overriding, rigify.switches(plan.obj, plan.gesture.properties))
             for plan in plans]
     scene = context.scene
     original_frame = scene.frame_current
-    lines = [_write(plan, agent, scene) for plan in plans]
+    written = [_write(plan, agent, scene) for plan in plans]
     try:
         # One BLAS thread, as in _compute: over an animated rig the check inverts a 4 x 4 matrix per bone and
         # frame, which took 3.5 times the CPU on threaded OpenBLAS.
@@ -541,7 +594,7 @@ def _write_and_verify(context, plans, agent, backups):
         scene.frame_set(original_frame)
     for backup in backups:
         backup.discard()
-    return lines
+    return written
 
 
 #: The role prefix of the arm a gesture on each arm does not gesture with.
@@ -549,59 +602,60 @@ _OTHER = {"LEFT": "Right", "RIGHT": "Left"}
 
 
 def _write(plan, agent, scene):
-    """Write one armature's planned gesture; returns its summary line."""
-    settings, obj = plan.settings, plan.obj
+    """Write one armature's planned gesture; returns (its summary line, the action written)."""
+    settings, obj, request, made = plan.settings, plan.obj, plan.request, plan.gesture
     (start, end), count = plan.frames, int(settings.frame_count)
-    label = f"{behaviours.title(settings.behaviour)} {settings.arm.title()}"
+    label = f"RLAnimate {behaviours.title(settings.behaviour)} {settings.arm.title()}"
     played = (min(scene.frame_start, start), max(scene.frame_end, end))
-    if plan.previous is not None:  # its constraints' fade undone first, so the new one applies once
-        constraints.unmute(obj, gestures.influence_before(plan.previous))
-        gesture_id = int(plan.previous.record.get("id", gestures.next_id(obj)))
-        memories = key_layers.rewrite(plan.previous, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                      plan.properties, gesture_id, in_place=bool(plan.preview))
-        plan.action = plan.previous.action
+    if request.previous is not None:  # its constraints' fade undone first, so the new one applies once
+        constraints.unmute(obj, gestures.influence_before(request.previous))
+        gesture_id = int(request.previous.record.get("id", gestures.next_id(obj)))
+        memories = key_layers.rewrite(request.previous, label, start, made.keys, made.blend_type, made.properties,
+                                      gesture_id, in_place=bool(request.preview))
+        action = request.previous.action
     else:
         gesture_id = gestures.next_id(obj)
-        plan.action, memories = key_layers.place(obj, f"RLAnimate {label}", start, plan.keys, plan.blend_type,
-                                                 played, plan.properties, plan.still, gesture_id)
-    influence_before = constraints.mute(obj, plan.overriding, start, end, plan.hold)
+        action, memories = key_layers.place(obj, label, start, made.keys, made.blend_type, played, made.properties,
+                                            request.still, gesture_id)
+    influence_before = constraints.mute(obj, plan.armature.overriding, start, end, made.hold)
     kind = agent.kind(settings.behaviour)
-    other = {bone for role, bone in plan.roles.items() if role.startswith(_OTHER[settings.arm]) and "Eye" not in role}
-    gestures.record(plan.action, {
+    other = {bone for role, bone in plan.armature.roles.items()
+             if role.startswith(_OTHER[settings.arm]) and "Eye" not in role}
+    gestures.record(action, {
         "id": gesture_id, "behaviour": settings.behaviour, "kind": kind, "arm": settings.arm, "start": start,
-        "end": end, "settings": gestures.snapshot(settings), "under": plan.under, "aimed_at": plan.targets,
-        "influence_before": influence_before, "animated": not plan.still},
+        "end": end, "settings": gestures.snapshot(settings), "under": made.under, "aimed_at": made.targets,
+        "influence_before": influence_before, "animated": not request.still},
         memories, {(path, i) for path, i, *_ in memories[MAIN].curves if gestures.bone_of(path) in other})
-    placed = next(g for g in gestures.placed_gestures(obj) if g.action == plan.action)
-    if plan.taking is not None:  # plays until the later gesture on its arm takes over
-        key_layers.trim(placed, plan.taking.start, gesture.blend_ramp(plan.taking.end - plan.taking.start + 1))
-    gestures.renamed(obj, plan.before.id if plan.before else "", plan.action.name)
-    return _summary(plan, agent, scene, placed, count)
+    placed = next(g for g in gestures.placed_gestures(obj) if g.action == action)
+    if request.taking is not None:  # plays until the later gesture on its arm takes over
+        key_layers.trim(placed, request.taking.start, gesture.blend_ramp(request.taking.end - request.taking.start + 1))
+    gestures.renamed(obj, request.before.id if request.before else "", action.name)
+    return _summary(plan, agent, scene, placed, count), action
 
 
 def _summary(plan, agent, scene, placed, count):
     """The report line of a written plan: what was baked where, and how it composes with the others."""
-    settings = plan.settings
+    settings, made = plan.settings, plan.gesture
     start, end = plan.frames
     label = f"{behaviours.title(settings.behaviour)} {settings.arm.title()}"
     note = _length_notes(plan, agent, scene, count) + _composing_notes(plan, placed)
-    if plan.from_ik:  # an animated switch already at FK is keyed at FK, and nothing is said
+    if made.from_ik:  # an animated switch already at FK is keyed at FK, and nothing is said
         note += f" (the {settings.arm.lower()} arm switched from IK to FK over its frames)"
-    if plan.overriding:
+    if plan.armature.overriding:
         held = (", held muted beyond them: they hold the rig at rest, so it stands as a still rig does"
-                if plan.hold else "")
-        note += f" (muted {constraints.describe(plan.overriding)} over its frames{held})"
-    layer = "" if plan.still else f", {plan.blend_type.title()} layer over its animation"
+                if made.hold else "")
+        note += f" (muted {constraints.describe(plan.armature.overriding)} over its frames{held})"
+    layer = "" if plan.request.still else f", {made.blend_type.title()} layer over its animation"
     editable = ""
     if settings.editable_keys:
-        keys = sum(len(kept) * values.shape[1] for layer_keys in plan.keys.values()
+        keys = sum(len(kept) * values.shape[1] for layer_keys in made.keys.values()
                    for _, values, kept in layer_keys.values())
-        editable = f"; editable: {keys} Bezier keys, worst deviation {plan.worst:.2f} deg"
+        editable = f"; editable: {keys} Bezier keys, worst deviation {made.worst:.2f} deg"
     if end > scene.frame_end:
         note += (f" ({gesture.LENGTH_WARNING} frames {start}-{end} run past the scene's end, frame "
                  f"{scene.frame_end}: click 'Extend Scene End' in the RLAnimate panel to play them)")
-    return (f"Baked {label} on {plan.obj.name!r} ({plan.family} bones): {len(plan.bones)} bones, frames "
-            f"{start}-{end}, action {plan.action.name!r}{layer}{note}{editable}")
+    return (f"Baked {label} on {plan.obj.name!r} ({plan.armature.family} bones): {len(made.bones)} bones, frames "
+            f"{start}-{end}, action {placed.action.name!r}{layer}{note}{editable}")
 
 
 def _length_notes(plan, agent, scene, count):
@@ -619,15 +673,16 @@ def _length_notes(plan, agent, scene, count):
 def _composing_notes(plan, placed):
     """Notes on how the gesture composes with the armature's others: baked again, taking over, trimmed, its
     spine and head turns added to others'."""
-    note = " (replaced the previous gesture)" if plan.previous is not None else ""
+    request = plan.request
+    note = " (replaced the previous gesture)" if request.previous is not None else ""
     start, end = plan.frames
-    if plan.taken is not None:
-        note += f" (takes over from {plan.taken.name!r} at frame {start}, which plays until there)"
-    if plan.taking is not None:
-        note += f" (plays until frame {plan.taking.start}, where {plan.taking.id!r} takes over)"
+    if request.taken is not None:
+        note += f" (takes over from {request.taken.name!r} at frame {start}, which plays until there)"
+    if request.taking is not None:
+        note += f" (plays until frame {request.taking.start}, where {request.taking.id!r} takes over)"
     span = placed.span
-    sharing = [g for g in gestures.placed_gestures(plan.obj) if g.action != plan.action and g.span.overlaps(span)
-               and not (plan.taken is not None and g.action == plan.taken.action)]
+    sharing = [g for g in gestures.placed_gestures(plan.obj) if g.action != placed.action and g.span.overlaps(span)
+               and not (request.taken is not None and g.action == request.taken.action)]
     for other in sharing:
         first, last = max(start, other.span.start), min(end, other.span.end)
         note += (f" (its spine, neck and head turns add to those of {other.name!r} over frames {first}-{last}, "
@@ -635,13 +690,14 @@ def _composing_notes(plan, placed):
     return note
 
 
-def _cascade(context, plan):
-    """Bake again, from their records, the armature's gestures that depend on the one the plan changed
-    (core.composition.dependants), but those edited by hand; returns a note on what was and was not."""
+def _cascade(context, plan, action):
+    """Bake again, from their records, the armature's gestures that depend on the one the plan changed (its
+    `action` written), but those edited by hand (core.composition.dependants); returns a note on what was and
+    was not."""
     obj = plan.obj
     placed = gestures.placed_gestures(obj)
-    now = next(g for g in placed if g.action == plan.action)
-    return rebake(context, obj, composition.dependants([g.span for g in placed], plan.before, now.span))
+    now = next(g for g in placed if g.action == action)
+    return rebake(context, obj, composition.dependants([g.span for g in placed], plan.request.before, now.span))
 
 
 def rebake(context, obj, spans):

@@ -111,7 +111,8 @@ def behaviour_number(behaviour):
     return _NUMBERS.get(behaviour, 2 + zlib.crc32(behaviour.encode()) % (2 ** 30))
 
 
-_items = {}
+#: The enum's items by (declared behaviours and kinds, the one held that the agent lacks): see behaviour_items.
+_items: dict[tuple[tuple[tuple[str, str], ...], str | None], list[tuple[str, str, str, int]]] = {}
 #: The behaviour ids of the paper's pair by enum number.
 _NAMED_NUMBERS = {number: name for name, number in _NUMBERS.items()}
 
@@ -169,7 +170,7 @@ def chosen_behaviour(settings, context):
     return next((item[0] for item in behaviour_items(settings, context) if item[3] == number), "")
 
 
-def declared_behaviour(context, behaviour):
+def declared_behaviour(context: bpy.types.Context, behaviour: str) -> behaviours.Behaviour | None:
     """The declaration (behaviours.Behaviour: its kind and what it does) of `behaviour` in the selected agent;
     the paper's, or None, when the agent cannot be loaded or lacks it."""
     try:

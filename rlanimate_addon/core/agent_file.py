@@ -16,22 +16,33 @@ import contextlib
 import io
 import json
 import math
+import os
 import struct
 import tokenize
 import warnings
 import zipfile
 import zlib
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
+from typing import IO, Any, TypeGuard
 
 import numpy as np
+import numpy.typing as npt
 
 from . import behaviours, rhythm, spaces
 from .errors import RLAnimateError
 
-try:
-    from lzma import LZMAError as _LZMAError
-except ImportError:  # a Python built without lzma, whose zipfile cannot inflate LZMA either
-    _LZMAError = zlib.error
+
+def _lzma_error() -> type[Exception]:
+    """lzma's error, or zlib's for a Python built without lzma, whose zipfile cannot inflate LZMA either."""
+    try:
+        from lzma import LZMAError
+    except ImportError:
+        return zlib.error
+    return LZMAError
+
+
+_LZMAError = _lzma_error()
 
 FORMAT_NAME = "rlanimate-agent"
 #: 2: waves' objectives carry their rhythm (core/rhythm.py) and the file its `wave_rhythm` model.
@@ -57,44 +68,50 @@ REQUIRED_SINCE_4 = ("behaviours",)
 _AGENT_SIZES = ("task_size", "behaviour_size", "stochastic_size", "hidden_size", "portrayal_hidden_size",
                 "hidden_layers")
 _AGENT_SCALARS = ("min_std", "concentration_floor", "concentration_scale")
+#: An array's shape, and what an npy header holds: (shape, Fortran order, dtype).
+Shape = tuple[int, ...]
+NpyHeader = tuple[Shape, bool, np.dtype[Any]]
+#: What sees an entry's (shape, dtype) before its data is read.
+HeaderCheck = Callable[[Shape, np.dtype[Any]], None]
 
 
-def uses_portrayal(variant):
+def uses_portrayal(variant: str) -> bool:
     """Whether the variant self-describes with a portrayal model (all but single_state)."""
     return variant != "single_state"
 
 
-def uses_task_state(variant):
+def uses_task_state(variant: str) -> bool:
     """Whether the variant keeps a separate task state h_t: not single_dynamics (one latent space) and
     not single_state (the objective is the agent's only state; paper Section 4.3)."""
     return variant not in ("single_state", "single_dynamics")
 
 
-def mlp_shapes(name, inputs, hidden, layers, outputs):
+def mlp_shapes(name: str, inputs: int, hidden: int, layers: int, outputs: int) -> dict[str, Shape]:
     """Shapes of an MLP's arrays: `layers` hidden Linear(+tanh) layers of width `hidden`, then a Linear."""
     widths = [inputs] + [hidden] * layers + [outputs]
-    shapes = {}
+    shapes: dict[str, Shape] = {}
     for k, (n_in, n_out) in enumerate(zip(widths[:-1], widths[1:], strict=True)):
         shapes[f"{name}.layers.{k}.weight"] = (n_out, n_in)
         shapes[f"{name}.layers.{k}.bias"] = (n_out,)
     return shapes
 
 
-def gru_shapes(name, inputs, size, suffix=""):
+def gru_shapes(name: str, inputs: int, size: int, suffix: str = "") -> dict[str, Shape]:
     """Shapes of a torch GRU / GRUCell's arrays (gates r, z, n stacked along the first axis)."""
     return {f"{name}.weight_ih{suffix}": (3 * size, inputs), f"{name}.weight_hh{suffix}": (3 * size, size),
             f"{name}.bias_ih{suffix}": (3 * size,), f"{name}.bias_hh{suffix}": (3 * size,)}
 
 
-def task_width(agent_config, variant, objective_size):
+def task_width(agent_config: Mapping[str, Any], variant: str, objective_size: int) -> int:
     """How wide the task input of f2 and the heads is: the task state, with the wave's phase features beside it
     for an agent with `phase_input` (rhythm.PHASE_FEATURES), or the objective itself without a task state."""
     if not uses_task_state(variant):
         return objective_size
-    return agent_config["task_size"] + (rhythm.PHASE_FEATURES if agent_config.get("phase_input", False) else 0)
+    width: int = agent_config["task_size"] + (rhythm.PHASE_FEATURES if agent_config.get("phase_input", False) else 0)
+    return width
 
 
-def expected_weight_shapes(agent_config, variant, objective_size):
+def expected_weight_shapes(agent_config: Mapping[str, Any], variant: str, objective_size: int) -> dict[str, Shape]:
     """{array name: shape} of an agent with `agent_config` (a dict of AgentConfig fields), `variant` and
     objectives of `objective_size` (its ObjectiveSpace's size)."""
     if variant not in VARIANTS:
@@ -105,7 +122,7 @@ def expected_weight_shapes(agent_config, variant, objective_size):
     E, Z, hid, n = c["behaviour_size"], c["stochastic_size"], c["hidden_size"], c["hidden_layers"]
     task = task_width(c, variant, O)  # what f2 and the heads see of the task
     head_inputs = (task if uses_task_state(variant) else 0) + E + Z
-    shapes = {}
+    shapes: dict[str, Shape] = {}
     if uses_portrayal(variant):
         shapes.update(mlp_shapes("portrayal", O, c["portrayal_hidden_size"], n, D))
     if uses_task_state(variant):
@@ -118,7 +135,7 @@ def expected_weight_shapes(agent_config, variant, objective_size):
     return shapes
 
 
-def objective_space(metadata):
+def objective_space(metadata: Mapping[str, Any]) -> spaces.ObjectiveSpace:
     """The ObjectiveSpace of a loaded file's metadata: its declared behaviours, or point and wave for a
     version 3 file (which declares none)."""
     if metadata["format_version"] == 3:
@@ -126,7 +143,7 @@ def objective_space(metadata):
     return spaces.ObjectiveSpace(tuple(behaviours.from_dict(b) for b in metadata["behaviours"]))
 
 
-def load_agent_file(path):
+def load_agent_file(path: str | os.PathLike[str]) -> tuple[dict[str, npt.NDArray[Any]], dict[str, Any]]:
     """(weights {name: float array}, metadata dict) from the agent file at `path`, fully validated.
 
     A version 3 file declares no behaviours: it holds point and wave (`objective_space`).
@@ -186,7 +203,7 @@ _ZIP64_LOCATOR_SIGNATURE, _ZIP64_LOCATOR_BYTES = b"PK\x06\x07", 20
 
 
 @contextlib.contextmanager
-def _unreadable(path):
+def _unreadable(path: Path) -> Iterator[None]:
     """Around code that parses the file's bytes: what the parsers raise becomes 'truncated or damaged'."""
     try:
         yield
@@ -194,7 +211,7 @@ def _unreadable(path):
         raise _damaged(path, error) from error
 
 
-def _open_archive(path):
+def _open_archive(path: Path) -> zipfile.ZipFile:
     with _unreadable(path):
         size = path.stat().st_size
         with open(path, "rb") as handle:
@@ -215,7 +232,7 @@ def _open_archive(path):
         return zipfile.ZipFile(path)
 
 
-def _check_end_record(path, tail):
+def _check_end_record(path: Path, tail: bytes) -> None:
     """The zip's end record, found as zipfile finds it in the file's last bytes `tail`, bounds what zipfile
     will parse: the entry count and the central directory's size, before zipfile reads the directory."""
     if tail[-_END_BYTES:-_END_BYTES + 4] == _END_SIGNATURE and tail[-2:] == b"\0\0":
@@ -235,12 +252,12 @@ def _check_end_record(path, tail):
                              f"trainer/agent/agent_export.py.")
 
 
-def _entries(path, archive):
+def _entries(path: Path, archive: zipfile.ZipFile) -> dict[str, zipfile.ZipInfo]:
     """{array name: ZipInfo} of the archive, its size, names and compression methods checked."""
     infos = archive.infolist()
     if len(infos) > MAX_ENTRIES:
         raise _not_an_agent(path)
-    entries = {}
+    entries: dict[str, zipfile.ZipInfo] = {}
     for info in infos:
         if not info.filename.endswith(_NPY) or info.filename[:-len(_NPY)] in entries:
             raise _damaged(path, f"entry {info.filename!r} is not one numpy array")
@@ -256,14 +273,16 @@ def _entries(path, archive):
     return entries
 
 
-def _npy_header(stream, name):
+def _npy_header(stream: IO[bytes], name: str) -> NpyHeader:
     """(shape, fortran_order, dtype) from the npy header at the start of `stream`, by numpy's own parser
     once the header's length field is checked: numpy would read as many bytes as the field claims."""
     magic = stream.read(len(_NPY_MAGIC) + 2)
     if len(magic) < len(_NPY_MAGIC) + 2 or not magic.startswith(_NPY_MAGIC):
         raise ValueError(f"{name} is not a numpy array")
     version = tuple(magic[-2:])
-    read = {(1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}.get(version)
+    readers: dict[tuple[int, ...], Callable[[IO[bytes]], NpyHeader]] = {
+        (1, 0): np.lib.format.read_array_header_1_0, (2, 0): np.lib.format.read_array_header_2_0}
+    read = readers.get(version)
     if read is None:
         raise ValueError(f"{name} is npy format version {version}")
     length_field = stream.read(2 if version == (1, 0) else 4)
@@ -274,10 +293,12 @@ def _npy_header(stream, name):
     header = io.BytesIO(length_field + stream.read(length))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # numpy's note on headers written by Python 2
-        return read(header)
+        parsed: NpyHeader = read(header)
+        return parsed
 
 
-def _read_npy(path, archive, info, name, check):
+def _read_npy(path: Path, archive: zipfile.ZipFile, info: zipfile.ZipInfo, name: str,
+              check: HeaderCheck) -> npt.NDArray[Any]:
     """The array in the archive entry `info`; `check(shape, dtype)` sees the header before any data is read."""
     with _unreadable(path), archive.open(info) as stream:
         shape, fortran_order, dtype = _npy_header(stream, name)
@@ -295,25 +316,25 @@ def _read_npy(path, archive, info, name, check):
         return np.frombuffer(bytearray(data), dtype=dtype).reshape(shape, order="F" if fortran_order else "C")
 
 
-def _damaged(path, error):
+def _damaged(path: Path, error: object) -> RLAnimateError:
     return RLAnimateError(f"The agent file {path} is truncated or damaged ({error}): export or copy it again.")
 
 
-def _pickled(path, name):
+def _pickled(path: Path, name: str) -> RLAnimateError:
     return RLAnimateError(f"The agent file {path} carries a pickled Python object in {name}, which is refused "
                           f"because loading it could run code: use an agent exported by trainer/agent/agent_export.py.")
 
 
-def _not_an_agent(path):
+def _not_an_agent(path: Path) -> RLAnimateError:
     return RLAnimateError(f"{path} is not an RLAnimate agent file (no {METADATA_KEY} entry): choose a .npz "
                           f"written by trainer/agent/agent_export.py.")
 
 
-def _read_metadata(path, archive, info):
+def _read_metadata(path: Path, archive: zipfile.ZipFile, info: zipfile.ZipInfo | None) -> npt.NDArray[Any]:
     if info is None:
         raise _not_an_agent(path)
 
-    def check(shape, dtype):
+    def check(shape: Shape, dtype: np.dtype[Any]) -> None:
         if dtype.kind != "U" or shape != ():
             raise _not_an_agent(path)
         if not 0 < dtype.itemsize <= MAX_METADATA_BYTES:  # numpy's itemsize wraps negative past 2 GB
@@ -323,7 +344,7 @@ def _read_metadata(path, archive, info):
     return _read_npy(path, archive, info, METADATA_KEY, check)
 
 
-def _parse_metadata(path, entry):
+def _parse_metadata(path: Path, entry: npt.NDArray[Any]) -> dict[str, Any]:
     try:
         metadata = json.loads(str(entry))
     except (ValueError, RecursionError) as error:
@@ -343,23 +364,24 @@ def _parse_metadata(path, entry):
     if missing:
         raise RLAnimateError(f"The agent file {path} lacks metadata {', '.join(missing)}: re-export it with "
                              f"trainer/agent/agent_export.py.")
-    return metadata
+    checked: dict[str, Any] = metadata
+    return checked
 
 
-def _is_int(value):
+def _is_int(value: object) -> TypeGuard[int]:
     return isinstance(value, int) and not isinstance(value, bool)
 
 
-def _is_number(value):
+def _is_number(value: object) -> bool:
     """An int (of any size: the range checks that follow compare it exactly) or a finite float."""
     return _is_int(value) or isinstance(value, float) and math.isfinite(value)
 
 
-def _count(n, noun):
+def _count(n: int, noun: str) -> str:
     return f"{n:,} {noun}{'s' if n > 1 else ''}"
 
 
-def _largest_number(value):
+def _largest_number(value: object) -> float:
     """The largest magnitude among the numbers anywhere in the JSON value (NaN if one is NaN, 0 if none)."""
     largest, pending = 0.0, [value]
     while pending:
@@ -375,7 +397,7 @@ def _largest_number(value):
     return largest
 
 
-def _describe(number):
+def _describe(number: float) -> str:
     """A number as a message names it: NaN, infinite, or its value (integers of any size in short)."""
     if isinstance(number, float) and math.isnan(number):
         return "NaN"
@@ -384,7 +406,7 @@ def _describe(number):
     return f"{number:.3g}" if isinstance(number, float) or abs(number) < 10 ** 15 else f"about 1e{len(str(number)) - 1}"
 
 
-def _check_metadata_values(path, metadata):
+def _check_metadata_values(path: Path, metadata: dict[str, Any]) -> dict[str, Shape]:
     """Every metadata value the add-on uses, checked for type and range; returns the expected weight shapes."""
     config = metadata["agent_config"]
     if not isinstance(config, dict) \
@@ -444,7 +466,7 @@ def _check_metadata_values(path, metadata):
     return {name: tuple(shape) for name, shape in expected.items()}
 
 
-def _checked_space(path, metadata):
+def _checked_space(path: Path, metadata: dict[str, Any]) -> spaces.ObjectiveSpace:
     """The ObjectiveSpace of the metadata: point and wave in version 3, else its `behaviours`, a list of
     {"name", "kind"}, 1 to MAX_BEHAVIOURS of them, in objective order (behaviours.ordered), each name once."""
     if metadata["format_version"] == 3:
@@ -471,11 +493,12 @@ def _checked_space(path, metadata):
     return space
 
 
-def _read_weights(path, archive, entries, expected):
+def _read_weights(path: Path, archive: zipfile.ZipFile, entries: dict[str, zipfile.ZipInfo],
+                  expected: dict[str, Shape]) -> dict[str, npt.NDArray[Any]]:
     """{name: float array} of the weight entries, checked against the expected shapes before any is read."""
     missing = sorted(set(expected) - set(entries))
     extra = sorted(set(entries) - set(expected))
-    headers = {}
+    headers: dict[str, NpyHeader] = {}
     for name, info in entries.items():
         with _unreadable(path), archive.open(info) as stream:
             headers[name] = _npy_header(stream, name)
@@ -490,22 +513,22 @@ def _read_weights(path, archive, entries, expected):
         raise RLAnimateError(f"The agent file {path} does not match its own config: {'; '.join(problems)}. "
                              f"Re-export the agent with trainer/agent/agent_export.py.")
 
-    def check(name):
-        def floats(shape, dtype):
+    def check(name: str) -> HeaderCheck:
+        def floats(shape: Shape, dtype: np.dtype[Any]) -> None:
             if shape != expected[name]:
                 raise _damaged(path, f"{name} changed its shape")
             if dtype.kind != "f":
                 raise RLAnimateError(f"The agent file {path} holds {name} as {dtype}, not floats: re-export it.")
         return floats
 
-    weights = {}
+    weights: dict[str, npt.NDArray[Any]] = {}
     for name in sorted(expected):
         weights[name] = _read_npy(path, archive, entries[name], name, check(name))
         _check_weight_values(path, name, weights[name])
     return weights
 
 
-def _check_weight_values(path, name, array):
+def _check_weight_values(path: Path, name: str, array: npt.NDArray[Any]) -> None:
     """RLAnimateError naming what is wrong with the weight array `name`: NaN, infinite or huge values."""
     nan, infinite = int(np.isnan(array).sum()), int(np.isinf(array).sum())
     finite = array[np.isfinite(array)]

@@ -29,8 +29,11 @@ import json
 import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
+from numpy.typing import ArrayLike
 
 from .errors import RLAnimateError
 from .skeleton import ARMS
@@ -63,11 +66,11 @@ class Rhythm:
     phase: float  # radians, at `start`
     ramp: float  # frames over which the envelope rises and falls
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return asdict(self)
 
 
-def signals(rhythm: "Rhythm", frame_count: int) -> np.ndarray:
+def signals(rhythm: "Rhythm", frame_count: int) -> npt.NDArray[np.float64]:
     """(N, 2) [A_t sin(phi_t), A_t cos(phi_t)] of `rhythm` over a gesture of `frame_count` frames."""
     t = np.arange(int(frame_count), dtype=np.float64)
     span = max(int(frame_count) - 1, 1)
@@ -77,7 +80,7 @@ def signals(rhythm: "Rhythm", frame_count: int) -> np.ndarray:
     return np.stack([envelope * np.sin(phi), envelope * np.cos(phi)], axis=1)
 
 
-def _smoothstep(x):
+def _smoothstep(x: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     s = np.clip(x, 0.0, 1.0)
     return s * s * (3.0 - 2.0 * s)
 
@@ -94,8 +97,10 @@ class RhythmModel:
     own arm's waves (it needs `arms`).
     """
 
-    def __init__(self, examples, phase, ramp, bandwidth=BANDWIDTH, phases=None, typical_tempo=None,
-                 tempo_bandwidth=TEMPO_BANDWIDTH, arms=None, by_arm=BY_ARM):
+    def __init__(self, examples: ArrayLike, phase: float, ramp: float, bandwidth: float = BANDWIDTH,
+                 phases: ArrayLike | None = None, typical_tempo: bool | None = None,
+                 tempo_bandwidth: float = TEMPO_BANDWIDTH, arms: Sequence[str] | None = None,
+                 by_arm: bool = BY_ARM) -> None:
         self.examples = np.asarray(examples, dtype=np.float64)
         self.phase, self.ramp, self.bandwidth = float(phase), float(ramp), float(bandwidth)
         self.phases = None if phases is None else np.asarray(phases, dtype=np.float64)
@@ -118,7 +123,8 @@ class RhythmModel:
         phase = float(np.angle(np.mean(np.exp(1j * phases))))
         return cls(examples, phase, float(np.mean([r.ramp for r in rhythms])), phases=phases, arms=arms)
 
-    def with_settings(self, bandwidth=None, typical_tempo=None, tempo_bandwidth=None, by_arm=None) -> "RhythmModel":
+    def with_settings(self, bandwidth: float | None = None, typical_tempo: bool | None = None,
+                      tempo_bandwidth: float | None = None, by_arm: bool | None = None) -> "RhythmModel":
         """The same training waves with another kernel bandwidth, choice of `typical_tempo`, tempo kernel and/or
         `by_arm` (None: keep this one's)."""
         return RhythmModel(self.examples, self.phase, self.ramp, self.bandwidth if bandwidth is None else bandwidth,
@@ -126,8 +132,8 @@ class RhythmModel:
                            self.tempo_bandwidth if tempo_bandwidth is None else tempo_bandwidth, self.arms,
                            self.by_arm if by_arm is None else by_arm)
 
-    def to_dict(self) -> dict:
-        values = {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
+    def to_dict(self) -> dict[str, Any]:
+        values: dict[str, Any] = {"examples": self.examples.tolist(), "phase": self.phase, "ramp": self.ramp,
                   "bandwidth": self.bandwidth}
         if self.phases is not None:
             values.update(phases=self.phases.tolist(), typical_tempo=self.typical_tempo,
@@ -137,7 +143,7 @@ class RhythmModel:
         return values
 
     @classmethod
-    def from_dict(cls, values: dict) -> "RhythmModel":
+    def from_dict(cls, values: dict[str, Any]) -> "RhythmModel":
         """The model an agent file's `wave_rhythm` holds; RLAnimateError naming the field that is wrong
         (`invalid_field`)."""
         problem = invalid_field(values)
@@ -148,7 +154,8 @@ class RhythmModel:
                    values.get("typical_tempo"), values.get("tempo_bandwidth", EARLIER_TEMPO_BANDWIDTH),
                    values.get("arms"), bool(values.get("by_arm")))
 
-    def weights(self, exaggeration: float, tempo: float | None = None, arm: str | None = None) -> np.ndarray:
+    def weights(self, exaggeration: float, tempo: float | None = None,
+                arm: str | None = None) -> npt.NDArray[np.float64]:
         """(K,) how much each training wave weighs in a request of this exaggeration (sum 1): with `by_arm`, only
         those of its `arm` where there are any (None: both arms'); with `typical_tempo`, near its tempo too
         (cycles per frame; None: the typical one)."""
@@ -165,7 +172,7 @@ class RhythmModel:
         return _normalised(log_kernel + _log_gaussian(log_tempos - math.log(max(float(tempo), _SLOWEST)),
                                                       self.tempo_bandwidth))
 
-    def _frequencies(self):
+    def _frequencies(self) -> npt.NDArray[np.float64]:
         return np.maximum(self.examples[:, 1 + PARAMETERS.index("frequency")], _SLOWEST)
 
     def tempo_range(self) -> tuple[float, float]:
@@ -182,7 +189,10 @@ class RhythmModel:
         weights = self.weights(exaggeration, tempo, arm)
         if seed is None:
             values = weights @ self.examples[:, 1:]
-            phase = float(np.angle(weights @ np.exp(1j * self.phases))) if self.typical_tempo else self.phase
+            phase = self.phase
+            if self.typical_tempo:
+                assert self.phases is not None, "typical_tempo needs the phases (invalid_field)"
+                phase = float(np.angle(weights @ np.exp(1j * self.phases)))
         else:
             rng = np.random.default_rng(seed)
             values, phase = self.examples[rng.choice(len(weights), p=weights), 1:], float(rng.uniform(-np.pi, np.pi))
@@ -196,7 +206,7 @@ class RhythmModel:
 PHASE_FEATURES = 4
 
 
-def phase_features(signals: np.ndarray) -> np.ndarray:
+def phase_features(signals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """(..., 4) [A sin(phi), A cos(phi), A sin(2 phi), A cos(2 phi)] of rhythm signals (..., 2) [A sin(phi),
     A cos(phi)]: the swing's phase and its second harmonic, as phase-conditioned motion models give the pose
     network its phase (an agent with AgentConfig.phase_input; the trainer's torch model computes the same)."""
@@ -209,34 +219,36 @@ def phase_features(signals: np.ndarray) -> np.ndarray:
 _SLOWEST = 1e-6
 
 
-def _log_gaussian(differences, bandwidth):
-    return -0.5 * (differences / bandwidth) ** 2
+def _log_gaussian(differences: npt.NDArray[np.float64], bandwidth: float) -> npt.NDArray[np.float64]:
+    log_kernel: npt.NDArray[np.float64] = -0.5 * (differences / bandwidth) ** 2
+    return log_kernel
 
 
-def _normalised(log_weights):
+def _normalised(log_weights: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     """Weights (sum 1) from their logarithms, shifted so that far ones still have weights."""
     weights = np.exp(log_weights - log_weights.max())
-    return weights / weights.sum()
+    normalised: npt.NDArray[np.float64] = weights / weights.sum()
+    return normalised
 
 
 #: The numbers of a rhythm model, each: JSON numbers within this (1e300 squared is infinite).
 _LARGEST = 1e300
 
 
-def _finite(value) -> bool:
+def _finite(value: object) -> bool:
     """A JSON number (not a boolean) that is finite and within +-_LARGEST."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return False
     return abs(value) <= _LARGEST if isinstance(value, int) else math.isfinite(value) and abs(value) <= _LARGEST
 
 
-def _json_type(value) -> str:
+def _json_type(value: object) -> str:
     """How a message names a JSON value's type."""
     names = {bool: "a boolean", str: "a string", list: "a list", dict: "an object", type(None): "null"}
     return names.get(type(value), "a number")
 
 
-def invalid_field(values) -> str | None:
+def invalid_field(values: object) -> str | None:
     """What is wrong with an agent file's `wave_rhythm` value, naming the field (None: nothing). Every field
     RhythmModel reads is checked for its JSON type, its length (one per training wave) and its range."""
     if not isinstance(values, dict):

@@ -12,9 +12,13 @@ over the last quarter of its blend out (`switch_values`): while it moves the FK 
 their way from the IK pose, so the mix of the two arms (which is not the gesture's own blend) stays
 close to both, and the aimed middle of the gesture plays on FK alone.
 """
-import numpy as np
+from collections.abc import Mapping, Sequence
 
-from .gesture import blend_weights
+import numpy as np
+import numpy.typing as npt
+from numpy.typing import ArrayLike
+
+from .gesture import RigState, blend_weights
 from .rig import inverse
 
 #: The arm's FK controls, shoulder to hand, without their side (".L", ".R").
@@ -23,17 +27,17 @@ SWITCH = "IK_FK"
 _SIDES = {"LEFT": ".L", "RIGHT": ".R"}
 
 
-def switch_bone(arm):
+def switch_bone(arm: str) -> str:
     """The bone holding the arm's IK_FK property."""
     return "upper_arm_parent" + _SIDES[arm]
 
 
-def fk_controls(arm):
+def fk_controls(arm: str) -> tuple[str, ...]:
     """The arm's FK controls, shoulder to hand."""
     return tuple(name + _SIDES[arm] for name in FK_CHAIN)
 
 
-def org_bone(control):
+def org_bone(control: str) -> str:
     """The ORG- bone an FK control stands for: 'upper_arm_fk.L' -> 'ORG-upper_arm.L'."""
     return "ORG-" + control.replace("_fk", "", 1)
 
@@ -42,17 +46,18 @@ def org_bone(control):
 SWITCH_AT = 0.25
 
 
-def switch_values(under, count, blend_type, default):
+def switch_values(under: ArrayLike, count: int, blend_type: str, default: float) -> npt.NDArray[np.float64]:
     """(N,) IK_FK keys for a gesture of `count` frames: from the switch's value underneath (N,) to FK
     (1.0) and back (see the module), as a Replace layer keys them, or, for a Combine layer (which adds
     a generic property's key minus its default value to the value underneath), that difference."""
     under = np.broadcast_to(np.asarray(under, dtype=np.float64), (count,))
     rise = np.minimum(1.0, blend_weights(count) / SWITCH_AT)
-    played = under + (1.0 - under) * rise * rise * (3.0 - 2.0 * rise)  # smoothstep: no kink in the hand's speed
+    # smoothstep: no kink in the hand's speed
+    played: npt.NDArray[np.float64] = under + (1.0 - under) * rise * rise * (3.0 - 2.0 * rise)
     return played - under + default if blend_type == "COMBINE" else played
 
 
-def snap_fk(rig, controls, played):
+def snap_fk(rig: RigState, controls: Sequence[str], played: Mapping[str, npt.NDArray[np.float64]]) -> RigState:
     """A RigState in which the FK `controls` (role bones, parents first) stand where the arm plays:
     played {control: (N, 4, 4)} the armature-space pose of the bone each stands for (its ORG- bone).
 
@@ -79,4 +84,5 @@ def snap_fk(rig, controls, played):
         if above and name not in controls:
             control = rig.skeleton.names[above[-1]]
             new_pose[:, i] = new_pose[:, above[-1]] @ inverse(played[control]) @ pose[:, i]
-    return rig.with_pose(new_basis, new_pose)
+    snapped: RigState = rig.with_pose(new_basis, new_pose)
+    return snapped

@@ -221,9 +221,10 @@ class GestureAgent:
         task = _gru_sequence(objectives, self._task_rnn)
         return np.hstack([task, self.space.phase_features(objectives)]) if self._phase_input else task
 
-    def _rollout(self, objectives, noise):
-        E, Z = self._sizes
-        A = spaces.ACTION_SIZE
+    def _step_inputs(self, objectives):
+        """(cell (N, 3E), belief (N, hidden), animation (N, hidden)): what each step's GRU cell, belief MLP and
+        animation MLP take from the task and the portrayal, precomputed for all N steps at once."""
+        E = self._sizes[0]
         count = len(objectives)
         task = self._task(objectives)  # (N, K)
         cell_inputs = task @ self._cell_task + self._cell_bias  # (N, 3E)
@@ -237,6 +238,15 @@ class GestureAgent:
         animation_inputs = np.broadcast_to(self._animation[0][1], (count, hidden))
         if self._uses_task_state:
             animation_inputs = animation_inputs + task @ self._animation_task  # (N, hidden)
+        return cell_inputs, belief_inputs, animation_inputs
+
+    def _rollout(self, objectives, noise):
+        """Actions (N, 45) of the objectives (N, O), one step per row, in preallocated buffers (views of one
+        another: each step writes them in place); noise (Z,) or None as in `rollout`."""
+        E, Z = self._sizes
+        A = spaces.ACTION_SIZE
+        cell_inputs, belief_inputs, animation_inputs = self._step_inputs(objectives)
+        hidden = belief_inputs.shape[1]
         gates, belief_end = 3 * E, 3 * E + hidden
         e, input_gates, hidden_gates = np.zeros(E), np.empty(3 * E), self._cell_hidden_bias.copy()  # W_hh e_0 + b_hh
         cell_step = _gru_stepper(e, hidden_gates)
@@ -252,13 +262,9 @@ class GestureAgent:
         alpha, beta = out[:A], out[A:]
         belief_layers, animation_layers = self._belief, self._animation
         from_e_weights, from_z_weights, from_a_weights = self._from_e, self._from_z, self._from_a
-        hidden_bias, floor, scale, min_std = (
-            self._cell_hidden_bias,
-            self._floor,
-            self._concentration_scale,
-            self._min_std,
-        )
-        actions = np.empty((count, A))
+        hidden_bias, floor = self._cell_hidden_bias, self._floor
+        scale, min_std = self._concentration_scale, self._min_std
+        actions = np.empty((len(objectives), A))
         for cell_row, belief_row, animation_row, a in zip(
             cell_inputs, belief_inputs, animation_inputs, actions, strict=True
         ):

@@ -10,9 +10,12 @@ MAX_JSON_BYTES of it, nested at most MAX_NESTING deep, and every field read is c
 before it is used.
 """
 import json
+import os
 import re
 import struct
 from collections import Counter
+from collections.abc import Iterable, Mapping
+from typing import Any, TypeGuard
 
 import numpy as np
 
@@ -37,9 +40,11 @@ _FINGERS = {"Index": "Index", "Middle": "Middle", "Ring": "Ring", "Little": "Pin
 _PHALANGES = ("Proximal", "Intermediate", "Distal")
 #: A thumb's three bones: VRM 0.x names them like the other fingers, VRM 1.0 from the metacarpal.
 _THUMB = {"0": _PHALANGES, "1": ("Metacarpal", "Proximal", "Distal")}
+#: A file's path, as open() takes it.
+FilePath = str | os.PathLike[str]
 
 
-def _role_names(major):
+def _role_names(major: str) -> dict[str, str]:
     """{VRM bone name: role} for a VRM major version ("0" or "1")."""
     names = dict(_CENTRE)
     for vrm_side, side in (("left", "Left"), ("right", "Right")):
@@ -56,12 +61,12 @@ ROLE_OF = {major: _role_names(major) for major in _THUMB}
 FAMILY = "VRM humanoid map"
 
 
-def snake_case(vrm_name):
+def snake_case(vrm_name: str) -> str:
     """The VRM add-on's property name for a VRM 1.0 bone name: 'leftUpperArm' -> 'left_upper_arm'."""
     return re.sub(r"([A-Z])", r"_\1", vrm_name).lower()
 
 
-def read_gltf_json(path):
+def read_gltf_json(path: FilePath) -> dict[str, Any]:
     """The glTF JSON (a dict) of a binary glTF (.vrm, .glb) file, reading only its header and JSON chunk;
     its nodes, skins and extensions checked for their JSON types (`_check_gltf`)."""
     try:
@@ -99,7 +104,8 @@ def read_gltf_json(path):
     if problem:
         raise RLAnimateError(f"The JSON chunk of {path} is not a glTF of a VRM ({problem}): the file is damaged; "
                              "re-export it.")
-    return gltf
+    checked: dict[str, Any] = gltf  # an object: _gltf_problem found none
+    return checked
 
 
 #: A JSON string (quotes and escapes inside it included): removed before brackets are counted.
@@ -114,16 +120,16 @@ def nesting(text: bytes) -> int:
     return int(np.cumsum(steps).max(initial=0))
 
 
-def _json_type(value):
+def _json_type(value: object) -> str:
     names = {bool: "a boolean", str: "a string", list: "a list", dict: "an object", type(None): "null"}
     return names.get(type(value), "a number")
 
 
-def _is_index(value, count):
+def _is_index(value: object, count: int) -> TypeGuard[int]:
     return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < count
 
 
-def _gltf_problem(gltf):
+def _gltf_problem(gltf: object) -> str | None:
     """What is wrong with the types of the glTF fields this module reads (None: nothing)."""
     if not isinstance(gltf, dict):
         return f"the chunk holds {_json_type(gltf)}, not an object"
@@ -147,7 +153,7 @@ def _gltf_problem(gltf):
     return None
 
 
-def humanoid_nodes(gltf, path="The file"):
+def humanoid_nodes(gltf: Mapping[str, Any], path: FilePath = "The file") -> tuple[str, dict[str, int]]:
     """(major version "0" or "1", {VRM bone name: node index}) of a glTF dict's VRM humanoid map (`path`:
     the file, for messages)."""
     extensions = gltf.get("extensions", {})
@@ -171,7 +177,7 @@ def humanoid_nodes(gltf, path="The file"):
         raise RLAnimateError(f"The VRM humanoid of {path} lists {len(pairs)} bones (VRM defines 55): the file is "
                              "damaged; re-export it.")
     count = len(gltf.get("nodes", []))
-    out = {}
+    out: dict[str, int] = {}
     for name, node in pairs:
         if not isinstance(name, str) or not _is_index(node, count):
             raise RLAnimateError(f"The VRM humanoid of {path} maps {str(name)[:40]!r} to node {str(node)[:20]}, "
@@ -180,7 +186,7 @@ def humanoid_nodes(gltf, path="The file"):
     return major, out
 
 
-def _dig(extension, label, path):
+def _dig(extension: Mapping[str, Any], label: str, path: FilePath) -> Any:
     humanoid = extension.get("humanoid")
     if not isinstance(humanoid, dict) or "humanBones" not in humanoid:
         raise RLAnimateError(f"The {label} extension of {path} has no humanoid.humanBones: it is not a humanoid "
@@ -188,11 +194,12 @@ def _dig(extension, label, path):
     return humanoid["humanBones"]
 
 
-def imported_bone_names(gltf):
+def imported_bone_names(gltf: Mapping[str, Any]) -> list[str]:
     """(nodes,) the bone name Blender's glTF importer gives each node: its name cut to 63 bytes, or
     'Node_<index>', with ".001", ".002", ... on a name an earlier joint (a node of a skin) took."""
     joints = {j for skin in gltf.get("skins", []) for j in skin.get("joints", [])}
-    taken, out = set(), []
+    taken: set[str] = set()
+    out: list[str] = []
     for index, node in enumerate(gltf.get("nodes", [])):
         unique = base = _cut(node.get("name") or f"Node_{index}")
         k = 0
@@ -205,18 +212,18 @@ def imported_bone_names(gltf):
     return out
 
 
-def _cut(name, limit=MAX_BONE_NAME_BYTES):
+def _cut(name: str, limit: int = MAX_BONE_NAME_BYTES) -> str:
     return name.encode("utf-8")[:limit].decode("utf-8", "ignore")
 
 
-def roles_from_map(major, bone_of):
+def roles_from_map(major: str, bone_of: Mapping[str, str]) -> dict[str, str]:
     """{role: bone name} from a VRM humanoid map {VRM bone name: bone name} of major version "0" or "1";
     VRM bones without a role (legs, toes, jaw) are left out."""
     names = ROLE_OF[major]
     return {names[vrm]: bone for vrm, bone in bone_of.items() if vrm in names and bone}
 
 
-def file_map(path):
+def file_map(path: FilePath) -> dict[str, str]:
     """{role: bone name} of the armature Blender's glTF importer makes from the VRM file at `path`: its
     humanoid map, read and checked (a bone given to two roles is refused, as in a bone-map file)."""
     gltf = read_gltf_json(path)
@@ -227,7 +234,7 @@ def file_map(path):
     return roles
 
 
-def check_one_role_per_bone(roles, source, then):
+def check_one_role_per_bone(roles: Mapping[str, str], source: str, then: str) -> None:
     """RLAnimateError when a VRM humanoid map (`source`, for the message) gives one bone two roles, as a
     bone-map file's is; `then`: what to do after correcting the map."""
     shared = sorted(bone for bone, uses in Counter(roles.values()).items() if uses > 1)
@@ -238,7 +245,8 @@ def check_one_role_per_bone(roles, source, then):
                              f"{then}, or map the bones with a bone-map file.")
 
 
-def check_bones(roles, bone_names, path, rig_name="the armature"):
+def check_bones(roles: Mapping[str, str], bone_names: Iterable[str], path: FilePath,
+                rig_name: str = "the armature") -> None:
     """RLAnimateError when the VRM file's map `roles` names bones the armature (`bone_names`) lacks."""
     present = set(bone_names)
     absent = sorted(bone for bone in roles.values() if bone not in present)
@@ -249,7 +257,7 @@ def check_bones(roles, bone_names, path, rig_name="the armature"):
                              "the panel and correct the names.")
 
 
-def file_roles(path, bone_names, rig_name="the armature"):
+def file_roles(path: FilePath, bone_names: Iterable[str], rig_name: str = "the armature") -> dict[str, str]:
     """{role: bone name} of an armature imported from the VRM file at path, checked against its bone names."""
     roles = file_map(path)
     check_bones(roles, bone_names, path, rig_name)

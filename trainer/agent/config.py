@@ -25,6 +25,7 @@
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
+from typing import Any
 
 from rlanimate_addon.core.errors import RLAnimateError
 
@@ -102,8 +103,9 @@ def _known_fields(cls, values):
 
 _DEFAULT_TRAIN = TrainConfig()
 #: What the debug and paper presets keep of the first defaults (issue 10 and 27's choices came after them).
-_FIRST_TRAIN = dict(update_steps_many=None, chunk_count_many=None, learning_rate=1e-3, learning_rate_final=None,
-                    wrist_scale=0.0, random_targets=1, random_target_margin_deg=0.0, random_target_weight=1.0)
+_FIRST_TRAIN: dict[str, Any] = dict(update_steps_many=None, chunk_count_many=None, learning_rate=1e-3,
+                                    learning_rate_final=None, wrist_scale=0.0, random_targets=1,
+                                    random_target_margin_deg=0.0, random_target_weight=1.0)
 PRESETS = {
     "debug": (
         AgentConfig(task_size=8, behaviour_size=8, stochastic_size=4, hidden_size=8,

@@ -13,7 +13,7 @@ import json
 import sys
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 import numpy as np
 from tqdm import tqdm
@@ -40,7 +40,7 @@ REPORT = "capture_report"
 PATHS_FIGURE = "capture_hand_paths.png"
 
 
-def is_capture_folder(clips: str | None) -> bool:
+def is_capture_folder(clips: str | None) -> TypeGuard[str]:
     """Whether --clips names a folder of takes without a manifest (what `label_folder` labels)."""
     return clips is not None and Path(clips).is_dir() and not (Path(clips) / MANIFEST).is_file()
 

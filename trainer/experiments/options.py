@@ -18,6 +18,14 @@ def some_of(names: Iterable[str]) -> Any:
     return tyro.conf.arg(constructor_factory=lambda: field_type)
 
 
+def one_of(names: Iterable[str]) -> Any:
+    """An `Annotated[str | None, one_of(NAMES)]` marker: the field takes one of `names` on the command line, which
+    --help lists and which refuses any other name; None (its default) when not given."""
+    literal: Any = Literal  # made at run time: Literal["a", "b"] from the names
+    field_type = literal[tuple(names)] | None
+    return tyro.conf.arg(constructor_factory=lambda: field_type, help_behavior_hint="(default: None)")
+
+
 def require_values(settings: Any, *names: str) -> None:
     """RLAnimateError naming each tuple field of `names` that `settings` (a settings dataclass) holds empty, as the
     option it is on the command line, with its default as an example."""

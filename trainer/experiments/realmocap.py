@@ -357,23 +357,11 @@ def run_experiments(settings: RealMocapSettings) -> dict:
     """All experiments of `settings` (RealMocapSettings); returns the realmocap results dict."""
     torch.set_num_threads(1)
     new_empty_scene()
-
-    root = require_realmocap(settings.realmocap)
-    Path(settings.results).mkdir(parents=True, exist_ok=True)
-    cache = Path(settings.runs) / "import_cache"
-    if settings.address is not None:  # the import's Ray tasks, if any, and the training runs go to the cluster
-        connect(settings.address)
-    with blender_output():
-        waves, byes, guides = (load_folder(f, root, cache, settings.import_workers) for f in ("wave", "bye", "guide"))
-        env = FKEnvironment()
+    waves, byes, guides, env = _load_capture(settings)
     references = ClipReferences(env)
     seeds = list(dict.fromkeys(settings.seeds))
-    command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {settings.epochs} --preset {settings.preset} "
-               f"--seeds {' '.join(str(seed) for seed in seeds)}")
-    if settings.point_agent:
-        command += f" --point-agent {settings.point_agent}"
     results = {"source": "Bandai Namco Research motion dataset (CC BY-NC 4.0), read from ../shared/realmocap/",
-               "command": command,
+               "command": _command(settings, seeds),
                "epochs": settings.epochs, "preset": settings.preset, "seeds": seeds,
                "labels": {"wave": label_table(waves), "bye": label_table(byes)},
                "tempos": tempo_table(waves, references)}
@@ -386,52 +374,84 @@ def run_experiments(settings: RealMocapSettings) -> dict:
             for name, (train_clips, test_clips) in experiments.items() for seed in seeds}
     reports = train_real_runs(runs.values(), settings.address, settings.workers)
     for name, (train_clips, test_clips) in experiments.items():
-        agents = {seed: baselines.AgentMethod(Path(runs[name, seed].settings.output) / "agent.npz") for seed in seeds}
-        report, agent = reports[runs[name, seeds[0]].settings.output], agents[seeds[0]]
-        methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
-                   "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
+        trained = {seed: (runs[name, seed].settings.output, reports[runs[name, seed].settings.output])
+                   for seed in seeds}
         sets = {"test": test_clips} if name == "holdout" else {"test": test_clips, "bye": byes}
-        entry = {"train_clips": len(train_clips), "episodes": report["episodes"],
-                 "train_seconds": report["train_seconds"],
-                 "seen": _summary(compare({"rlanimate": agent}, scoring.select_clips(
-                     train_clips, (behaviours.WAVE,), scoring.SEEN_CLIP_COUNT), env, references)["rlanimate"]),
-                 "train_cpu_seconds": {str(seed): reports[runs[name, seed].settings.output]["train_cpu_seconds"]
-                                       for seed in seeds}}
-        if name == "holdout":
-            entry["held_out_styles"] = list(HOLDOUT_STYLES)
-        for (set_name, clips), (suffix, with_tempo) in itertools.product(sets.items(), REQUESTS.items()):
-            key = set_name + suffix
-            entry[key] = compare(methods, clips, env, references, with_tempo)
-            entry[f"{key}_seeds"] = {str(seeds[0]): seed_summary(entry[key]["rlanimate"])}
-            for seed in seeds[1:]:
-                result = compare({"rlanimate": agents[seed]}, clips, env, references, with_tempo)["rlanimate"]
-                entry[f"{key}_seeds"][str(seed)] = seed_summary(result)
-        results[name] = entry
+        results[name], agent = _experiment(name, train_clips, sets, trained, env, references)
         if name == "wave":
-            chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
-            generated = baselines.generate_for(methods["rlanimate"], chosen)
-            frames_figure(
-                env,
-                [
-                    (f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
-                    for c, g in zip(chosen, generated, strict=True)
-                ],
-                Path(settings.results) / "realmocap_frames.png",
-            )
+            _frames_figure(agent, test_clips, env, Path(settings.results) / "realmocap_frames.png")
     results["evaluation_cpu_seconds"] = time.process_time() - evaluation_started
+    results["guide"] = _guide(settings, seeds[0], guides, env)
+    return results
 
+
+def _load_capture(settings: RealMocapSettings) -> tuple[list, list, list, FKEnvironment]:
+    """(waves, byes, guides, the FK environment): the capture's takes, imported where the cache lacks them."""
+    root = require_realmocap(settings.realmocap)
+    Path(settings.results).mkdir(parents=True, exist_ok=True)
+    cache = Path(settings.runs) / "import_cache"
+    if settings.address is not None:  # the import's Ray tasks, if any, and the training runs go to the cluster
+        connect(settings.address)
+    with blender_output():
+        waves, byes, guides = (load_folder(f, root, cache, settings.import_workers) for f in ("wave", "bye", "guide"))
+        env = FKEnvironment()
+    return waves, byes, guides, env
+
+
+def _command(settings: RealMocapSettings, seeds: list[int]) -> str:
+    """The command that regenerates the results."""
+    command = (f"nice -n 15 python -m trainer.scripts.realmocap --epochs {settings.epochs} --preset {settings.preset} "
+               f"--seeds {' '.join(str(seed) for seed in seeds)}")
+    if settings.point_agent:
+        command += f" --point-agent {settings.point_agent}"
+    return command
+
+
+def _experiment(name: str, train_clips: list, sets: dict, trained: dict, env: FKEnvironment,
+                references: ClipReferences) -> tuple[dict, baselines.AgentMethod]:
+    """(the experiment's results entry, the first seed's agent): every method on every set and request, each
+    seed's agent on them too. trained: {seed: (its run's output folder, its training report)}, first seed first."""
+    agents = {seed: baselines.AgentMethod(Path(output) / "agent.npz") for seed, (output, _) in trained.items()}
+    seeds = list(trained)
+    report, agent = trained[seeds[0]][1], agents[seeds[0]]
+    methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(train_clips),
+               "procedural_ik": ProceduralIK(baselines.mean_start_pose(train_clips))}
+    entry = {"train_clips": len(train_clips), "episodes": report["episodes"],
+             "train_seconds": report["train_seconds"],
+             "seen": _summary(compare({"rlanimate": agent}, scoring.select_clips(
+                 train_clips, (behaviours.WAVE,), scoring.SEEN_CLIP_COUNT), env, references)["rlanimate"]),
+             "train_cpu_seconds": {str(seed): trained[seed][1]["train_cpu_seconds"] for seed in seeds}}
+    if name == "holdout":
+        entry["held_out_styles"] = list(HOLDOUT_STYLES)
+    for (set_name, clips), (suffix, with_tempo) in itertools.product(sets.items(), REQUESTS.items()):
+        key = set_name + suffix
+        entry[key] = compare(methods, clips, env, references, with_tempo)
+        entry[f"{key}_seeds"] = {str(seeds[0]): seed_summary(entry[key]["rlanimate"])}
+        for seed in seeds[1:]:
+            result = compare({"rlanimate": agents[seed]}, clips, env, references, with_tempo)["rlanimate"]
+            entry[f"{key}_seeds"][str(seed)] = seed_summary(result)
+    return entry, agent
+
+
+def _frames_figure(agent: baselines.AgentMethod, test_clips: list, env: FKEnvironment, path: Path) -> None:
+    """realmocap_frames.png: the agent's waves beside the test takes nearest exaggerations 0.1, 0.7 and 1."""
+    chosen = [min(test_clips, key=lambda c: abs(c.exaggeration - e)) for e in (0.1, 0.7, 1.0)]
+    generated = baselines.generate_for(agent, chosen)
+    frames_figure(env, [(f"{c.style} {c.arm.lower()} {c.take}\ne = {c.exaggeration:.2f}", c.rotvecs, g)
+                        for c, g in zip(chosen, generated, strict=True)], path)
+
+
+def _guide(settings: RealMocapSettings, seed: int, guides: list, env: FKEnvironment) -> dict:
+    """The guide experiment's results: each method's forearm angle on the guide takes, asked as pointing; or
+    why it was skipped (no pointing agent and no sample library to train one on)."""
     try:
-        point_method, point_clips = point_agent_and_library(settings.point_agent, settings.runs, settings.epochs,
-                                                            seeds[0])
-    except RLAnimateError as error:  # no pointing agent and no sample library to train one on
-        results["guide"] = {"skipped": str(error)}
-        return results
+        point_method, point_clips = point_agent_and_library(settings.point_agent, settings.runs, settings.epochs, seed)
+    except RLAnimateError as error:
+        return {"skipped": str(error)}
     guide_methods = {"rlanimate": point_method, "nearest_clip": baselines.NearestClip(point_clips),
                      "procedural_ik": ProceduralIK(baselines.mean_start_pose(point_clips))}
-    agent_path = point_method.path.resolve()
-    results["guide"] = {"point_agent": str(shown(agent_path)),
-                        **{name: guide_angles(method, guides, env) for name, method in guide_methods.items()}}
-    return results
+    return {"point_agent": str(shown(point_method.path.resolve())),
+            **{name: guide_angles(method, guides, env) for name, method in guide_methods.items()}}
 
 
 def _method_rows(comparison):

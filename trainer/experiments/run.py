@@ -17,10 +17,11 @@ from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any
 
 import numpy as np
 import torch
+import tyro
 from tqdm import tqdm
 
 from rlanimate_addon.core import behaviours
@@ -29,10 +30,11 @@ from trainer.agent import checkpoint
 from trainer.agent.agent_export import export_agent
 from trainer.agent.algorithm import Trainer
 from trainer.agent.config import PRESETS, load_preset
-from trainer.agent.models import RLAnimateAgent
+from trainer.agent.models import VARIANTS, RLAnimateAgent
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.cluster import connect, run_tasks
 from trainer.evaluation.scoring import evaluate_seen_unseen, select_clips
+from trainer.experiments.options import one_of
 from trainer.motion.autolabel import still_free_arm
 from trainer.motion.clip import trained_behaviours, training_space
 from trainer.motion.library_checks import check_new_behaviours, left_out
@@ -47,22 +49,30 @@ RESUMED_SETTINGS = ("behaviour", "clips", "preset", "variant", "seed", "eval_eve
 
 @dataclass(frozen=True)
 class RunSettings:
-    """What a run is. None means "not given": a new run takes the default below (`epochs`: the preset's,
-    the paper's 50 for one behaviour and 100 for both), a resumed run its checkpoint's value."""
-    output: str
-    behaviour: str = None  # the training set: "all", "both", a behaviour's key or keys joined by commas
-    #                        (core.behaviours.training_set)
-    clips: str = None  # the clip library's manifest.json (or its folder), recorded in the report
-    epochs: int = None  # iterations of Algorithm 1
-    seed: int = None
-    preset: str = None  # config preset: debug, default or paper
-    variant: str = None  # ablation variant (Table 4)
-    eval_every: int = None  # evaluate on seen and unseen clips every N epochs (0: only at the end)
-    resume: bool = False  # continue the run in `output` from its checkpoint
-    overwrite: bool = False  # replace the run in `output` (without it, a new run there is refused)
-    allow_new_behaviour: bool = False  # "all" trains a new behaviour that fewer than 3 clips name
-    checkpoint_every: int = 1
-    progress: bool = True  # show a progress bar
+    """What a run is (train.py's command line). A setting left out (None) takes the default its help names,
+    or on --resume the run's own value."""
+    output: str  # the run's folder: its agent, checkpoint, metrics, report and plots
+    # the behaviours to learn: all (every behaviour of the clip library), both (point and wave), one
+    # behaviour (point), or several joined by commas (point,beckon) (None: all; on --resume, the run's own)
+    behaviour: str | None = None
+    # clip library: a manifest.json or the folder that holds one; or a folder of .bvh/.fbx takes without one, which
+    # is labelled from the takes' names and motion into <output>/manifest.json (None: sample_rigs/clips)
+    clips: str | None = None
+    # iterations of Algorithm 1 (None: the preset's, the paper's 50 for one behaviour and 100 for both;
+    # on --resume, the run's own)
+    epochs: int | None = None
+    seed: int | None = None  # the training seed (None: 2)
+    preset: str | None = None  # config preset: debug, default or paper (None: default)
+    variant: Annotated[str | None, one_of(VARIANTS)] = None  # ablation variant (Table 4; None: rlanimate)
+    # evaluate on seen and unseen clips every N epochs (0: only at the end; None: 10)
+    eval_every: int | None = None
+    resume: bool = False  # continue the run in --output from its checkpoint, with the run's own settings
+    overwrite: bool = False  # replace the run in --output (without it, a new run into a run's folder is refused)
+    # with --behaviour all, also learn a behaviour other than point and wave that fewer than 3 clips name (without
+    # it, such a behaviour is refused as a likely typo)
+    allow_new_behaviour: bool = False
+    checkpoint_every: int = 1  # write the run's checkpoint every N epochs
+    progress: tyro.conf.Suppress[bool] = True  # show a progress bar (the command line's --quiet turns it off)
 
 
 #: Seed 2: of seeds 0-3 of the default preset (T = 120 updates an epoch), the one whose agent meets issue
@@ -240,6 +250,7 @@ def _trainer(settings: RunSettings, session: Any, saved: dict | None) -> tuple[T
     """(Trainer, planned epochs) of the resolved `settings` on `session`, from the checkpoint `saved` when
     resuming; a new run with "all" first says which of the library's behaviours it leaves out, and refuses
     a new behaviour that fewer than 3 clips name (library_checks)."""
+    assert settings.behaviour is not None and settings.seed is not None, "resolved settings (resolve) fill both"
     agent_config, train_config = load_preset(settings.preset)
     trained = trained_behaviours(session.train_clips, settings.behaviour)
     if settings.behaviour == behaviours.ALL:

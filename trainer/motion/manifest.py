@@ -41,11 +41,11 @@ class ManifestEntry:
     behaviour: str  # the behaviour's id ("POINT", "WAVE", "BECKON")
     kind: str  # behaviours.TARGET or INTENSITY
     arm: str  # "LEFT" or "RIGHT"
-    target: tuple = None  # (3,) in the character frame, or None
-    direction: tuple = None  # (3,) unit vector, or None
-    exaggeration: float = None
-    frames: int = None
-    fps: float = None  # the entry's own, or the manifest's
+    target: tuple[float, ...] | None = None  # (3,) in the character frame, or None
+    direction: tuple[float, ...] | None = None  # (3,) unit vector, or None
+    exaggeration: float | None = None
+    frames: int | None = None
+    fps: float | None = None  # the entry's own, or the manifest's
     split: str = "train"
     does: str | None = None  # behaviours.ACTIONS, or None: the shipped name's
 

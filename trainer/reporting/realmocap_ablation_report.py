@@ -5,7 +5,7 @@ import numpy as np
 
 from rlanimate_addon.core.rhythm import BANDWIDTH, TEMPO_BANDWIDTH
 from trainer.reporting.realmocap_report import SEED_METRICS, STYLE_METRICS, metric_cells
-from trainer.reporting.tables import markdown_table
+from trainer.reporting.tables import page, paragraphs, section, table
 
 #: Retrieval's results: for the plain request, and for the one naming the take's tempo.
 RETRIEVAL, RETRIEVAL_TEMPO = "nearest_clip", "nearest_clip, tempo asked"
@@ -92,93 +92,65 @@ def findings(results):
     return lines + [""]
 
 
+#: The seeds, settings, presets and requests of the page's methods, one list item each.
+_VARIANTS = (
+    "- *typical tempo*: what the agent file plays for Variation Seed 0 (the panel's seed 0 is no seed): "
+    f"the weighted mean rate, start and stop of the training waves near the request's exaggeration (kernel "
+    f"sd {BANDWIDTH:g}) and near the typical tempo of those (the mode of their log tempos; kernel sd "
+    f"{TEMPO_KERNEL}), of both arms, at their weighted circular mean phase (core/rhythm.py; the kernels "
+    "and arms chosen on validation takes, docs/results/realmocap_length.md).",
+    "- *mean rhythm, all waves' phase*: as files exported without their waves' phases play, and as every "
+    "agent played before: the weighted mean of the waves near the exaggeration alone (kernel sd 0.05), "
+    "whatever their tempo, at the circular mean phase of all training waves.",
+    "- *the kernels before*: the typical tempo with the kernels of the files made before they were chosen "
+    "(sd 0.05, log 1.25).",
+    "- *the request's arm's waves*: the typical tempo from the training waves of the request's arm alone, "
+    "as retrieval fetches only that arm's.",
+    "- *sampled states N*: the typical tempo, with the stochastic states sampled (seed N) instead of their means.",
+    "- *seed N*: the panel's Variation Seed N > 0: one nearby training wave's rhythm at a uniformly random "
+    "phase, and sampled stochastic states.",
+    "- *tempo asked*: the request names the take's own tempo (Hz, read from its swing as the trainer reads "
+    "it: the panel's Tempo); the agent swings at it, its start, stop and phase those of the training "
+    "waves near its exaggeration and that tempo (*mean rhythm*: of those near its exaggeration alone). "
+    "Retrieval, tempo asked, ranks the training waves by exaggeration and log tempo, each in units of its sd.",
+    "- *each take's own rhythm*: the agent as exported, its rhythm read from the held-out take itself (as "
+    "training reads a clip's): not a method, since no request can say it, but what the agent's poses give "
+    "when its rhythm is right; the gap between it and *as exported* is the rhythm's.",
+    "- *preset P*: the agent trained with preset P instead, playing the typical tempo (`end_chunks` is "
+    "`default` with a fifth of the "
+    "update's chunks ending at the gesture's last frame, trainer/agent/buffer.py).")
+#: The columns of the tables after the test set (and style): the method and realmocap_report.SEED_METRICS'.
+_METRIC_COLUMNS = ["method", "score", "DTW score", "swing ratio", "frequency ratio", "last-frame elevation error (deg)",
+                   "accepted"]
+
+
 def ablation_markdown(results):
     """docs/results/realmocap_ablation.md from run_ablation's results."""
     deterministic = [name for name in results["variants"] if not _seeded(name)] + [RETRIEVAL, RETRIEVAL_TEMPO]
+    return page(
+        ["# The wave's rhythm and tempo at play time, and the training preset, on real capture (an ablation)", ""],
+        paragraphs(_introduction(results)), [*_VARIANTS, ""], findings(results),
+        section("All takes", "Mean score and DTW score; median swing and frequency ratios (issue 26 asks 0.75-1.33 "
+                "and 0.8-1.25) and last-frame arm elevation error (degrees; asked: at most 4); waves "
+                "`core.behaviour_metrics` accepts."),
+        table(["test set", *_METRIC_COLUMNS], overall_rows(results)),
+        section("Per style (the deterministic settings and retrieval)"),
+        table(["test set", "style", *_METRIC_COLUMNS], style_rows(results, deterministic)),
+        section("Hand paths", "The first right-arm test take of the worst and best styles: the wrist's side-to-side "
+                "offset from its shoulder over time (left) and its path seen from the front (right), the real take "
+                "in black.", "![hand paths of real takes and the variants](realmocap_ablation_paths.png)"))
+
+
+def _introduction(results):
+    """The page's first paragraph: the agents, how the methods answer, the command and its times."""
     timing = "; ".join(f"{entry['test_set']}: agent trained in {entry['train_seconds']:.0f} s, all variants "
                        f"scored in {entry['evaluation_cpu_seconds']:.0f} CPU s"
                        for entry in results["experiments"].values())
-    lines = [
-        "# The wave's rhythm and tempo at play time, and the training preset, on real capture (an ablation)",
-        "",
-        f"One agent per test set (training seed {results['seed']}, preset `{results['preset']}`, "
-        f"{results['epochs']} epochs: the agents `trainer.scripts.realmocap --epochs {results['epochs']}` "
-        "trains), played with different "
-        "rhythm settings and nothing retrained, beside the same seed's agents of other presets "
-        "(trainer/experiments/realmocap_ablation.py). Every method answers each held-out take's own request "
-        "(its auto-label and length, and where it says so the take's tempo) and is scored against it as in "
-        "docs/results/realmocap.md. Regenerate: "
-        f"`{results['command']}` ({timing}; one torch thread).",
-        "",
-        "- *typical tempo*: what the agent file plays for Variation Seed 0 (the panel's seed 0 is no seed): "
-        f"the weighted mean rate, start and stop of the training waves near the request's exaggeration (kernel "
-        f"sd {BANDWIDTH:g}) and near the typical tempo of those (the mode of their log tempos; kernel sd "
-        f"{TEMPO_KERNEL}), of both arms, at their weighted circular mean phase (core/rhythm.py; the kernels "
-        "and arms chosen on validation takes, docs/results/realmocap_length.md).",
-        "- *mean rhythm, all waves' phase*: as files exported without their waves' phases play, and as every "
-        "agent played before: the weighted mean of the waves near the exaggeration alone (kernel sd 0.05), "
-        "whatever their tempo, at the circular mean phase of all training waves.",
-        "- *the kernels before*: the typical tempo with the kernels of the files made before they were chosen "
-        "(sd 0.05, log 1.25).",
-        "- *the request's arm's waves*: the typical tempo from the training waves of the request's arm alone, "
-        "as retrieval fetches only that arm's.",
-        "- *sampled states N*: the typical tempo, with the stochastic states sampled (seed N) instead of their means.",
-        "- *seed N*: the panel's Variation Seed N > 0: one nearby training wave's rhythm at a uniformly random "
-        "phase, and sampled stochastic states.",
-        "- *tempo asked*: the request names the take's own tempo (Hz, read from its swing as the trainer reads "
-        "it: the panel's Tempo); the agent swings at it, its start, stop and phase those of the training "
-        "waves near its exaggeration and that tempo (*mean rhythm*: of those near its exaggeration alone). "
-        "Retrieval, tempo asked, ranks the training waves by exaggeration and log tempo, each in units of its sd.",
-        "- *each take's own rhythm*: the agent as exported, its rhythm read from the held-out take itself (as "
-        "training reads a clip's): not a method, since no request can say it, but what the agent's poses give "
-        "when its rhythm is right; the gap between it and *as exported* is the rhythm's.",
-        "- *preset P*: the agent trained with preset P instead, playing the typical tempo (`end_chunks` is "
-        "`default` with a fifth of the "
-        "update's chunks ending at the gesture's last frame, trainer/agent/buffer.py).",
-        "",
-        *findings(results),
-        "## All takes",
-        "",
-        "Mean score and DTW score; median swing and frequency ratios (issue 26 asks 0.75-1.33 and 0.8-1.25) and "
-        "last-frame arm elevation error (degrees; asked: at most 4); waves `core.behaviour_metrics` accepts.",
-        "",
-        *markdown_table(
-            [
-                "test set",
-                "method",
-                "score",
-                "DTW score",
-                "swing ratio",
-                "frequency ratio",
-                "last-frame elevation error (deg)",
-                "accepted",
-            ],
-            overall_rows(results),
-        ),
-        "",
-        "## Per style (the deterministic settings and retrieval)",
-        "",
-        *markdown_table(
-            [
-                "test set",
-                "style",
-                "method",
-                "score",
-                "DTW score",
-                "swing ratio",
-                "frequency ratio",
-                "last-frame elevation error (deg)",
-                "accepted",
-            ],
-            style_rows(results, deterministic),
-        ),
-        "",
-        "## Hand paths",
-        "",
-        "The first right-arm test take of the worst and best styles: the wrist's side-to-side offset from its "
-        "shoulder over time (left) and its path seen from the front (right), the real take in black.",
-        "",
-        "![hand paths of real takes and the variants](realmocap_ablation_paths.png)",
-        "",
-    ]
-    return "\n".join(lines)
+    return (f"One agent per test set (training seed {results['seed']}, preset `{results['preset']}`, "
+            f"{results['epochs']} epochs: the agents `trainer.scripts.realmocap --epochs {results['epochs']}` "
+            "trains), played with different "
+            "rhythm settings and nothing retrained, beside the same seed's agents of other presets "
+            "(trainer/experiments/realmocap_ablation.py). Every method answers each held-out take's own request "
+            "(its auto-label and length, and where it says so the take's tempo) and is scored against it as in "
+            "docs/results/realmocap.md. Regenerate: "
+            f"`{results['command']}` ({timing}; one torch thread).")

@@ -7,7 +7,7 @@ from trainer.motion.realmocap_takes import parse_name
 from trainer.reporting import plots
 from trainer.reporting.baselines_report import METHOD_LABELS
 from trainer.reporting.realmocap_report import mean_and_sd, seed_summary
-from trainer.reporting.tables import markdown_table
+from trainer.reporting.tables import page, paragraphs, section, table
 
 #: The sets of the page, in order: (key in results["sets"], behaviour key in by_behaviour, label).
 SETS = (("waves", "wave", "waves, takes 009-010"),
@@ -184,112 +184,108 @@ def wave_style_rows(results, wave_only):
     return rows
 
 
+#: What the page says of the three behaviours the agent learns.
+_TRAINED = (
+    "One agent per seed, three behaviours (core/behaviours.py kinds):\n"
+    "- `WAVE` (intensity): the one-arm waves of dataset 2, split as realmocap.md's wave experiment "
+    "(takes 001-008 and 021-036 train, takes 009-010 test; takes 011-020 never read).\n"
+    "- `GUIDE` (target): \"this way\", the right arm held out to direct. It is conditioned on a direction, as "
+    "point is: the direction in which the actor held the arm (autolabel.label_point, rest shoulder to index "
+    "base at the hold). The capture has no fingers, so the hand is the synthesised relaxed one; the palm's "
+    "turn comes from the captured wrist.\n"
+    "- `BYE` (intensity): the goodbye waves of dataset 1, a wave of a different actor and style set, "
+    "conditioned on the exaggeration autolabel reads from the motion (as the waves are). It is a behaviour "
+    "of its own rather than more `WAVE` clips, so that the agent and retrieval can tell a goodbye from a "
+    "wave and the two experiments' waves stay comparable; measured with the wave metrics.")
+#: How retrieval answers, and how each behaviour is measured.
+_RETRIEVAL = (
+    "Retrieval (nearest clip) answers the same requests from the same training clips: the training clip of "
+    "the same behaviour and arm whose label (direction or exaggeration) is nearest, time-warped to the "
+    "requested length. Guide takes are measured with the guide metrics (core.behaviour_metrics: heading "
+    "within 20 deg, palm within 65 deg of up, reach 0.5 arm lengths, held 0.4 s, free arm down) towards a "
+    "target 3 m along the held direction; goodbye waves with the wave metrics (swing and frequency against "
+    "the real take).")
+_GUIDE_METRICS = (
+    "Medians over the takes. \"Real take\" is the real take measured against its own held direction: what "
+    "a perfect copy reaches. The guide metrics were set on the sample library's generated guides; the "
+    "real actors often hold the arm out for less than 0.4 s or move the free arm more than 0.1 arm "
+    "lengths, so \"form\" also counts the takes whose heading, palm and reach are within the bounds, "
+    "leaving out the hold and the free arm.")
+_WAVE_METRICS = (
+    "Medians of the swing and frequency ratios (issue 10 asks 0.75-1.33x and 0.8-1.2x) and of the "
+    "last-frame elevation error; waves `core.behaviour_metrics` accepts. On takes 009-010 the wave-only "
+    "agent of realmocap.md (same takes, seed, preset and epochs, without guide and bye) is shown for the "
+    "before/after. For scale: over seeds 0-2 the wave-only agent trained on takes 001-008 alone "
+    "(112 clips, commit 1ea161e) spread by 1.3 in score, 1.5 in DTW score and 2.1 in accepted waves (sd).")
+
+
 def gestures_markdown(results, wave_only=None):
     """docs/results/realmocap_guide_bye.md from run_experiment's results; `wave_only`: the wave agent's
     seed-0 summary on takes 009-010 from realmocap.json, for the before/after rows."""
-    styles = ", ".join(results["test_styles"])
-    counts = results["train_clips"]
-    lines = [
-        "# Guide and goodbye takes beside the waves (real capture, an experiment)",
-        "",
-        "Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the sample rig "
-        "as in realmocap.md. **Nothing trained here ships** (the licence is non-commercial): only these figures "
-        f"and the plot are in the repository. Regenerate: `{results['command']}`.",
-        "",
-        f"Preset `{results['preset']}`, {results['epochs']} epochs, {_seeds_sentence(results['seeds'])} The "
-        "held-out guide and bye sets have 4 takes each, so one take is 25 points of acceptance; read them as "
-        "indications, not measurements.",
-        "",
-        "## What was trained",
-        "",
-        "One agent per seed, three behaviours (core/behaviours.py kinds):",
-        "- `WAVE` (intensity): the one-arm waves of dataset 2, split as realmocap.md's wave experiment "
-        "(takes 001-008 and 021-036 train, takes 009-010 test; takes 011-020 never read).",
-        "- `GUIDE` (target): \"this way\", the right arm held out to direct. It is conditioned on a direction, as "
-        "point is: the direction in which the actor held the arm (autolabel.label_point, rest shoulder to index "
-        "base at the hold). The capture has no fingers, so the hand is the synthesised relaxed one; the palm's "
-        "turn comes from the captured wrist.",
-        "- `BYE` (intensity): the goodbye waves of dataset 1, a wave of a different actor and style set, "
-        "conditioned on the exaggeration autolabel reads from the motion (as the waves are). It is a behaviour "
-        "of its own rather than more `WAVE` clips, so that the agent and retrieval can tell a goodbye from a "
-        "wave and the two experiments' waves stay comparable; measured with the wave metrics.",
-        "",
+    return page(_introduction(results), _trained_section(results), _score_section(results),
+                section("Guide metrics", _GUIDE_METRICS),
+                table(["set", "method", "heading error (deg)", "palm from up (deg)", "reach (arm lengths)",
+                       "hold ratio", "accepted", "form (heading, palm, reach)"], guide_rows(results)),
+                _wave_section(results, wave_only),
+                paragraphs("![hand paths of a held-out guide and bye take](realmocap_guide_bye_paths.png)"))
+
+
+def _introduction(results):
+    return [
+        "# Guide and goodbye takes beside the waves (real capture, an experiment)", "",
+        *paragraphs(
+            "Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the sample "
+            "rig as in realmocap.md. **Nothing trained here ships** (the licence is non-commercial): only these "
+            f"figures and the plot are in the repository. Regenerate: `{results['command']}`.",
+            f"Preset `{results['preset']}`, {results['epochs']} epochs, {_seeds_sentence(results['seeds'])} The "
+            "held-out guide and bye sets have 4 takes each, so one take is 25 points of acceptance; read them as "
+            "indications, not measurements.")]
+
+
+def _trained_section(results):
+    """'What was trained': the behaviours, the held-out styles and clips, retrieval, the goodbyes' cuts."""
+    counts, raised = results["train_clips"], raised_starts(results)
+    seconds = ", ".join(f"{t:.0f} s (seed {s})" for s, t in results["train_seconds_per_seed"].items())
+    return section(
+        "What was trained", _TRAINED,
         f"Dataset 1 has one guide and one bye take per style, so they are held out by style: the same 4 of the "
-        f"14 styles for both behaviours ({styles}), drawn with numpy's default_rng(27) before training "
-        "(trainer/motion/realmocap_takes.py, gesture_test_styles); the other 10 train "
+        f"14 styles for both behaviours ({', '.join(results['test_styles'])}), drawn with numpy's default_rng(27) "
+        "before training (trainer/motion/realmocap_takes.py, gesture_test_styles); the other 10 train "
         f"({', '.join(results['train_styles'])}). Training clips: {counts['wave']} waves, {counts['guide']} guides, "
-        f"{counts['bye']} byes; {results['episodes']} episodes; training took "
-        f"{', '.join(f'{t:.0f} s (seed {s})' for s, t in results['train_seconds_per_seed'].items())} "
+        f"{counts['bye']} byes; {results['episodes']} episodes; training took {seconds} "
         "(1 torch thread, under load). Note that 2 of the 4 held-out goodbye waves (active 0.99, childish 0.94) "
         "lie above the training byes' labels (the highest: masculinity 0.75): both methods extrapolate there.",
-        "",
-        "Retrieval (nearest clip) answers the same requests from the same training clips: the training clip of "
-        "the same behaviour and arm whose label (direction or exaggeration) is nearest, time-warped to the "
-        "requested length. Guide takes are measured with the guide metrics (core.behaviour_metrics: heading "
-        "within 20 deg, palm within 65 deg of up, reach 0.5 arm lengths, held 0.4 s, free arm down) towards a "
-        "target 3 m along the held direction; goodbye waves with the wave metrics (swing and frequency against "
-        "the real take).",
-        "",
-        f"**The goodbye takes are cut unevenly**: {len(raised_starts(results))} of the 14 start (and end) with the "
-        f"arm already raised, {RAISED_START_DEG:.0f} deg or more from hanging ({', '.join(raised_starts(results))}); "
+        _RETRIEVAL,
+        f"**The goodbye takes are cut unevenly**: {len(raised)} of the 14 start (and end) with the "
+        f"arm already raised, {RAISED_START_DEG:.0f} deg or more from hanging ({', '.join(raised)}); "
         "the others start and end hanging. Those "
         "raised throughout are mostly the higher exaggerations, so a goodbye request near them gets a hand held "
         "up from the first frame, by both methods (the figure's musical bye). The guide takes all start and end "
-        "with the arm hanging.",
-        "",
-        "## Score, DTW score and acceptance",
-        "",
-        *markdown_table(["set", "method", "takes", "score", "DTW score", "smoothness", "accepted"],
-                        summary_rows(results)),
-        "",
-        "RLAnimate (the first seed's agent) minus retrieval on the held-out sets (negative: retrieval is better):",
-        "",
-        *markdown_table(["set", "score", "DTW score", "accepted takes"], gap_rows(results)),
-        "",
-        "### Seeds",
-        "",
-        "Each seed's agent on the held-out sets (the tables above and below are the first seed's).",
-        "",
-        *markdown_table(["set", "method", "score", "DTW score", "accepted"], seed_rows(results)),
-        "",
-        "## Guide metrics",
-        "",
-        "Medians over the takes. \"Real take\" is the real take measured against its own held direction: what "
-        "a perfect copy reaches. The guide metrics were set on the sample library's generated guides; the "
-        "real actors often hold the arm out for less than 0.4 s or move the free arm more than 0.1 arm "
-        "lengths, so \"form\" also counts the takes whose heading, palm and reach are within the bounds, "
-        "leaving out the hold and the free arm.",
-        "",
-        *markdown_table(["set", "method", "heading error (deg)", "palm from up (deg)", "reach (arm lengths)",
-                         "hold ratio", "accepted", "form (heading, palm, reach)"], guide_rows(results)),
-        "",
-        "## Wave metrics (waves and goodbye waves)",
-        "",
-        "Medians of the swing and frequency ratios (issue 10 asks 0.75-1.33x and 0.8-1.2x) and of the "
-        "last-frame elevation error; waves `core.behaviour_metrics` accepts. On takes 009-010 the wave-only "
-        "agent of realmocap.md (same takes, seed, preset and epochs, without guide and bye) is shown for the "
-        "before/after. For scale: over seeds 0-2 the wave-only agent trained on takes 001-008 alone "
-        "(112 clips, commit 1ea161e) spread by 1.3 in score, 1.5 in DTW score and 2.1 in accepted waves (sd).",
-        "",
-        *markdown_table(["set", "method", "score", "DTW score", "swing ratio", "frequency ratio",
-                         "last-frame elevation error (deg)", "accepted"], wave_rows(results, wave_only)),
-        "",
-        "### Per held-out take",
-        "",
-        "RLAnimate / retrieval.",
-        "",
-        *markdown_table(["behaviour", "style", "score", "DTW score", "accepted"], style_rows(results)),
-        "",
-        "### Waves per style, takes 009-010",
-        "",
-        "This agent / the wave-only agent of realmocap.md / retrieval (4 takes a style).",
-        "",
-        *markdown_table(["style", "score", "DTW score", "accepted"], wave_style_rows(results, wave_only)),
-        "",
-        "![hand paths of a held-out guide and bye take](realmocap_guide_bye_paths.png)",
-        "",
-    ]
-    return "\n".join(lines)
+        "with the arm hanging.")
+
+
+def _score_section(results):
+    """Score, DTW score and acceptance per set and method, RLAnimate's gap to retrieval, and the seeds."""
+    return [*section("Score, DTW score and acceptance"),
+            *table(["set", "method", "takes", "score", "DTW score", "smoothness", "accepted"], summary_rows(results)),
+            *paragraphs("RLAnimate (the first seed's agent) minus retrieval on the held-out sets (negative: retrieval "
+                        "is better):"),
+            *table(["set", "score", "DTW score", "accepted takes"], gap_rows(results)),
+            *section("Seeds", "Each seed's agent on the held-out sets (the tables above and below are the first "
+                     "seed's).", level=3),
+            *table(["set", "method", "score", "DTW score", "accepted"], seed_rows(results))]
+
+
+def _wave_section(results, wave_only):
+    """The wave metrics of the waves and goodbye waves, per held-out take, and per wave style."""
+    return [*section("Wave metrics (waves and goodbye waves)", _WAVE_METRICS),
+            *table(["set", "method", "score", "DTW score", "swing ratio", "frequency ratio",
+                    "last-frame elevation error (deg)", "accepted"], wave_rows(results, wave_only)),
+            *section("Per held-out take", "RLAnimate / retrieval.", level=3),
+            *table(["behaviour", "style", "score", "DTW score", "accepted"], style_rows(results)),
+            *section("Waves per style, takes 009-010",
+                     "This agent / the wave-only agent of realmocap.md / retrieval (4 takes a style).", level=3),
+            *table(["style", "score", "DTW score", "accepted"], wave_style_rows(results, wave_only))]
 
 
 def paths_figure(env, methods, sets, path, style=FIGURE_STYLE):

@@ -8,7 +8,7 @@ from rlanimate_addon.core import skeleton
 from trainer.motion.realmocap_takes import HOLDOUT_STYLES, TAKE_GROUPS, TEST_TAKES, VALIDATION_TAKES, parse_name
 from trainer.reporting.baselines_report import METHOD_LABELS
 from trainer.reporting.paired import gap_cell, paired_gap
-from trainer.reporting.tables import markdown_table
+from trainer.reporting.tables import page, paragraphs, section, table
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -221,20 +221,23 @@ def fallback_notes(results):
     return notes
 
 
+#: What the side-by-side table shows.
+_BOTH_REQUESTS = (
+    "Each test take asked the paper's way (its auto-label and length) and again naming its tempo (the Hz at "
+    "which its hand swings, as a user types it in the panel's Tempo). Score / DTW score: RLAnimate's mean ± "
+    "sd over the seeds' agents, and nearest-clip retrieval's from the same training takes. Gap: RLAnimate's "
+    "per-take score (mean over the seeds paired: those whose per-take scores the results keep, the first "
+    "seed's alone in pages scored before they were kept) minus retrieval's on the same take, mean and 95% "
+    "interval over the takes.")
+
+
 def both_requests_section(results):
     """Lines of the page's first section: each test set asked both ways, side by side (both_request_rows)."""
     notes = fallback_notes(results)
-    return ["## Both requests, side by side", "",
-            "Each test take asked the paper's way (its auto-label and length) and again naming its tempo (the Hz at "
-            "which its hand swings, as a user types it in the panel's Tempo). Score / DTW score: RLAnimate's mean ± "
-            "sd over the seeds' agents, and nearest-clip retrieval's from the same training takes. Gap: RLAnimate's "
-            "per-take score (mean over the seeds paired: those whose per-take scores the results keep, the first "
-            "seed's alone in pages scored before they were kept) minus retrieval's on the same take, mean and 95% "
-            "interval over the takes.", "",
-            *markdown_table(["test set", "request", "RLAnimate score / DTW", "retrieval score / DTW",
-                             "paired score gap (95%)", "paired DTW gap (95%)", "seeds paired"],
-                            both_request_rows(results)),
-            *(["", *notes] if notes else []), ""]
+    return [*section("Both requests, side by side", _BOTH_REQUESTS),
+            *table(["test set", "request", "RLAnimate score / DTW", "retrieval score / DTW",
+                    "paired score gap (95%)", "paired DTW gap (95%)", "seeds paired"], both_request_rows(results)),
+            *([*notes, ""] if notes else [])]
 
 
 def cpu_list(entry):
@@ -281,142 +284,172 @@ def reach_rows(results):
     return rows
 
 
+#: The paragraph under the auto-labels table: the two readings of a style's tempo.
+_TEMPO_READINGS = (
+    "Tempo, median over the style's takes, read two ways: the peak of the hand's side-to-side "
+    "spectrum (how the trainer reads a training wave's rhythm, and the Tempo a request names), and "
+    "the strokes between turning points at least 8% of the shoulder width apart "
+    "(`core.behaviour_metrics.wave_measures`, whose frequency ratio the tables below report); stroke: "
+    "their median length. Where the strokes are small (a tremble) the two disagree, and the frequency "
+    "ratio judges a wave by the second.")
+_TAKE_GROUPS_NOTE = (
+    "Each cell: the mean exaggeration, the median tempo as the trainer reads it (spectrum), and the "
+    "takes. Takes 007-008 validate what takes 009-010 test (trainer/experiments/realmocap_length.py). Where a "
+    "style's tempo moves from one group of takes to another while its label barely does, a rhythm drawn "
+    "from the label cannot follow it, and validation on takes 007-008 cannot show what it costs on takes "
+    "009-010.")
+_REQUESTS = (
+    "Every method answers each test take's request twice: with the take's auto-label and length (the "
+    "paper's request; *test*, *bye*), and with the same naming the take's own tempo as well (*tempo "
+    "asked*: the Hz at which its hand swings side to side, read as the trainer reads a training wave's; "
+    "the panel's Tempo). One exaggeration cannot say a tempo: masculine and normal waves share one label "
+    "and swing at different rates. Asked a tempo, RLAnimate swings at it; retrieval ranks the training "
+    "waves by exaggeration and log tempo, each in units of its sd; procedural IK swings at it.")
+_BEHAVIOUR = (
+    "Each generated wave against the real take for the same request (docs/METRICS.md): the score after "
+    "time alignment (DTW), the medians of the swing and frequency ratios (issue 10 asks 0.75-1.33x "
+    "and 0.8-1.2x) and of the full cycles while the hand is up, and the waves that "
+    "`core.behaviour_metrics` accepts.")
+_PER_STYLE = (
+    "Over a style's test takes (takes 009-010: two takes x two arms; unseen styles: takes 001-010 x two "
+    "arms): mean score and DTW score; median swing and frequency ratios (issue 26 asks 0.75-1.33 and "
+    "0.8-1.25 in every style) and last-frame arm elevation error (degrees; asked: at most 4); waves "
+    "accepted. RLAnimate: mean ± sd over the seeds' agents when there are several.")
+#: The columns of the per-style and seeds tables after the test set (and style, method and takes).
+_STYLE_COLUMNS = ["score", "DTW score", "swing ratio", "frequency ratio", "last-frame elevation error (deg)",
+                  "accepted"]
+
+
 def realmocap_markdown(results):
     """docs/results/realmocap.md from the results run_experiments returns."""
-    tempos = results["tempos"]
+    return page(_introduction(results), both_requests_section(results), _labels_section(results),
+                _reach_section(results), _score_sections(results), _seeds_section(results),
+                section("Guide clips as pointing"), _guide_section(results["guide"]))
+
+
+def _introduction(results):
+    """The page's title, what the capture and the agents are, and the command."""
+    seeds = results["seeds"]
+    return ["# Learning from real motion capture", "", *paragraphs(
+        f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the "
+        f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
+        f"Preset `{results['preset']}`, {results['epochs']} epochs, seeds "
+        f"{', '.join(str(seed) for seed in seeds)} (the tables but the last are seed {seeds[0]}'s). "
+        f"Regenerate: `{results['command']}`.",
+        *([f"**One seed only (seed {seeds[0]}): no spread over seeds is given, and one seed's agent can sit a few "
+           "points either side of the mean.**"] if len(seeds) == 1 else []))]
+
+
+def _labels_section(results):
+    """The waves' auto-labels and tempos per style, and per group of takes."""
+    tempos, styles = results["tempos"], results["labels"]["wave"]
     label_rows = [[style, f"{row['exaggeration']:.2f} ± {row['exaggeration_sd']:.2f}", f"{row['elevation_deg']:.0f}",
                    f"{row['stroke_arm_lengths']:.2f}", f"{row['arm_correct']}/{row['clips']}",
                    f"{tempos[style]['spectrum_hz']:.2f}", f"{tempos[style]['strokes_hz']:.2f}",
-                   f"{tempos[style]['stroke_cm']:.1f}"]
-                  for style, row in results["labels"]["wave"].items()]
+                   f"{tempos[style]['stroke_cm']:.1f}"] for style, row in styles.items()]
     take_group_rows = [[style, *(_take_group_cell(tempos[style]["by_takes"].get(group)) for group in TAKE_GROUPS)]
-                       for style in results["labels"]["wave"]]
-    widths = reach_widths(results)
+                       for style in styles]
+    return [*section("Auto-labels per style (one-arm waves: takes 001-010 and 021-036)"),
+            *table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)", "arm detected",
+                    "tempo, spectrum (Hz)", "tempo, strokes (Hz)", "stroke (cm)"], label_rows),
+            *paragraphs(_TEMPO_READINGS),
+            *section("Label and tempo by group of takes", level=3),
+            *table(["style", *(f"takes {group}" + TAKE_GROUP_ROLES.get(takes, "")
+                               for group, takes in TAKE_GROUPS.items())], take_group_rows),
+            *paragraphs(_TAKE_GROUPS_NOTE)]
+
+
+def _reach_section(results):
+    """What tempo the label can reach (reach_rows), and the goodbye waves' labels."""
+    widths, reach = reach_widths(results), results["label_reach"]
+    in_every_style = ", ".join(f"{label} {reach[name]['in_band_in_every_style']} of {reach[name]['rules']}"
+                               for name, label in REACH_SETS)
+    return [*section("What tempo the label can reach", level=3),
+            *table(["test set", "style", "takes", "labels", "tempo (Hz)",
+                    f"training waves within ±{', ±'.join(widths)} of its labels: within 0.8-1.25x of its tempo / all",
+                    f"styles within ±{widths[-1]}", f"styles within ±{widths[-1]} and 0.8-1.25x",
+                    "rate played / its own, median over its takes: lowest-highest over the rules "
+                    "(rules within 0.8-1.25x)"], reach_rows(results)),
+            *paragraphs(
+                "From the training waves and the test takes alone, no agent (trainer/evaluation/label_reach.py): "
+                "a rhythm taken from the training waves near a request's exaggeration, as RLAnimate's and "
+                "retrieval's are, can only swing at a rate those waves swing at. The rules are the rhythm model's "
+                "exaggeration kernels of sd 0.01-1, with the mean rhythm or the typical tempo (tempo kernels log "
+                "1.05, 1.25, 2), from both arms' waves or the request's arm's. Rules whose median lies within "
+                f"0.8-1.25x in every style: {in_every_style}. A diagnosis of the tests, nothing chosen from it.",
+                "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}"
+                                              for style, row in results["labels"]["bye"].items()))]
+
+
+def _experiments(results):
+    """The experiments of the score tables: (key of the results, its label from its training clips and styles)."""
+    return (("wave", f"wave agent, takes 001-008 and 021-036 ({results['wave']['train_clips']} clips)"),
+            ("holdout", f"wave agent, 5 styles ({results['holdout']['train_clips']} clips; unseen: "
+                        f"{', '.join(HOLDOUT_STYLES)})"))
+
+
+def _score_rows(label, entry):
+    """Rows of the score table and of the behaviour table of one experiment (its results `entry`)."""
+    scores, behaviours = [], []
+    for set_name, set_label in SET_LABELS.items():
+        for method, result in entry.get(set_name, {}).items():
+            clips, wave = len(result["clips"]), result["by_behaviour"]["wave"]
+            shown = [label, f"{set_label} ({clips})", METHOD_LABELS[method]]
+            scores.append([*shown, f"{result['score']:.2f}", f"{result['smoothness']:.2f}",
+                           f"{result['label_error']:.3f}"])
+            behaviours.append([*shown, f"{wave['aligned_score']:.2f}", f"{wave['swing_ratio_median']:.2f}",
+                               f"{wave['frequency_ratio_median']:.2f}", f"{wave['cycles_median']:.0f}",
+                               f"{round(wave['accepted_share'] * clips)}/{clips}"])
+    seen = entry["seen"]
+    scores.append([label, f"seen ({seen['clips']} training clips)", "RLAnimate", f"{seen['score']:.2f}",
+                   f"{seen['smoothness']:.2f}", ""])
+    return scores, behaviours
+
+
+def _score_sections(results):
+    """Score and smoothness, behaviour and behaviour per style, per experiment, test set and method."""
     score_rows, behaviour_rows, style_rows = [], [], []
-    for name, label in (("wave", f"wave agent, takes 001-008 and 021-036 ({results['wave']['train_clips']} clips)"),
-                        ("holdout", f"wave agent, 5 styles ({results['holdout']['train_clips']} clips; unseen: "
-                                    f"{', '.join(HOLDOUT_STYLES)})")):
+    for name, label in _experiments(results):
         entry = results[name]
-        for set_name, set_label in SET_LABELS.items():
-            for method, result in entry.get(set_name, {}).items():
-                score_rows.append(
-                    [
-                        label,
-                        f"{set_label} ({len(result['clips'])})",
-                        METHOD_LABELS[method],
-                        f"{result['score']:.2f}",
-                        f"{result['smoothness']:.2f}",
-                        f"{result['label_error']:.3f}",
-                    ]
-                )
-                wave = result["by_behaviour"]["wave"]
-                behaviour_rows.append(
-                    [
-                        label,
-                        f"{set_label} ({len(result['clips'])})",
-                        METHOD_LABELS[method],
-                        f"{wave['aligned_score']:.2f}",
-                        f"{wave['swing_ratio_median']:.2f}",
-                        f"{wave['frequency_ratio_median']:.2f}",
-                        f"{wave['cycles_median']:.0f}",
-                        f"{round(wave['accepted_share'] * len(result['clips']))}/{len(result['clips'])}",
-                    ]
-                )
+        scores, behaviours = _score_rows(label, entry)
+        score_rows += scores
+        behaviour_rows += behaviours
         for set_name in ("test", "test_tempo"):
-            style_rows += per_style_rows(next(shown for experiment, key, shown in SEED_SETS
-                                              if (experiment, key) == (name, set_name)),
-                                         entry[set_name], entry[f"{set_name}_seeds"])
-        score_rows.append([label, f"seen ({entry['seen']['clips']} training clips)", "RLAnimate",
-                           f"{entry['seen']['score']:.2f}", f"{entry['seen']['smoothness']:.2f}", ""])
-    bye = results["labels"]["bye"].items()
-    lines = ["# Learning from real motion capture", "",
-             f"Bandai Namco Research motion dataset (CC BY-NC 4.0, Kobayashi et al. 2023), brought onto the "
-             f"sample rig with a synthesised relaxed hand and labelled from the motion (docs/REALMOCAP.md). "
-             f"Preset `{results['preset']}`, {results['epochs']} epochs, seeds "
-             f"{', '.join(str(seed) for seed in results['seeds'])} (the tables but the last are seed "
-             f"{results['seeds'][0]}'s). "
-             f"Regenerate: `{results['command']}`.", "",
-             *([f"**One seed only (seed {results['seeds'][0]}): no spread over seeds is given, and one seed's "
-                "agent can sit a few points either side of the mean.**", ""] if len(results["seeds"]) == 1 else []),
-             *both_requests_section(results),
-             "## Auto-labels per style (one-arm waves: takes 001-010 and 021-036)", "",
-             *markdown_table(["style", "exaggeration (mean ± sd)", "elevation (deg)", "stroke (arm lengths)",
-                              "arm detected", "tempo, spectrum (Hz)", "tempo, strokes (Hz)", "stroke (cm)"],
-                            label_rows),
-             "", "Tempo, median over the style's takes, read two ways: the peak of the hand's side-to-side "
-             "spectrum (how the trainer reads a training wave's rhythm, and the Tempo a request names), and "
-             "the strokes between turning points at least 8% of the shoulder width apart "
-             "(`core.behaviour_metrics.wave_measures`, whose frequency ratio the tables below report); stroke: "
-             "their median length. Where the strokes are small (a tremble) the two disagree, and the frequency "
-             "ratio judges a wave by the second.",
-             "", "### Label and tempo by group of takes", "",
-             *markdown_table(["style", *(f"takes {group}" + TAKE_GROUP_ROLES.get(takes, "")
-                                         for group, takes in TAKE_GROUPS.items())], take_group_rows),
-             "", "Each cell: the mean exaggeration, the median tempo as the trainer reads it (spectrum), and the "
-             "takes. Takes 007-008 validate what takes 009-010 test (trainer/experiments/realmocap_length.py). Where a "
-             "style's tempo moves from one group of takes to another while its label barely does, a rhythm drawn "
-             "from the label cannot follow it, and validation on takes 007-008 cannot show what it costs on takes "
-             "009-010.",
-             "", "### What tempo the label can reach", "",
-             *markdown_table(["test set", "style", "takes", "labels", "tempo (Hz)",
-                              f"training waves within ±{', ±'.join(widths)} of its labels: within 0.8-1.25x of "
-                              f"its tempo / all", f"styles within ±{widths[-1]}",
-                              f"styles within ±{widths[-1]} and 0.8-1.25x",
-                              "rate played / its own, median over its takes: lowest-highest over the rules "
-                              "(rules within 0.8-1.25x)"], reach_rows(results)),
-             "", "From the training waves and the test takes alone, no agent (trainer/evaluation/label_reach.py): "
-             "a rhythm taken from the training waves near a request's exaggeration, as RLAnimate's and retrieval's "
-             "are, can only swing at a rate those waves swing at. The rules are the rhythm model's exaggeration "
-             "kernels of sd 0.01-1, with the mean rhythm or the typical tempo (tempo kernels log 1.05, 1.25, 2), "
-             "from both arms' waves or the request's arm's. Rules whose median lies within 0.8-1.25x in every "
-             "style: " + ", ".join(f"{label} {results['label_reach'][name]['in_band_in_every_style']} of "
-                                   f"{results['label_reach'][name]['rules']}" for name, label in REACH_SETS) +
-             ". A diagnosis of the tests, nothing chosen from it.",
-             "", "Goodbye waves: " + ", ".join(f"{style} {row['exaggeration']:.2f}" for style, row in bye), "",
-             "## Score and smoothness", "",
-             "Every method answers each test take's request twice: with the take's auto-label and length (the "
-             "paper's request; *test*, *bye*), and with the same naming the take's own tempo as well (*tempo "
-             "asked*: the Hz at which its hand swings side to side, read as the trainer reads a training wave's; "
-             "the panel's Tempo). One exaggeration cannot say a tempo: masculine and normal waves share one label "
-             "and swing at different rates. Asked a tempo, RLAnimate swings at it; retrieval ranks the training "
-             "waves by exaggeration and log tempo, each in units of its sd; procedural IK swings at it.", "",
-             "Label error: mean |exaggeration auto-labelled from the generated wave - requested exaggeration|.", "",
-             *markdown_table(["experiment", "test set", "method", "score", "smoothness", "label error"], score_rows),
-             "", "## Behaviour", "",
-             "Each generated wave against the real take for the same request (docs/METRICS.md): the score after "
-             "time alignment (DTW), the medians of the swing and frequency ratios (issue 10 asks 0.75-1.33x "
-             "and 0.8-1.2x) and of the full cycles while the hand is up, and the waves that "
-             "`core.behaviour_metrics` accepts.", "",
-             *markdown_table(["experiment", "test set", "method", "DTW score", "swing ratio", "frequency ratio",
-                              "cycles", "accepted"], behaviour_rows),
-             "", "### Per style", "",
-             "Over a style's test takes (takes 009-010: two takes x two arms; unseen styles: takes 001-010 x two "
-             "arms): mean score and DTW score; median swing and frequency ratios (issue 26 asks 0.75-1.33 and "
-             "0.8-1.25 in every style) and last-frame arm elevation error (degrees; asked: at most 4); waves "
-             "accepted. RLAnimate: mean ± sd over the seeds' agents when there are several.", "",
-             *markdown_table(["test set", "style", "method", "takes", "score", "DTW score", "swing ratio",
-                              "frequency ratio", "last-frame elevation error (deg)", "accepted"], style_rows),
-             "", "### Seeds", "",
-             "RLAnimate trained with each seed, on the same sets: mean score and DTW score, median swing and "
-             "frequency ratios and last-frame elevation error, waves accepted (the mean ± sd row is over the "
-             "seeds).", "",
-             *markdown_table(["test set", "method", "score", "DTW score", "swing ratio", "frequency ratio",
-                              "last-frame elevation error (deg)", "accepted"], seed_rows(results)),
-             "", f"CPU time (one torch thread): training, per seed's agent ({results['wave']['episodes']} "
-             f"episodes), {cpu_list(results['wave'])} for the wave agent and {cpu_list(results['holdout'])} for the "
-             f"hold-out agent; scoring every method, request and seed, {results['evaluation_cpu_seconds']:.0f} s.", "",
-             "The wave's rhythm at play time (its phase, the kernel, seeded draws), varied on seed 0's agents "
-             "without retraining: [realmocap_ablation.md](realmocap_ablation.md).", "",
-             "## Guide clips as pointing", ""]
-    if "skipped" in results["guide"]:
-        return "\n".join(lines + [f"Not run: {results['guide']['skipped']}", "",
-                                   "![real and generated frames](realmocap_frames.png)", ""])
-    guide_rows = [[METHOD_LABELS[method], f"{entry['mean_forearm_angle_deg']:.1f}",
-                   f"{entry['median_forearm_angle_deg']:.1f}"]
-                  for method, entry in results["guide"].items() if isinstance(entry, dict)]
-    lines += [f"Pointing agent `{results['guide']['point_agent']}`, given the direction in which the actor held "
-              "the arm (rest shoulder to the index base at the hold). Angle between the generated and the real "
-              "forearm (elbow to wrist), each at its own hold:", "",
-              *markdown_table(["method", "mean (deg)", "median (deg)"], guide_rows),
-              "", "![real and generated frames](realmocap_frames.png)", ""]
-    return "\n".join(lines)
+            shown = next(shown for experiment, key, shown in SEED_SETS if (experiment, key) == (name, set_name))
+            style_rows += per_style_rows(shown, entry[set_name], entry[f"{set_name}_seeds"])
+    return [*section("Score and smoothness", _REQUESTS, "Label error: mean |exaggeration auto-labelled from the "
+                     "generated wave - requested exaggeration|."),
+            *table(["experiment", "test set", "method", "score", "smoothness", "label error"], score_rows),
+            *section("Behaviour", _BEHAVIOUR),
+            *table(["experiment", "test set", "method", "DTW score", "swing ratio", "frequency ratio", "cycles",
+                    "accepted"], behaviour_rows),
+            *section("Per style", _PER_STYLE, level=3),
+            *table(["test set", "style", "method", "takes", *_STYLE_COLUMNS], style_rows)]
+
+
+def _seeds_section(results):
+    """Each seed's agent on the wave sets, the training and scoring times, and a pointer to the ablation."""
+    return [*section("Seeds", "RLAnimate trained with each seed, on the same sets: mean score and DTW score, median "
+                     "swing and frequency ratios and last-frame elevation error, waves accepted (the mean ± sd row is "
+                     "over the seeds).", level=3),
+            *table(["test set", "method", *_STYLE_COLUMNS], seed_rows(results)),
+            *paragraphs(
+                f"CPU time (one torch thread): training, per seed's agent ({results['wave']['episodes']} "
+                f"episodes), {cpu_list(results['wave'])} for the wave agent and {cpu_list(results['holdout'])} for "
+                f"the hold-out agent; scoring every method, request and seed, "
+                f"{results['evaluation_cpu_seconds']:.0f} s.",
+                "The wave's rhythm at play time (its phase, the kernel, seeded draws), varied on seed 0's agents "
+                "without retraining: [realmocap_ablation.md](realmocap_ablation.md).")]
+
+
+def _guide_section(guide):
+    """The pointing agent's forearm angle on the guide clips per method (or why it was not run), and the figure."""
+    figure = "![real and generated frames](realmocap_frames.png)"
+    if "skipped" in guide:
+        return paragraphs(f"Not run: {guide['skipped']}", figure)
+    rows = [[METHOD_LABELS[method], f"{entry['mean_forearm_angle_deg']:.1f}",
+             f"{entry['median_forearm_angle_deg']:.1f}"] for method, entry in guide.items() if isinstance(entry, dict)]
+    return [*paragraphs(f"Pointing agent `{guide['point_agent']}`, given the direction in which the actor held the arm "
+                        "(rest shoulder to the index base at the hold). Angle between the generated and the real "
+                        "forearm (elbow to wrist), each at its own hold:"),
+            *table(["method", "mean (deg)", "median (deg)"], rows), *paragraphs(figure)]

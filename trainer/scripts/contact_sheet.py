@@ -1,11 +1,13 @@
 """Contact sheets: the clip library's key frames (docs/contact_sheet.png), or, with --generated, the add-on's
 Generate Gesture on the sample character rendered by Blender (Cycles, CPU) into
 docs/results/generated_frames.png (point and wave), or, with --generated --further, the guide and
-raise-hand gestures into docs/results/generated_guide_raise_frames.png, or, with --composing, gestures
-composed on one character (both arms at once, a handover) into docs/results/composing_frames.png.
+raise-hand gestures into docs/results/generated_guide_raise_frames.png, or, with --generated --overview, one
+gesture of each behaviour (point, wave, guide, raise hand) into docs/results/four_behaviours_frames.png (the
+README's picture), or, with --composing, gestures composed on one character (both arms at once, a handover) into
+docs/results/composing_frames.png.
 
     python -m trainer.scripts.contact_sheet [--out docs/contact_sheet.png] [--seed S]
-    nice -n 10 python -m trainer.scripts.contact_sheet --generated [--further] [--agent PATH] [--out PNG]
+    nice -n 10 python -m trainer.scripts.contact_sheet --generated [--further | --overview] [--agent PATH] [--out PNG]
     nice -n 10 python -m trainer.scripts.contact_sheet --composing [--agent PATH] [--out PNG]
 """
 import tempfile
@@ -22,10 +24,12 @@ from trainer.scripts.cli import run_main
 GENERATED_SHEET = RESULTS_DIR / "generated_frames.png"
 FURTHER_SHEET = RESULTS_DIR / "generated_guide_raise_frames.png"
 COMPOSING_SHEET = RESULTS_DIR / "composing_frames.png"
+OVERVIEW_SHEET = RESULTS_DIR / "four_behaviours_frames.png"
 TARGET_HIGH = (-0.9, -2.0, 1.7)  # ahead, up and to the character's right
 TARGET_ACROSS = (-0.9, -1.8, 0.9)  # low, across the body for the left arm
 TARGET_DOOR = (-2.2, -1.6, 0.9)  # a doorway ahead and out to the character's right, at waist height
 TARGET_FLOOR = (0.6, -2.2, 0.05)  # on the floor ahead, a little to the left
+TARGET_ASIDE = (-1.0, -1.8, 0.9)  # at waist height ahead and to the character's right, in the camera's view
 
 
 @dataclass(frozen=True)
@@ -35,6 +39,7 @@ class SheetSettings:
     seed: int = DEFAULT_SEED  # library plan seed (library sheet)
     generated: bool = False  # render Generate Gesture's output with Blender
     further: bool = False  # with --generated: the guide and raise-hand gestures
+    overview: bool = False  # with --generated: one gesture of each behaviour (the README's picture)
     composing: bool = False  # render gestures composed on one character (both arms, a handover) with Blender
     agent: Path | None = None  # agent file for the add-on (None: the bundled agent)
 
@@ -79,6 +84,28 @@ def further_requests():
     ]
 
 
+def overview_requests() -> list:
+    """The requests of the overview sheet: one gesture of each shipped behaviour, right arm."""
+    from trainer.blender_io.gesture_render import RenderRequest
+    return [
+        RenderRequest("point", {"behaviour": "POINT", "arm": "RIGHT", "exact_aim": True, "seed": 0},
+                      target=TARGET_HIGH),
+        RenderRequest("wave, e 0.8", {"behaviour": "WAVE", "arm": "RIGHT", "exaggeration": 0.8, "seed": 0}),
+        RenderRequest("guide (this way)", {"behaviour": "GUIDE", "arm": "RIGHT", "seed": 0}, target=TARGET_ASIDE),
+        RenderRequest("raise hand, e 0.8", {"behaviour": "RAISE_HAND", "arm": "RIGHT", "exaggeration": 0.8,
+                                            "seed": 0}),
+    ]
+
+
+def _generated(settings: SheetSettings) -> tuple[list, Path]:
+    """Which requests --generated renders, and the sheet they go to."""
+    if settings.overview:
+        return overview_requests(), OVERVIEW_SHEET
+    if settings.further:
+        return further_requests(), FURTHER_SHEET
+    return generated_requests(), GENERATED_SHEET
+
+
 def compositions():
     """The compositions of the composing sheet: a point and a wave on overlapping frames, a point handing over
     to a wave on the same arm (docs/EXTENSION.md, "Composing gestures")."""
@@ -116,11 +143,10 @@ def main(argv=None):
         return 0
     from trainer.blender_io.gesture_render import render_requests
     with tempfile.TemporaryDirectory() as frames:
-        requests = render_requests(further_requests() if settings.further else generated_requests(), frames,
-                                   agent_path=settings.agent)
+        chosen, sheet = _generated(settings)
+        requests = render_requests(chosen, frames, agent_path=settings.agent)
         agent = shown(settings.agent) if settings.agent else "the bundled agent"
-        out = generated_sheet([(r.title, r.frames) for r in requests],
-                              settings.out or (FURTHER_SHEET if settings.further else GENERATED_SHEET),
+        out = generated_sheet([(r.title, r.frames) for r in requests], settings.out or sheet,
                               f"Generate Gesture on the sample character, {agent}, rendered by Blender (Cycles); "
                               f"red: the target")
     print(f"wrote {out}")

@@ -13,90 +13,60 @@ report to docs/results/. Outputs: see trainer/experiments/run.py. `--resume` con
 from its checkpoint with the run's own settings; the continuation equals the uninterrupted run. A new run
 into the folder of another is refused unless `--overwrite`.
 """
-import argparse
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Annotated
+
+import tyro
 
 from rlanimate_addon.core.errors import RLAnimateError
-from trainer.agent.models import VARIANTS
 from trainer.blender_io.clip_session import LibrarySession
 from trainer.blender_io.import_worker import ImportLimits
 from trainer.experiments import capture
-from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings, check_settings, resolve, train
+from trainer.experiments.run import RunSettings, check_settings, resolve, train
 from trainer.files import atomic_copy
 from trainer.paths import DEFAULT_OUTPUT, INSTALLED_AGENT, RESULTS_DIR, shown
+from trainer.scripts import cli
 from trainer.scripts.cli import run_main, script_args
 
 #: What an interrupted run says: every epoch it finished is in its checkpoint.
 INTERRUPTED = "interrupted: the run's checkpoint holds every epoch it finished; continue it with --resume"
 
 
-def build_parser():
-    """The command line. Run settings default to None ("not given"): a new run takes NEW_RUN_DEFAULTS, a
-    resumed run its checkpoint's values."""
-    defaults = NEW_RUN_DEFAULTS
-    parser = argparse.ArgumentParser(prog="trainer/train.py", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--behaviour", help="the behaviours to learn: all (every behaviour of the clip library), "
-                                             "both (point and wave), one behaviour (point), or several joined by "
-                                             f"commas (point,beckon); default {defaults['behaviour']}")
-    parser.add_argument("--clips", help="clip library: a manifest.json or the folder that holds one (default "
-                                        "sample_rigs/clips); or a folder of .bvh/.fbx takes without one, which is "
-                                        "labelled from the takes' names and motion into <output>/manifest.json")
-    parser.add_argument("--hold-out", type=float, default=capture.capture_folder.HOLD_OUT_SHARE,
-                        help="with a folder of takes: the share of each behaviour and arm's takes held out for "
-                             "the comparison with retrieval (default %(default)s)")
-    parser.add_argument("--epochs", type=int,
-                        help="iterations of Algorithm 1 (default: the preset's, the paper's 50 for one behaviour "
-                             "and 100 for both; on --resume, the run's own)")
-    parser.add_argument("--seed", type=int, help=f"default {defaults['seed']}")
-    parser.add_argument("--output", default=str(DEFAULT_OUTPUT))
-    parser.add_argument("--preset", help="config preset: debug, default or paper (default default)")
-    parser.add_argument("--variant", choices=VARIANTS, help="ablation variant (Table 4; default rlanimate)")
-    parser.add_argument("--resume", action="store_true",
-                        help="continue the run in --output from its checkpoint, with the run's own settings")
-    parser.add_argument("--overwrite", action="store_true",
-                        help="replace the run in --output (without it, a new run into a run's folder is refused)")
-    parser.add_argument("--allow-new-behaviour", action="store_true",
-                        help="with --behaviour all, also learn a behaviour other than point and wave that fewer "
-                             "than 3 clips name (without it, such a behaviour is refused as a likely typo)")
-    parser.add_argument("--install", action="store_true",
-                        help="install the agent as the add-on's default and its report into docs/results/")
-    parser.add_argument("--eval-every", type=int,
-                        help=f"evaluate on seen and unseen clips every N epochs (0: only at the end; default "
-                             f"{defaults['eval_every']})")
-    parser.add_argument("--checkpoint-every", type=int, default=1)
-    parser.add_argument("--quiet", action="store_true", help="no progress bar")
-    parser.add_argument("--verbose", action="store_true", help="show what Blender prints while loading the clips")
-    parser.add_argument("--import-workers", type=int, default=1,
-                        help="import the clips the cache lacks with N Blenders at once (worker processes; default 1)")
-    parser.add_argument("--import-memory-limit", type=float, default=ImportLimits.memory_gb, metavar="GB",
-                        help="the memory one clip's import may take; a clip that needs more is skipped with a note "
-                             f"(default {ImportLimits.memory_gb:g})")
-    parser.add_argument("--import-time-limit", type=float, default=ImportLimits.seconds, metavar="SECONDS",
-                        help="the time one clip's import may take; a clip that takes longer is skipped with a note "
-                             f"(default {ImportLimits.seconds:g})")
-    return parser
+@dataclass(frozen=True)
+class TrainSettings:
+    """The train command: a run (its options unprefixed: --epochs, --output), and what to do around it."""
+    run: RunSettings = RunSettings(output=str(DEFAULT_OUTPUT))
+    # with a folder of takes: the share of each behaviour and arm's takes held out for the comparison with retrieval
+    hold_out: float = capture.capture_folder.HOLD_OUT_SHARE
+    install: bool = False  # install the agent as the add-on's default and its report into docs/results/
+    quiet: bool = False  # no progress bar
+    verbose: bool = False  # show what Blender prints while loading the clips
+    import_workers: int = 1  # import the clips the cache lacks with N Blenders at once (worker processes)
+    # the memory one clip's import may take; a clip that needs more is skipped with a note
+    import_memory_limit: Annotated[float, tyro.conf.arg(metavar="GB")] = ImportLimits.memory_gb
+    # the time one clip's import may take; a clip that takes longer is skipped with a note
+    import_time_limit: Annotated[float, tyro.conf.arg(metavar="SECONDS")] = ImportLimits.seconds
 
 
-def import_limits(args: argparse.Namespace) -> ImportLimits:
-    """The ImportLimits of the arguments; RLAnimateError naming each that is not a positive number."""
+def parse_settings(argv: Sequence[str] | None = None) -> TrainSettings:
+    """TrainSettings from the command line."""
+    return cli.parse_settings(TrainSettings, argv, prog="trainer/train.py", doc=__doc__)
+
+
+def import_limits(settings: TrainSettings) -> ImportLimits:
+    """The ImportLimits of the settings; RLAnimateError naming each that is not a positive number."""
     problems = [f"{option} {value:g}: give a number above 0{example}" for option, value, example in (
-        ("--import-workers", args.import_workers, ", such as 2"),
-        ("--import-memory-limit", args.import_memory_limit, " (GB), such as 2"),
-        ("--import-time-limit", args.import_time_limit, " (seconds), such as 60")) if not value > 0]
+        ("--import-workers", settings.import_workers, ", such as 2"),
+        ("--import-memory-limit", settings.import_memory_limit, " (GB), such as 2"),
+        ("--import-time-limit", settings.import_time_limit, " (seconds), such as 60")) if not value > 0]
     if problems:
         raise RLAnimateError("; ".join(problems) + ". Nothing was trained.")
-    return ImportLimits(memory_gb=args.import_memory_limit, seconds=args.import_time_limit)
+    return ImportLimits(memory_gb=settings.import_memory_limit, seconds=settings.import_time_limit)
 
 
-def run_settings(args):
-    """RunSettings from parsed arguments."""
-    return RunSettings(output=args.output, behaviour=args.behaviour, clips=args.clips, epochs=args.epochs,
-                       seed=args.seed, preset=args.preset, variant=args.variant, eval_every=args.eval_every,
-                       resume=args.resume, overwrite=args.overwrite, allow_new_behaviour=args.allow_new_behaviour,
-                       checkpoint_every=args.checkpoint_every, progress=not args.quiet)
-
-
-def install(output):
+def install(output: Path) -> None:
     """Copy a run's agent into the add-on (atomically) and its report and curves into docs/results/."""
     atomic_copy(output / "agent.npz", INSTALLED_AGENT)
     for source, target in (("report.json", "default_agent.json"), ("report.md", "default_agent.md"),
@@ -104,32 +74,32 @@ def install(output):
         atomic_copy(output / source, RESULTS_DIR / target)
 
 
-def main(argv=None):
-    args = build_parser().parse_args(script_args(argv))
-    settings = run_settings(args)
+def main(argv: Sequence[str] | None = None) -> int:
+    command = parse_settings(argv)
+    settings = replace(command.run, progress=not command.quiet)
+    output = settings.output
     labelled = None
-    if not args.resume and capture.is_capture_folder(args.clips):  # a studio's folder of takes, no manifest
+    if not settings.resume and capture.is_capture_folder(settings.clips):  # a studio's folder of takes, no manifest
         check_settings(settings)
-        labelled = capture.label_folder(args.clips, args.output, args.hold_out, args.verbose)
+        labelled = capture.label_folder(settings.clips, output, command.hold_out, command.verbose)
         settings = capture.capture_settings(settings, labelled)
     settings = resolve(settings)
-    limits = import_limits(args)
-    session = LibrarySession(settings.clips, verbose=args.verbose, import_workers=args.import_workers,
+    limits = import_limits(command)
+    session = LibrarySession(settings.clips, verbose=command.verbose, import_workers=command.import_workers,
                              import_limits=limits)
     report, _ = train(settings, session)
     scored, split = ((report["held_out"], "held-out") if report["held_out"] is not None
                      else (report["training"], "no held-out clips; training-clip"))
     print(f"trained: {report['epochs']} epochs, {report['episodes']} episodes, {report['train_seconds'] / 60:.1f} min; "
-          f"{split} score {scored['score']:.2f}, smoothness {scored['smoothness']:.2f}; outputs in {args.output}")
+          f"{split} score {scored['score']:.2f}, smoothness {scored['smoothness']:.2f}; outputs in {output}")
     if labelled is not None:
-        page = capture.write_report(labelled, report, session, args.output, " ".join(["trainer/train.py",
-                                                                                      *script_args(argv)]))
+        page = capture.write_report(labelled, report, session, output, " ".join(["trainer/train.py",
+                                                                                 *script_args(argv)]))
         print(f"compared with retrieval on the held-out takes: {page}")
-    if args.install:
+    if command.install:
         install(Path(settings.output))
         print(f"installed: {shown(INSTALLED_AGENT)}, and the report in {shown(RESULTS_DIR)}")
     return 0
-
 
 if __name__ == "__main__":
     raise SystemExit(run_main(main, interrupted=INTERRUPTED))

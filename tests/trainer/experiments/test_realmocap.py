@@ -89,6 +89,13 @@ def test_experiment_pipeline_runs_end_to_end_on_a_few_clips(tmp_path):
     generated = methods["rlanimate"].generate("WAVE", "LEFT", test[0].exaggeration, test[0].frames)
     frames_figure(env, [("t", test[0].rotvecs, generated)], picture, times=(0.5,))
     assert picture.stat().st_size > 1000
+    # One experiment's entry as run_experiments writes it: every method and request, each seed's agent.
+    entry, first = realmocap._experiment("wave", train, {"test": test}, {0: (run.settings.output, report)}, env,
+                                         references)
+    assert first.path == agent.path and entry["train_cpu_seconds"] == {"0": report["train_cpu_seconds"]}
+    assert set(entry) >= {"seen", "test", "test_tempo", "test_seeds", "test_tempo_seeds"}
+    assert entry["test"]["rlanimate"]["score"] == comparison["rlanimate"]["score"]
+    assert entry["test_seeds"] == {"0": seed_summary(entry["test"]["rlanimate"])}
 
 
 def _as_point(clip):

@@ -1,12 +1,19 @@
-"""The one markdown-table writer, and Table 4 written with it."""
+"""The markdown building blocks of the reports, and Table 4 written with them."""
 from trainer.experiments.paper import aggregate
 from trainer.reporting.table4 import cell, table4_markdown
-from trainer.reporting.tables import markdown_table
+from trainer.reporting.tables import markdown_table, page, paragraphs, section, table
 
 
 def test_markdown_table_has_a_header_a_rule_and_one_line_per_row():
     lines = markdown_table(["clip", "score"], [["a", 1.5], ["b", "-"]], align=["---", "---:"])
     assert lines == ["| clip | score |", "|---|---:|", "| a | 1.5 |", "| b | - |"]
+
+
+def test_a_page_is_its_blocks_each_ending_in_a_blank_line():
+    assert section("Seeds", "First.", "Second.", level=3) == ["### Seeds", "", "First.", "", "Second.", ""]
+    assert paragraphs() == [] and table(["a"], [[1]]) == ["| a |", "|---|", "| 1 |", ""]
+    text = page(["# Title", ""], section("Part"), table(["a"], [[1]]), paragraphs("End."))
+    assert text == "# Title\n\n## Part\n\n| a |\n|---|\n| 1 |\n\nEnd.\n"
 
 
 def test_markdown_shows_mean_and_sd_only_over_several_seeds():

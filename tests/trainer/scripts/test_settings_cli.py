@@ -4,9 +4,11 @@ dataclass's defaults, every option has help, the options the docs use parse as t
 import ast
 import dataclasses
 import re
+import typing
 from pathlib import Path
 
 import pytest
+import tyro
 
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.scripts import (
@@ -22,6 +24,7 @@ from trainer.scripts import (
     realmocap_gestures,
     realmocap_length,
     realmocap_model,
+    train,
 )
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -33,24 +36,40 @@ SCRIPTS = ((agent_ablation, agent_ablation.AblationSettings), (baselines, baseli
            (realmocap_ablation, realmocap_ablation.AblationSettings),
            (realmocap_gestures, realmocap_gestures.GestureSettings),
            (realmocap_length, realmocap_length.LengthSettings),
-           (realmocap_model, realmocap_model.ModelSettings))
+           (realmocap_model, realmocap_model.ModelSettings), (train, train.TrainSettings))
 
 
-def options_without_help(settings_type, capsys, monkeypatch):
-    """The options of `settings_type`'s command line whose --help line says nothing but the default."""
+def option_fields(settings_type):
+    """The fields of `settings_type` that are options: a nested settings dataclass's own, not those --help hides."""
+    for field in dataclasses.fields(settings_type):
+        if dataclasses.is_dataclass(field.type):
+            yield from option_fields(field.type)
+        elif tyro.conf.Suppress not in typing.get_args(field.type)[1:]:
+            yield field
+
+
+def help_entries(settings_type, capsys, monkeypatch):
+    """The --help of `settings_type`'s command line, one entry per option: its lines joined, its name and metavar,
+    then its help (on its line or the next)."""
     monkeypatch.setenv("COLUMNS", "1000")  # one line per option
     with pytest.raises(SystemExit) as exit_:
         cli.parse_settings(settings_type, ["prog", "--help"], prog="prog", doc="A script.")
     assert exit_.value.code == 0
-    entries = []  # each option's lines joined: its name and metavar, then its help (on its line or the next)
+    entries = []
     for line in capsys.readouterr().out.splitlines():
         text = line.strip("│ ")
         if text.startswith("-"):
             entries.append(text)
         elif entries and text:
             entries[-1] += "  " + text
+    return entries
+
+
+def options_without_help(settings_type, capsys, monkeypatch):
+    """The options of `settings_type`'s command line whose --help line says nothing but the default."""
+    entries = help_entries(settings_type, capsys, monkeypatch)
     missing = []
-    for field in dataclasses.fields(settings_type):
+    for field in option_fields(settings_type):
         option = "--" + field.name.replace("_", "-")
         entry = next(entry for entry in entries if entry.startswith(option + " "))
         if not re.match(rf"{option}( \S+)*\s\s+\S.*\(default:", entry):  # after the metavar, if any, the help

@@ -1,24 +1,52 @@
 """trainer/train.py (the shim for trainer.scripts.train) as a subprocess on a tiny FBX clip library: its
 outputs exist and load without torch."""
 import json
+import re
 import subprocess
 import sys
 
 import numpy as np
 import pytest
+from test_settings_cli import help_entries
 
 from rlanimate_addon.core import runtime
 from trainer.agent.algorithm import clip_objective
 from trainer.agent.config import load_preset
 from trainer.blender_io.clip_import import load_clip_set
+from trainer.experiments.run import NEW_RUN_DEFAULTS, RunSettings
 from trainer.paths import REPO_ROOT
 from trainer.scripts import cli, train
 
 
 def test_blender_style_arguments_are_parsed_after_the_double_dash():
     argv = ["blender", "-b", "-P", "trainer/train.py", "--", "--preset", "debug", "--behaviour", "wave"]
-    args = train.build_parser().parse_args(cli.script_args(argv))
-    assert (args.preset, args.behaviour, args.variant, args.install) == ("debug", "wave", None, False)
+    settings = train.parse_settings(argv)
+    assert (settings.run.preset, settings.run.behaviour, settings.run.variant, settings.install) == (
+        "debug", "wave", None, False)
+
+
+def test_every_option_train_had_parses_with_its_meaning(capsys):
+    argv = ["train.py", "--behaviour", "point,beckon", "--clips", "takes", "--hold-out", "0.3", "--epochs", "7",
+            "--seed", "4", "--output", "runs/x", "--preset", "paper", "--variant", "supervised", "--resume",
+            "--overwrite", "--allow-new-behaviour", "--install", "--eval-every", "0", "--checkpoint-every", "2",
+            "--quiet", "--verbose", "--import-workers", "3", "--import-memory-limit", "1.5",
+            "--import-time-limit", "30"]
+    assert train.parse_settings(argv) == train.TrainSettings(
+        RunSettings(output="runs/x", behaviour="point,beckon", clips="takes", epochs=7, seed=4, preset="paper",
+                    variant="supervised", eval_every=0, resume=True, overwrite=True, allow_new_behaviour=True,
+                    checkpoint_every=2),
+        hold_out=0.3, install=True, quiet=True, verbose=True, import_workers=3, import_memory_limit=1.5,
+        import_time_limit=30.0)
+    with pytest.raises(SystemExit) as exit_:
+        train.parse_settings(["train.py", "--variant", "rlanimat"])
+    assert exit_.value.code == 2 and "rlanimat" in capsys.readouterr().err
+
+
+def test_the_help_names_the_defaults_a_new_run_takes(capsys, monkeypatch):
+    entries = help_entries(train.TrainSettings, capsys, monkeypatch)
+    for name in ("behaviour", "seed", "preset", "variant", "eval_every"):
+        entry = next(entry for entry in entries if entry.startswith("--" + name.replace("_", "-") + " "))
+        assert re.search(rf"\(.*None: {NEW_RUN_DEFAULTS[name]}[;)]", entry), entry
 
 
 def test_train_cli_writes_an_agent_report_and_plots_that_load(tiny_library, tmp_path):

@@ -80,7 +80,7 @@ def test_only_a_folder_without_a_manifest_is_labelled_and_it_trains_the_real_cap
     assert capture.is_capture_folder(str(tmp_path)) and not capture.is_capture_folder(None)
     (tmp_path / "manifest.json").write_text("{}")
     assert not capture.is_capture_folder(str(tmp_path)) and not capture.is_capture_folder(str(tmp_path / "x.json"))
-    given = train.run_settings(train.build_parser().parse_args(["--output", "run", "--epochs", "7"]))
+    given = train.parse_settings(["train.py", "--output", "run", "--epochs", "7"]).run
     labels = [capture_folder.TakeLabel(f"/t/{name}.bvh", behaviour, "intensity", "LEFT", 90, 30.0, 0.5, split=split)
               for name, behaviour, split in (("a", "WAVE", "train"), ("b", "HELLO", "test"), ("c", "WAVE", "test"))]
     labelled = capture.Labelled("takes", tmp_path / "run" / "manifest.json", labels)
