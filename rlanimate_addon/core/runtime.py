@@ -14,13 +14,23 @@ the rollout runs on one BLAS thread (core/blas_threads.py).
                default_rng(seed), while a_t stays the Beta mean. Drawn once, the noise varies the
                gesture coherently; drawn afresh every frame (z_t or a_t) it only adds jitter.
 """
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 from numpy.typing import ArrayLike
 
 from . import agent_file, behaviours, blas_threads, frame_rate, rhythm, spaces
 from .errors import RLAnimateError
+
+#: A float64 array: the weights, and every buffer of the rollout.
+Array = npt.NDArray[np.float64]
+#: [(weight (in, out), bias (out,))] of an MLP (`_mlp_arrays`).
+Layers = Sequence[tuple[Array, Array]]
+#: (W_ih, W_hh, b_ih, b_hh) of a GRU (`_gru_arrays`).
+Gru = tuple[Array, Array, Array, Array]
 
 
 def load_agent(path: str | Path) -> "GestureAgent":
@@ -29,18 +39,18 @@ def load_agent(path: str | Path) -> "GestureAgent":
     return GestureAgent(weights, metadata)
 
 
-def _softplus_(x, out):
+def _softplus_(x: Array, out: Array) -> Array:
     """softplus(x) = log(1 + e^x) into out."""
     return np.logaddexp(0.0, x, out=out)
 
 
-def _mlp_arrays(weights, name, layers):
+def _mlp_arrays(weights: Mapping[str, Array], name: str, layers: int) -> list[tuple[Array, Array]]:
     """[(weight (in, out), bias (out,))] of an MLP: Linear layers with tanh between them."""
     return [(weights[f"{name}.layers.{k}.weight"].T.copy(), weights[f"{name}.layers.{k}.bias"])
             for k in range(layers + 1)]
 
 
-def _mlp_tail(layers, x, spare, out):
+def _mlp_tail(layers: Layers, x: Array, spare: Array, out: Array) -> Array:
     """An MLP from its first layer's pre-activation x on (tanh, then the remaining Linear layers), in
     preallocated arrays, for one frame (width,) or all (N, width) at once: x and spare, of the hidden
     width, are overwritten; the result goes into out, which is returned."""
@@ -58,7 +68,7 @@ def _mlp_tail(layers, x, spare, out):
     return out
 
 
-def _gru_arrays(weights, name, suffix=""):
+def _gru_arrays(weights: Mapping[str, Array], name: str, suffix: str = "") -> Gru:
     """(W_ih (in, 3H), W_hh (H, 3H), b_ih, b_hh) of a torch GRU / GRUCell, gates r, z, n, with the r and z
     columns halved: sigmoid(x) = 0.5 (1 + tanh(x / 2)), and halving is exact in floating point, so
     `_gru_stepper` takes tanh of the gates as they come."""
@@ -69,7 +79,7 @@ def _gru_arrays(weights, name, suffix=""):
     return arrays
 
 
-def _gru_stepper(h, hidden_gates):
+def _gru_stepper(h: Array, hidden_gates: Array) -> Callable[[Array, Array], None]:
     """step(input_rz (2H,), input_n (H,)): torch's GRU update h' = (1 - z) n + z h in place on h (H,), from
     W_ih x + b_ih (its r, z and its n parts) and W_hh h + b_hh, written into hidden_gates (3H,) before each
     step (weights from `_gru_arrays`). Scratch arrays and views are made once: the per-frame loops are
@@ -79,7 +89,7 @@ def _gru_stepper(h, hidden_gates):
     reset, update = gates[:H], gates[H:]
     hidden_rz, hidden_n = hidden_gates[:2 * H], hidden_gates[2 * H:]
 
-    def step(input_rz, input_n):
+    def step(input_rz: Array, input_n: Array) -> None:
         np.add(input_rz, hidden_rz, out=gates)  # halved pre-activations
         np.tanh(gates, out=gates)
         np.add(gates, 1.0, out=gates)
@@ -93,7 +103,7 @@ def _gru_stepper(h, hidden_gates):
     return step
 
 
-def _gru_sequence(inputs, gru):
+def _gru_sequence(inputs: Array, gru: Gru) -> Array:
     """(N, in) -> (N, H) states of a GRU from h_0 = 0."""
     input_weight, hidden_weight, input_bias, hidden_bias = gru
     input_gates = inputs @ input_weight + input_bias  # (N, 3H)
@@ -117,7 +127,7 @@ class GestureAgent:
     input's weights into every layer it feeds are joined side by side at load time.
     """
 
-    def __init__(self, weights, metadata):
+    def __init__(self, weights: Mapping[str, ArrayLike], metadata: Mapping[str, Any]) -> None:
         self.metadata = metadata
         self.variant = metadata["variant"]
         self.action_bounds = np.asarray(metadata["action_bounds"], dtype=np.float64)  # (45, 2)
@@ -168,7 +178,7 @@ class GestureAgent:
         self._from_a = cell_a  # (A, 3E)
 
     def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None,
-                    tempo: float | None = None, arm: str | None = None) -> np.ndarray | None:
+                    tempo: float | None = None, arm: str | None = None) -> Array | None:
         """(N, 2) rhythm signals for a wave's objectives (ObjectiveSpace.make_objective), drawn as core/rhythm.py
         says (the training waves' mean for seed None; those of `arm` where the file keeps them) at `tempo` (Hz;
         None: the training waves'), or None for an agent without a rhythm model."""
@@ -178,7 +188,9 @@ class GestureAgent:
                                      "chosen tempo: set Tempo to 0, or choose an agent trained with it.")
             return None
         if tempo is not None:
-            low, high = self.tempo_range()
+            tempo_range = self.tempo_range()
+            assert tempo_range is not None  # the agent has a rhythm model
+            low, high = tempo_range
             if not low <= float(tempo) <= high:  # also refuses NaN
                 raise RLAnimateError(f"A tempo of {float(tempo):.2f} Hz is outside what this agent learned: set "
                                      f"Tempo between {low:.2f} and {high:.2f} Hz, or to 0 to let the agent choose.")
@@ -197,7 +209,7 @@ class GestureAgent:
         """The kind of a declared behaviour (behaviours.TARGET or INTENSITY)."""
         return self.space.kind(behaviour)
 
-    def rollout(self, objectives: ArrayLike, seed: int | None = None) -> np.ndarray:
+    def rollout(self, objectives: ArrayLike, seed: int | None = None) -> Array:
         """Objectives (N, O) -> actions (N, 45) in [0, 1]; `seed` as in the module docstring."""
         objectives = np.asarray(objectives, dtype=np.float64)
         if objectives.ndim != 2 or objectives.shape[1] != self.space.size or len(objectives) == 0 \
@@ -213,7 +225,7 @@ class GestureAgent:
             noise = None if seed is None else np.random.default_rng(seed).standard_normal(self._sizes[1])  # (Z,)
             return self._rollout(objectives, noise)
 
-    def _task(self, objectives):
+    def _task(self, objectives: Array) -> Array:
         """(N, K) what f2 and the heads see of the task: the task state (with the wave's phase features beside it,
         rhythm.phase_features, for a phase-input agent), or the objectives without a task state."""
         if not self._uses_task_state:
@@ -221,7 +233,7 @@ class GestureAgent:
         task = _gru_sequence(objectives, self._task_rnn)
         return np.hstack([task, self.space.phase_features(objectives)]) if self._phase_input else task
 
-    def _step_inputs(self, objectives):
+    def _step_inputs(self, objectives: Array) -> tuple[Array, Array, Array]:
         """(cell (N, 3E), belief (N, hidden), animation (N, hidden)): what each step's GRU cell, belief MLP and
         animation MLP take from the task and the portrayal, precomputed for all N steps at once."""
         E = self._sizes[0]
@@ -236,11 +248,11 @@ class GestureAgent:
                                   np.empty((count, len(self._portrayal[-1][1]))))  # (N, D)
             belief_inputs = belief_inputs + described @ self._belief[0][0][E:]  # (N, hidden)
         animation_inputs = np.broadcast_to(self._animation[0][1], (count, hidden))
-        if self._uses_task_state:
+        if self._animation_task is not None:  # an agent with a task state
             animation_inputs = animation_inputs + task @ self._animation_task  # (N, hidden)
         return cell_inputs, belief_inputs, animation_inputs
 
-    def _rollout(self, objectives, noise):
+    def _rollout(self, objectives: Array, noise: Array | None) -> Array:
         """Actions (N, 45) of the objectives (N, O), one step per row, in preallocated buffers (views of one
         another: each step writes them in place); noise (Z,) or None as in `rollout`."""
         E, Z = self._sizes
