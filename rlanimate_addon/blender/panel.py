@@ -50,7 +50,8 @@ def _overriding_constraints(context, obj, settings, behaviour):
                                                                      declared, settings.arm, still))
 
 
-_roles = {}
+#: `_rig_roles`' one remembered armature: {(bone names, paths, versions, VRM add-on map, known): (family, roles)}.
+_roles: dict[tuple[object, ...], tuple[str, dict[str, str]]] = {}
 #: Bone namings that tell an armature imported from a VRM file.
 _VRM_FAMILIES = {vrm.FAMILY, rig_roles.VROID.name, rig_roles.VRM_HUMANOID.name, rig_roles.VRM_ADDON.name}
 
