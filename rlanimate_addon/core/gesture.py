@@ -25,11 +25,13 @@ A rig may differ from the canonical skeleton in many ways, all handled here:
     line passes through the target whatever the rig's proportions and whatever moves underneath.
 """
 import math
+from collections.abc import Callable, Collection, Container, Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import NamedTuple, Protocol
 
 import numpy as np
 import numpy.typing as npt
+from numpy.typing import ArrayLike
 
 from . import aim, behaviours, frame_rate, rig_roles, skeleton, spaces
 from .errors import RLAnimateError
@@ -44,6 +46,9 @@ from .rotations import (
     rotvec_to_matrix,
     rotvec_to_quat,
 )
+
+#: A float64 array: positions, rotations (vectors, quaternions, matrices) and weights, per frame and bone.
+Array = npt.NDArray[np.float64]
 
 #: Lengths the agent supports, as fractions of its learned average length (paper Section 4.4).
 SUPPORTED_LENGTH = (0.4, 1.5)
@@ -63,18 +68,38 @@ POINTING_HAND = {
 }
 
 
+class Agent(Protocol):
+    """What the pipeline asks of an agent: core.runtime.GestureAgent, or a stand-in that plays given actions."""
+
+    space: spaces.ObjectiveSpace
+    action_bounds: Array  # (45, 2)
+
+    @property
+    def average_frames(self) -> Mapping[str, float]: ...
+
+    @property
+    def still_free_arm(self) -> Collection[str]: ...
+
+    def kind(self, behaviour: str) -> str: ...
+
+    def rollout(self, objectives: ArrayLike, seed: int | None = None) -> Array: ...
+
+    def wave_rhythm(self, exaggeration: float, frame_count: int, seed: int | None = None,
+                    tempo: float | None = None, arm: str | None = None) -> Array | None: ...
+
+
 #: The shortest gesture that moves: the first and last frames are the start pose (`blend_weights`).
 MIN_FRAMES = 3
 
 
-def check_length(frame_count):
+def check_length(frame_count: int) -> None:
     """RLAnimateError for a gesture too short to move."""
     if int(frame_count) < MIN_FRAMES:
         raise RLAnimateError(f"The gesture is {int(frame_count)} frames long: it starts and ends at the pose of "
                              f"its start frame, so nothing would move. Set a length of at least {MIN_FRAMES} frames.")
 
 
-def supported_length_range(average_frames):
+def supported_length_range(average_frames: float) -> tuple[int, int]:
     """(shortest, longest) gesture length in frames the agent portrays without visible artefacts."""
     low, high = SUPPORTED_LENGTH
     return max(2, int(round(low * average_frames))), max(2, int(round(high * average_frames)))
@@ -84,7 +109,7 @@ def supported_length_range(average_frames):
 LENGTH_WARNING = "warning:"
 
 
-def length_warning(frame_count, average_frames):
+def length_warning(frame_count: int, average_frames: float) -> str:
     """A note for a gesture shorter than the agent's supported range (its gesture squeezed into so few frames
     that it is rushed), else ""."""
     shortest, longest = supported_length_range(average_frames)
@@ -99,7 +124,7 @@ _ORIENTATION_BONES = ("Hips", "Spine", "Spine1", "Spine2", "Neck", "Head",
                       "LeftShoulder", "RightShoulder", "LeftArm", "RightArm")
 
 
-def character_frame(rest_heads):
+def character_frame(rest_heads: Mapping[str, ArrayLike]) -> Array:
     """(3, 3) rotation A taking vectors in a rig's armature space to the character frame.
 
     rest_heads: mapping of role -> rest head (3,) in the rig's armature space. A is the rotation that
@@ -112,7 +137,8 @@ def character_frame(rest_heads):
     rig, canonical = rig - rig.mean(axis=0), canonical - canonical.mean(axis=0)
     u, _, vt = np.linalg.svd(canonical.T @ rig)
     sign = np.sign(np.linalg.det(u @ vt))
-    return u @ np.diag([1.0, 1.0, sign]) @ vt
+    rotation: Array = u @ np.diag([1.0, 1.0, sign]) @ vt
+    return rotation
 
 
 #: A target nearer the rest shoulder than this times the arm's reach is refused: the collar bone's turn
@@ -121,7 +147,7 @@ def character_frame(rest_heads):
 REACH_MARGIN = 1.1
 
 
-def check_finite_targets(targets):
+def check_finite_targets(targets: ArrayLike) -> None:
     """RLAnimateError when any target (N, 3) is not a number."""
     broken = ~np.isfinite(np.atleast_2d(targets)).all(axis=1)
     if np.any(broken):
@@ -130,7 +156,7 @@ def check_finite_targets(targets):
                              "and parents, and the armature's transform.")
 
 
-def pointing_directions(arm, targets, rest_heads):
+def pointing_directions(arm: str, targets: ArrayLike, rest_heads: Mapping[str, ArrayLike]) -> Array:
     """(N, 3) unit vectors in the character frame from the rig's rest shoulder to each target.
 
     targets: (N, 3) target positions in the rig's armature space (any units, the rig's own).
@@ -148,10 +174,11 @@ def pointing_directions(arm, targets, rest_heads):
                              f"{norms.min() / reach:.0%} of the way from the shoulder to the outstretched index "
                              "finger), so the pointing arm would reach through it and point away from it: move the "
                              f"target at least {REACH_MARGIN:.1f} times that far from the shoulder.")
-    return (offsets / norms[:, None]) @ character_frame(rest_heads).T
+    directions: Array = (offsets / norms[:, None]) @ character_frame(rest_heads).T
+    return directions
 
 
-def arm_reach(arm, rest_heads):
+def arm_reach(arm: str, rest_heads: Mapping[str, ArrayLike]) -> float:
     """The outstretched arm's reach: from the rest shoulder to the index finger's base, in the rig's
     units (rest_heads: {role: (3,)}); from the wrist, scaled as on the canonical skeleton, for a rig
     without index bones."""
@@ -166,8 +193,9 @@ def arm_reach(arm, rest_heads):
     return float(ratio * np.linalg.norm(np.subtract(rest_heads[prefix + "Hand"], shoulder)))
 
 
-def build_objectives(space, behaviour, arm, frame_count, *, targets=None, rest_heads=None, exaggeration=0.5,
-                     rhythm=None):
+def build_objectives(space: spaces.ObjectiveSpace, behaviour: str, arm: str, frame_count: int, *,
+                     targets: ArrayLike | None = None, rest_heads: Mapping[str, ArrayLike] | None = None,
+                     exaggeration: float = 0.5, rhythm: ArrayLike | None = None) -> Array:
     """(N, O) objectives of the ObjectiveSpace `space` for a gesture: a target behaviour needs targets
     (N, 3) and rest_heads; an intensity behaviour an exaggeration and, for an oscillating one (a wave) from an
     agent trained with them, rhythm signals (N, 2) (GestureAgent.wave_rhythm)."""
@@ -176,14 +204,15 @@ def build_objectives(space, behaviour, arm, frame_count, *, targets=None, rest_h
         if targets is None:
             raise RLAnimateError(f"{behaviours.title(behaviour)} needs a target: pick a target object, or tick "
                                  "'Use 3D Cursor'.")
-        attributes = pointing_directions(arm, targets, rest_heads)
+        assert rest_heads is not None, "a target behaviour's objectives need the rig's rest_heads"
+        attributes: ArrayLike = pointing_directions(arm, targets, rest_heads)
     else:
         attributes = exaggeration
     return space.make_objective(behaviour, arm, attributes, frame_count,
                                 rhythm if space.behaviour(behaviour).oscillates else None)
 
 
-def resample(values, count):
+def resample(values: ArrayLike, count: int) -> Array:
     """Linear resampling of (M, ...) values along the first axis to (count, ...), ends kept."""
     values = np.asarray(values, dtype=np.float64)
     if len(values) == count:
@@ -192,10 +221,11 @@ def resample(values, count):
     low = np.floor(position).astype(int)
     high = np.minimum(low + 1, len(values) - 1)
     frac = (position - low).reshape((-1,) + (1,) * (values.ndim - 1))
-    return values[low] * (1.0 - frac) + values[high] * frac
+    resampled: Array = values[low] * (1.0 - frac) + values[high] * frac
+    return resampled
 
 
-def rollout_length(frame_count, average_frames, kind):
+def rollout_length(frame_count: int, average_frames: float, kind: str) -> int:
     """Steps the agent runs for a gesture of frame_count frames: clamped into its supported range, and
     for a target behaviour (`kind`) never fewer than the agent's average. A shorter point is the
     average-length point played faster: the agent's own quick points hold for a few frames and miss by
@@ -206,7 +236,8 @@ def rollout_length(frame_count, average_frames, kind):
     return int(np.clip(frame_count, shortest, longest))
 
 
-def run_agent(agent, behaviour, objectives, seed=None, frame_count=None):
+def run_agent(agent: Agent, behaviour: str, objectives: Array, seed: int | None = None,
+              frame_count: int | None = None) -> Array:
     """Canonical local rotation vectors (N, 15, 3) for the objectives (M, O) at the agent's rate.
 
     The agent runs for `rollout_length(M)` steps; its actions are resampled to the N = frame_count
@@ -230,7 +261,8 @@ def run_agent(agent, behaviour, objectives, seed=None, frame_count=None):
 _CANONICAL_FRAMES = {bone.name: skeleton.rest_frame(bone) for bone in skeleton.BONES}
 
 
-def retarget_matrices(canonical_bones, rig_rest_frames, to_character, swings=None):
+def retarget_matrices(canonical_bones: Iterable[str], rig_rest_frames: ArrayLike, to_character: Array,
+                      swings: Array | None = None) -> Array:
     """(B, 3, 3) C = F_can^-1 D A F_rig for each named canonical bone.
 
     rig_rest_frames: (B, 3, 3) armature-space rest rotations of the rig's bones (columns: local axes).
@@ -244,7 +276,7 @@ def retarget_matrices(canonical_bones, rig_rest_frames, to_character, swings=Non
     return np.swapaxes(canonical, -1, -2) @ frames
 
 
-def retarget(canonical_rotvecs, conversions, parent_conversions=None):
+def retarget(canonical_rotvecs: ArrayLike, conversions: Array, parent_conversions: Array | None = None) -> Array:
     """Canonical local rotation vectors (..., B, 3) -> the rig's local quaternions (..., B, 4).
 
     R_rig = P^-1 R_can C per bone, with C from `retarget_matrices` and P the same built with the
@@ -272,7 +304,8 @@ _FINGER_LAST = {f"{side}Hand{finger}3" for side in ("Left", "Right") for finger 
 _TAIL_TRUST_DEG = 45.0
 
 
-def _rest_direction(name, rest_heads, rest_tails):
+def _rest_direction(name: str, rest_heads: Mapping[str, ArrayLike],
+                    rest_tails: Mapping[str, ArrayLike]) -> Array | None:
     """(3,) the rig's rest direction of role `name` (armature space), or None: towards the head of the
     role it points to, else, for a finger's last bone, along its own tail while that continues the
     finger (within _TAIL_TRUST_DEG of the bone before it)."""
@@ -282,14 +315,15 @@ def _rest_direction(name, rest_heads, rest_tails):
     if child in rest_heads:
         return np.subtract(rest_heads[child], rest_heads[name])
     before = skeleton.BONE_BY_NAME[name].parent
-    if name not in _FINGER_LAST or name not in rest_tails or before not in rest_heads:
+    if name not in _FINGER_LAST or name not in rest_tails or before is None or before not in rest_heads:
         return None
     own, previous = np.subtract(rest_tails[name], rest_heads[name]), np.subtract(rest_heads[name], rest_heads[before])
     cos = own @ previous / (np.linalg.norm(own) * np.linalg.norm(previous))
     return own if cos >= np.cos(np.radians(_TAIL_TRUST_DEG)) else None
 
 
-def rest_swings(roles, rest_heads, rest_tails, to_character):
+def rest_swings(roles: Container[str], rest_heads: Mapping[str, ArrayLike], rest_tails: Mapping[str, ArrayLike],
+                to_character: ArrayLike) -> dict[str, Array]:
     """{role: (3, 3)} D per role: the shortest rotation (character frame) taking the rig's rest
     direction of the bone onto the canonical one. Bones without a direction of their own (the spine,
     a finger's last bone whose tail does not follow the finger) take their parent's (identity at the
@@ -315,14 +349,14 @@ def rest_swings(roles, rest_heads, rest_tails, to_character):
             strict=True,
         )
     )
-    swings = {}
+    swings: dict[str, Array] = {}
     for name in names:
         parent = _parent_role(name, roles)
         swings[name] = turns.get(name, np.eye(3) if parent is None else swings[parent])
     return swings
 
 
-def _parent_role(name, present):
+def _parent_role(name: str, present: Container[str]) -> str | None:
     parent = skeleton.BONE_BY_NAME[name].parent
     while parent is not None and parent not in present:
         parent = skeleton.BONE_BY_NAME[parent].parent
@@ -334,7 +368,7 @@ def _parent_role(name, present):
 FOLDED_CHAINS = (rig_roles.SPINE, ("LeftShoulder", "LeftArm"), ("RightShoulder", "RightArm"))
 
 
-def fold_missing(rotvecs, joints, present):
+def fold_missing(rotvecs: Array, joints: Sequence[str], present: Container[str]) -> tuple[list[str], Array]:
     """Canonical rotations (N, J, 3) of `joints` with each joint of a FOLDED_CHAINS chain the rig lacks
     folded into one of that chain it has.
 
@@ -345,12 +379,13 @@ def fold_missing(rotvecs, joints, present):
     """
     out = rotvecs.copy()
     rotations = rotvec_to_matrix(rotvecs)  # (N, J, 3, 3), each as it would be converted alone
-    keepers, turns = [], []
+    keepers: list[int] = []
+    turns: list[Array] = []
     for chain in FOLDED_CHAINS:
         have = [j for j in chain if j in present]
         if not have:  # an arm the rig lacks
             continue
-        groups = {j: [] for j in have}
+        groups: dict[str, list[str]] = {j: [] for j in have}
         for j in chain:
             below = [p for p in have if chain.index(p) <= chain.index(j)]
             groups[below[-1] if below else have[0]].append(j)
@@ -368,12 +403,12 @@ def fold_missing(rotvecs, joints, present):
     return [joints[i] for i in kept], out[:, kept]
 
 
-def blend_ramp(count, fraction=BLEND_FRACTION):
+def blend_ramp(count: int, fraction: float = BLEND_FRACTION) -> int:
     """Frames of each of `blend_weights`' ramps for a gesture of `count` frames."""
     return max(1, int(round(fraction * (count - 1))))
 
 
-def blend_weights(count, fraction=BLEND_FRACTION):
+def blend_weights(count: int, fraction: float = BLEND_FRACTION) -> Array:
     """(count,) weights of the gesture against the pose underneath: 0 at both ends, 1 in the middle.
 
     Smoothstep ramps over `fraction` of the frames at each end keep velocity continuous.
@@ -383,10 +418,11 @@ def blend_weights(count, fraction=BLEND_FRACTION):
     rise = np.clip(t / ramp, 0.0, 1.0)
     fall = np.clip((count - 1 - t) / ramp, 0.0, 1.0)
     s = np.minimum(rise, fall)
-    return s * s * (3.0 - 2.0 * s)
+    weights: Array = s * s * (3.0 - 2.0 * s)
+    return weights
 
 
-def slerp(q0, q1, weight):
+def slerp(q0: ArrayLike, q1: ArrayLike, weight: ArrayLike) -> Array:
     """Spherical interpolation of unit quaternions (..., 4) by weight (...,), on the short arc."""
     q0, q1 = np.asarray(q0, dtype=np.float64), np.asarray(q1, dtype=np.float64)
     dot = np.sum(q0 * q1, axis=-1)
@@ -399,16 +435,17 @@ def slerp(q0, q1, weight):
     a = np.where(near, 1.0 - w, np.sin((1.0 - w) * angle) / np.where(near, 1.0, sin))
     b = np.where(near, w, np.sin(w * angle) / np.where(near, 1.0, sin))
     q = a[..., None] * q0 + b[..., None] * q1
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    unit: Array = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return unit
 
 
-def blend_from_pose(under_quats, gesture_quats, weights):
+def blend_from_pose(under_quats: ArrayLike, gesture_quats: Array, weights: ArrayLike) -> Array:
     """Blend (N, B, 4) gesture quaternions with the pose underneath ((B, 4) or (N, B, 4)) by (N,) weights."""
     under = np.broadcast_to(under_quats, np.shape(gesture_quats))
     return slerp(under, gesture_quats, np.broadcast_to(np.asarray(weights)[:, None], np.shape(gesture_quats)[:2]))
 
 
-def pointing_hand_rotations(arm, count):
+def pointing_hand_rotations(arm: str, count: int) -> tuple[tuple[str, ...], Array]:
     """Canonical local rotation vectors (count, H, 3) of the pointing hand shape and their bone names."""
     prefix = skeleton.ARM_PREFIX[arm]
     names = tuple(prefix + bone for bone in POINTING_HAND)
@@ -416,11 +453,11 @@ def pointing_hand_rotations(arm, count):
     return names, rotvecs
 
 
-def _standing_pose():
+def _standing_pose() -> dict[str, Array]:
     """Canonical local rotation vectors of a natural standing pose: arms hanging 75 degrees down from the
     T-pose, elbows bent 17 degrees forward. Rigs with no animation start and end here, not in their
     bind pose."""
-    pose = {}
+    pose: dict[str, Array] = {}
     for side, sign in (("Left", 1.0), ("Right", -1.0)):
         for bone, world in ((side + "Arm", (0.0, sign * 1.3, 0.0)), (side + "ForeArm", (0.0, 0.0, -sign * 0.3))):
             frame = _CANONICAL_FRAMES[bone]
@@ -446,14 +483,14 @@ class FingerLine(NamedTuple):
     end: str
     to_tail: bool = False
 
-    def points(self, skeleton: RigSkeleton, pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def points(self, skeleton: RigSkeleton, pose: Array) -> tuple[Array, Array]:
         """(base (..., 3), tip (..., 3)) of the line in (..., B, 4, 4) pose (or rest) matrices of `skeleton`."""
         base = pose[..., skeleton.index[self.start], :3, 3]
         tip = skeleton.tails(pose, self.end) if self.to_tail else pose[..., skeleton.index[self.end], :3, 3]
         return base, tip
 
 
-def finger_line_bones(roles, arm):
+def finger_line_bones(roles: Mapping[str, str], arm: str) -> FingerLine:
     """The rig's pointing line (a FingerLine): joint positions, as the mesh shows them, not a finger bone's
     tail (an imported bone's tail may point anywhere). The index finger from its base (Index1) to the
     farthest index joint the rig has (Index4 ... Index2); with Index1 alone, the hand's head to the index
@@ -467,7 +504,8 @@ def finger_line_bones(roles, arm):
     return FingerLine(index[0], index[-1]) if len(index) > 1 else FingerLine(roles[prefix + "Hand"], index[0])
 
 
-def aim_rig(rig, basis, changed, arm, targets, weights):
+def aim_rig(rig: "RigState", basis: Array, changed: Sequence[int], arm: str, targets: Array,
+            weights: ArrayLike) -> Array:
     """(N, 4, 4) basis matrices of the pointing Arm bone turned so the rig's finger line
     (`finger_line_bones`) passes through targets (N, 3) by `weights` (N,) of the turn, solved against
     the posed rig.
@@ -490,13 +528,15 @@ def aim_rig(rig, basis, changed, arm, targets, weights):
     return aimed
 
 
-def _rotation_part(matrices):
+def _rotation_part(matrices: Array) -> Array:
     """(..., 3, 3) rotations of (..., 4, 4) matrices, scale removed."""
     rotation = matrices[..., :3, :3]
-    return rotation / np.linalg.norm(rotation, axis=-2, keepdims=True)
+    unscaled: Array = rotation / np.linalg.norm(rotation, axis=-2, keepdims=True)
+    return unscaled
 
 
-def look_at(rig, basis, changed, eye_bones, to_character, targets, weights):
+def look_at(rig: "RigState", basis: Array, changed: Sequence[int], eye_bones: Sequence[str], to_character: Array,
+            targets: Array, weights: ArrayLike) -> Array:
     """(N, E, 4) local quaternions turning each eye so it looks at targets (N, 3) by `weights` (N,).
 
     An eye looks along the character's forward at rest, whatever its bone's axes; it is turned from
@@ -518,7 +558,7 @@ def look_at(rig, basis, changed, eye_bones, to_character, targets, weights):
     return matrix_to_quat(_rotation_part(basis[:, rows]) @ np.swapaxes(world, -1, -2) @ turn @ world)
 
 
-def hips_relative_targets(rig, targets, count):
+def hips_relative_targets(rig: "RigState", targets: ArrayLike, count: int) -> Array:
     """(N, 3) targets (3,) or (N, 3) in the rig's armature space, carried back by the motion of its hips
     underneath at each of `count` frames: where each target is for a body whose hips rest.
 
@@ -530,10 +570,11 @@ def hips_relative_targets(rig, targets, count):
         return points
     i = rig.skeleton.index[rig.roles["Hips"]]
     back = rig.skeleton.rest[i] @ inverse(rig.under_pose_at(count)[:, i])  # (N, 4, 4) pose -> rest
-    return np.einsum("nij,nj->ni", back[:, :3, :3], points) + back[:, :3, 3]
+    carried: Array = np.einsum("nij,nj->ni", back[:, :3, :3], points) + back[:, :3, 3]
+    return carried
 
 
-def played_finger_base(canonical, arm):
+def played_finger_base(canonical: Array, arm: str) -> Array:
     """(N, 3) index-base path of canonical rotations (N, 15, 3) blended from their first frame as the keys
     blend from the pose underneath (`blend_weights`): it comes back to its start even where the agent's
     own hand does not (a target behind the character), so the aim's pointing phase stays whole. Only the
@@ -550,14 +591,14 @@ def played_finger_base(canonical, arm):
 TORSO = rig_roles.SPINE + ("Neck", "Head")
 
 
-def free_arm_columns(names, arm):
+def free_arm_columns(names: Sequence[str], arm: str) -> list[int]:
     """The columns of `names` (canonical roles) that are the joints of the arm other than `arm`, collar to index
     base."""
     side = skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
     return [k for k, name in enumerate(names) if name in skeleton.ACTION_JOINTS and name.startswith(side)]
 
 
-def owned_joints(arm, still):
+def owned_joints(arm: str, still: bool) -> tuple[str, ...]:
     """The action joints a gesture on `arm` keys: the spine, neck and head (a turn added to what plays
     underneath), its own arm, and, made as on a still rig, the other arm too (from its natural standing
     pose; on an animated rig the other arm is the animation's)."""
@@ -565,7 +606,7 @@ def owned_joints(arm, still):
     return tuple(joint for joint in skeleton.ACTION_JOINTS if still or not joint.startswith(other))
 
 
-def _objectives(agent, request, rig):
+def _objectives(agent: Agent, request: "GestureRequest", rig: "RigState") -> Array:
     """(M, O) objectives of the request at the agent's rate (M: the gesture's seconds at the agent's rate)."""
     span = request.agent_frames
     rhythm = (agent.wave_rhythm(request.exaggeration, span, request.seed, request.tempo, request.arm)
@@ -578,7 +619,7 @@ def _objectives(agent, request, rig):
                             rest_heads=rig.rest_heads, exaggeration=request.exaggeration, rhythm=rhythm)
 
 
-def _conversions(names, rig, to_character):
+def _conversions(names: Sequence[str], rig: "RigState", to_character: Array) -> tuple[Array, Array]:
     """((D, 3, 3) C, (D, 3, 3) P) of the named roles for `retarget`."""
     swings = rest_swings(rig.roles, rig.rest_heads, rig.rest_tails, to_character)
     frames = [rig.skeleton.rest_frame(rig.roles[n]) for n in names]
@@ -587,7 +628,8 @@ def _conversions(names, rig, to_character):
             retarget_matrices(names, frames, to_character, np.array(parent_swings)))
 
 
-def _played(request, rig, canonical, pointing):
+def _played(request: "GestureRequest", rig: "RigState", canonical: Array,
+            pointing: bool) -> tuple[list[str], Array, Array, Array]:
     """(names of the roles keyed, (N, D, 4) the gesture's rotations of them on the rig, (D, 4) the standing
     pose, to_character): the owned action joints, then, for a `pointing` behaviour, the pointing hand shape."""
     names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
@@ -610,7 +652,8 @@ def _played(request, rig, canonical, pointing):
     return names, played, standing, to_character
 
 
-def _blended(rig, names, columns, played, standing, held=()):
+def _blended(rig: "RigState", names: Sequence[str], columns: Sequence[int], played: Array, standing: Array,
+             held: Sequence[int] = ()) -> tuple[Array, Array]:
     """((N, D, 4) keyed, (N, D, 4) underneath): each bone blended from the pose it starts from into the
     gesture and back (on a still rig, bones at rest start from the standing pose, not the bind pose); the
     columns `held` (a free arm with no part in the gesture) stay on that start pose on every frame. The
@@ -618,7 +661,7 @@ def _blended(rig, names, columns, played, standing, held=()):
     into the gesture's, by the same weights, on top of the pose underneath: over the animation alone the
     gesture's pose, and over other gestures that turn them too, the turns of all."""
     count = len(played)
-    quats = lambda frames: matrix_to_quat(frames[:, columns, :3, :3])  # noqa: E731
+    quats: Callable[[Array], Array] = lambda frames: matrix_to_quat(frames[:, columns, :3, :3])  # noqa: E731
     under = each_frame(quats, rig.under_at(count))  # (N, D, 4)
     start = each_frame(quats, rig.start_at(count))
     torso = [k for k, name in enumerate(names) if name in TORSO]
@@ -645,7 +688,7 @@ def _blended(rig, names, columns, played, standing, held=()):
     return keyed, under
 
 
-def gesture_rotations(agent, request, rig):
+def gesture_rotations(agent: Agent, request: "GestureRequest", rig: "RigState") -> tuple[tuple[str, ...], Array, Array]:
     """Per-frame local quaternions to key on the rig: (bone names, keyed (N, D, 4), underneath (N, D, 4)).
 
     request: a GestureRequest. rig: a RigState (the rig's bones, roles and the pose underneath).
@@ -667,14 +710,14 @@ class Blended:
     behaviour). `aimed` finishes it for a target, and for another."""
     names: tuple[str, ...]
     columns: tuple[int, ...]
-    keyed: npt.NDArray[np.float64]
-    under: npt.NDArray[np.float64]
-    phase_base: npt.NDArray[np.float64] | None
-    to_character: npt.NDArray[np.float64]
+    keyed: Array
+    under: Array
+    phase_base: Array | None
+    to_character: Array
     aims: bool
 
 
-def blended_gesture(agent: Any, request: "GestureRequest", rig: "RigState") -> Blended:
+def blended_gesture(agent: Agent, request: "GestureRequest", rig: "RigState") -> Blended:
     """The agent's gesture for the request, retargeted to the rig and blended from and into the pose underneath."""
     rig_roles.check_roles(rig.name, rig.roles, request.arm, rig.family)
     check_length(request.frame_count)
@@ -690,7 +733,7 @@ def blended_gesture(agent: Any, request: "GestureRequest", rig: "RigState") -> B
 
 
 def aimed(request: "GestureRequest", rig: "RigState",
-          blended: Blended) -> tuple[tuple[str, ...], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+          blended: Blended) -> tuple[tuple[str, ...], Array, Array]:
     """`gesture_rotations`' result from a blended gesture: a target behaviour's aim and gaze solved for the
     request's targets (which may be others than the gesture was made for: Follow Target's cheap path), the
     rotations made continuous; RLAnimateError for rotations that are not numbers."""
@@ -709,10 +752,12 @@ def aimed(request: "GestureRequest", rig: "RigState",
     return tuple(bones), keyed, under
 
 
-def _aimed(rig, request, names, columns, keyed, under, blended):
+def _aimed(rig: "RigState", request: "GestureRequest", names: list[str], columns: list[int], keyed: Array,
+           under: Array, blended: Blended) -> tuple[list[str], Array, Array]:
     """(bones, keyed, under) of a target behaviour: the eyes look at the target, and a pointing behaviour's
     finger is aimed exactly on the rig (Exact Aim), solved against the pose as it will play."""
     phase_base, to_character = blended.phase_base, blended.to_character
+    assert phase_base is not None and request.targets is not None  # a target behaviour's, asked with targets
     count = request.frame_count
     bones = [rig.roles[n] for n in names]
     phase = aim.pointing_phase(phase_base)
@@ -742,8 +787,9 @@ class GestureRequest:
     behaviour's attribute, a wave's tempo (Hz; None: the agent's choice), and whether Point solves its aim
     exactly on the rig (else it keys the agent's own aim)."""
 
-    def __init__(self, behaviour, arm, frame_count, *, targets=None, exaggeration=0.5, seed=None, tempo=None,
-                 exact_aim=True, fps=frame_rate.AGENT_FPS):
+    def __init__(self, behaviour: str, arm: str, frame_count: int, *, targets: ArrayLike | None = None,
+                 exaggeration: float = 0.5, seed: int | None = None, tempo: float | None = None,
+                 exact_aim: bool = True, fps: float = frame_rate.AGENT_FPS) -> None:
         self.behaviour, self.arm = behaviour, arm
         self.frame_count, self.seed = int(frame_count), seed
         self.targets, self.exaggeration, self.tempo = targets, float(exaggeration), tempo
@@ -751,7 +797,7 @@ class GestureRequest:
         self.fps = float(fps)
 
     @property
-    def agent_frames(self):
+    def agent_frames(self) -> int:
         """The gesture's length at the agent's rate (core/frame_rate.py)."""
         return frame_rate.agent_frames(self.frame_count, self.fps)
 
@@ -776,8 +822,10 @@ class RigState:
     the layers above the gesture's own add to them (their Combine layers multiply in, in the stack's order).
     """
 
-    def __init__(self, name, skeleton_, roles, family, under, animated, under_pose=None, *, still=None, held=0,
-                 resting=None, bare=None, above=None):
+    def __init__(self, name: str, skeleton_: RigSkeleton, roles: Mapping[str, str], family: str, under: ArrayLike,
+                 animated: bool, under_pose: ArrayLike | None = None, *, still: bool | None = None, held: int = 0,
+                 resting: Mapping[str, Array] | None = None, bare: Mapping[str, Array] | None = None,
+                 above: Mapping[str, Array] | None = None) -> None:
         self.name, self.skeleton, self.roles, self.family = name, skeleton_, dict(roles), family
         self.under, self.animated = np.asarray(under, dtype=np.float64), animated
         if under_pose is None:
@@ -788,16 +836,16 @@ class RigState:
         self.held, self.resting = int(held), dict(resting or {})
         self.bare, self.above = dict(bare or {}), dict(above or {})
 
-    def with_pose(self, under, under_pose):
+    def with_pose(self, under: ArrayLike, under_pose: ArrayLike | None) -> "RigState":
         """This rig with another pose underneath (basis, pose), its other settings kept."""
         return RigState(self.name, self.skeleton, self.roles, self.family, under, self.animated, under_pose,
                         still=self.still, held=self.held, resting=self.resting, bare=self.bare, above=self.above)
 
-    def under_at(self, count):
+    def under_at(self, count: int) -> Array:
         """(N, B, 4, 4) basis matrices underneath at each of `count` frames."""
         return np.broadcast_to(self.under, (count,) + self.under.shape[-3:])
 
-    def animation_at(self, count):
+    def animation_at(self, count: int) -> Array:
         """(N, B, 4, 4) basis matrices of the animation underneath: `under`, but the spine, neck and head
         without other gestures' turns (`bare`) and the `resting` bones at their basis."""
         pose = self.under_at(count)
@@ -808,7 +856,7 @@ class RigState:
             pose[:, self.skeleton.index[bone]] = basis
         return pose
 
-    def start_at(self, count):
+    def start_at(self, count: int) -> Array:
         """(N, B, 4, 4) basis matrices the gesture blends from and back to: `animation_at`, but over the `held`
         frames the pose underneath at the first frame (where the gesture it takes over from is)."""
         start = self.animation_at(count)
@@ -818,26 +866,26 @@ class RigState:
         start[:self.held] = self.under_at(count)[0]
         return start
 
-    def under_pose_at(self, count):
+    def under_pose_at(self, count: int) -> Array:
         """(N, B, 4, 4) pose matrices underneath at each of `count` frames."""
         return np.broadcast_to(self.under_pose, (count,) + self.under_pose.shape[-3:])
 
     @property
-    def rest_heads(self):
+    def rest_heads(self) -> dict[str, Array]:
         """{role: (3,) rest head in armature space}."""
         return {role: self.skeleton.rest_head(bone) for role, bone in self.roles.items()}
 
     @property
-    def rest_tails(self):
+    def rest_tails(self) -> dict[str, Array]:
         """{role: (3,) rest tail in armature space}."""
         return {role: self.skeleton.tails(self.skeleton.rest, bone) for role, bone in self.roles.items()}
 
 
-def role_skeleton(roles, rest, lengths):
+def role_skeleton(roles: Mapping[str, str], rest: Mapping[str, Array], lengths: Mapping[str, float]) -> RigSkeleton:
     """A RigSkeleton of the bones playing `roles` ({role: bone}), each parented to the bone of its
     nearest canonical ancestor that the rig has; rest: {bone: (4, 4)}, lengths: {bone: float}."""
     ordered = [name for name in skeleton.BONE_NAMES if name in roles]  # canonical order: parents first
-    parents = []
+    parents: list[str | None] = []
     for role in ordered:
         parent = skeleton.BONE_BY_NAME[role].parent
         while parent is not None and parent not in roles:
@@ -847,7 +895,7 @@ def role_skeleton(roles, rest, lengths):
     return RigSkeleton(bones, parents, [rest[b] for b in bones], [lengths[b] for b in bones])
 
 
-def canonical_rig():
+def canonical_rig() -> RigState:
     """The canonical skeleton at rest, unanimated, as a RigState: for tests and checks without Blender."""
     bones = skeleton.BONES
     rigged = RigSkeleton([b.name for b in bones], [b.parent for b in bones], skeleton.rest_matrices(),
