@@ -17,11 +17,11 @@
              the default with a fifth of the chunks ending at the gesture's last frame, where the arm
              comes down (trainer/agent/buffer.py), and that with every state and hidden layer twice as
              wide (real capture: docs/results/realmocap.md, realmocap_ablation.md);
-    end_chunks_long, end_chunks_smooth, end_chunks_phase
+    end_chunks_long, end_chunks_smooth, end_chunks_phase, end_chunks_phase_smooth
              end_chunks with chunks of 64 frames (half as many, the same frames an update), so that a
              slow real wave's whole cycle lies in one chunk; or with the pose-velocity term; or with the
              wave's phase and its second harmonic beside the task state, as phase-conditioned motion models
-             give it (real capture's model search: docs/results/realmocap_model.md).
+             give it; or with both of the last two (real capture's model search: docs/results/realmocap_model.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -129,6 +129,8 @@ PRESETS = {
     "end_chunks_long": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, chunk_length=64, chunk_count=16)),
     "end_chunks_smooth": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
     "end_chunks_phase": (AgentConfig(phase_input=True), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
+    "end_chunks_phase_smooth": (AgentConfig(phase_input=True),
+                                replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,
                     portrayal_hidden_size=200),
