@@ -92,6 +92,7 @@ def test_the_shipped_agent_is_what_the_readme_run_exports_and_names_no_machine_p
     assert "/" + str(REPO_ROOT).split("/")[1] not in json.dumps(shipped), "the shipped metadata names no machine path"
     space = runtime.load_agent(INSTALLED_AGENT).space
     assert space.names == ("POINT", "WAVE", "GUIDE", "RAISE_HAND"), "every behaviour of the sample library"
+    assert sorted(shipped["still_free_arm"]) == sorted(space.names), "the sample clips leave every free arm still"
     agent = RLAnimateAgent(AgentConfig.from_dict(shipped["agent_config"]), shipped["variant"], space)
     agent.load_state_dict({name: torch.from_numpy(array) for name, array in weights.items()})
     training = {key: shipped["training"][key] for key in ("behaviour", "variant", "preset", "seed", "epochs",
@@ -101,7 +102,7 @@ def test_the_shipped_agent_is_what_the_readme_run_exports_and_names_no_machine_p
     written = export_agent(agent, path, {
         "training": training, "train_config": shipped["train_config"], "action_bounds": shipped["action_bounds"],
         "average_frames": shipped["average_frames"], "wave_rhythm": shipped["wave_rhythm"],
-        "evaluation": shipped["evaluation"]})
+        "still_free_arm": shipped["still_free_arm"], "evaluation": shipped["evaluation"]})
     for metadata in (written, shipped):
         metadata["training"] = {k: v for k, v in metadata["training"].items() if k not in ("git_commit", "date")}
     assert shipped["format_version"] == agent_file.FORMAT_VERSION and shipped["training"]["behaviour"] == "all"
