@@ -3,7 +3,6 @@
     import_clip(path)                       -> MotionClip (raises RLAnimateError naming file and fix)
     import_clip_directory(dir_or_manifest)  -> (clips, problems): goes on past bad files
     load_clip_set(manifest_path)            -> ClipSet with the manifest's labels and split
-    import_into_cache(files, cache_dir, N)  -> the files the cache lacks imported as N Ray tasks at once
 
 A clip's `rotvecs` (F, 15, 3) are local rotations of skeleton.ACTION_JOINTS relative to the canonical
 rest frames (the action space before its [0, 1] mapping); `fingers` holds the other hand bones when the
@@ -418,21 +417,23 @@ def _import_files(files: list[tuple[Path, float]], cache: Path | None, workers: 
     import workers first."""
     results: dict[tuple[Path, float], MotionClip | RLAnimateError] = {}
     with nullcontext(str(cache)) if _writable(cache) else tempfile.TemporaryDirectory() as folder:
-        store, missing = Path(folder), []
+        store = Path(folder)
+        missing: dict[tuple[Path, float], Path] = {}  # the files the cache lacks: their cache file
         for path, fps in dict.fromkeys((Path(path), float(fps)) for path, fps in files):
             try:
                 _check_file(path)
-                cached = _read_cache(_cache_file(path, fps, None, store), path)
+                cache_file = _cache_file(path, fps, None, store)  # hashes the file: once per file
+                cached = _read_cache(cache_file, path)
             except RLAnimateError as error:
                 results[path, fps] = error
                 continue
             if cached is None:
-                missing.append((path, fps))
+                missing[path, fps] = cache_file
             else:
                 results[path, fps] = cached
-        failed = import_worker.import_into_cache(missing, store, workers, limits, progress)
-        for path, fps in missing:
-            result = failed.get((path, fps)) or _read_cache(_cache_file(path, fps, None, store), path)
+        failed = import_worker.import_into_cache(list(missing), store, workers, limits, progress)
+        for (path, fps), cache_file in missing.items():
+            result = failed.get((path, fps)) or _read_cache(cache_file, path)
             results[path, fps] = result or RLAnimateError(f"{path}: its import left no readable cache entry in "
                                                           f"{store}. Import it again.")
     return results

@@ -119,7 +119,11 @@ def _moving_average(values, window):
 
 def moving_arm(rotvecs):
     """'LEFT' or 'RIGHT': the arm whose wrist travels further relative to its shoulder."""
-    vectors = _arm_vectors(rotvecs)
+    return _moving(_arm_vectors(rotvecs))
+
+
+def _moving(vectors):
+    """'LEFT' or 'RIGHT': the arm of _arm_vectors' {arm: vectors} whose wrist travels further."""
     return max(vectors, key=lambda arm: _travel(vectors[arm]))
 
 
@@ -188,7 +192,7 @@ def arm_elevation(rotvecs, arm=None) -> tuple[str, float]:
     """(arm, degrees): the moving arm (or `arm`) and how high it goes, the ELEVATION_PERCENTILE-th percentile
     of its elevation_t: the measure an intensity behaviour other than WAVE is labelled by."""
     vectors = _arm_vectors(rotvecs)
-    arm = arm or max(vectors, key=lambda side: _travel(vectors[side]))
+    arm = arm or _moving(vectors)
     return arm, float(np.percentile(_elevation(vectors[arm]), ELEVATION_PERCENTILE))
 
 

@@ -15,7 +15,7 @@ A share of the takes is held out by take (`hold_out`): in each behaviour and arm
 label's range. A wave too short to read its swing is held out (asked with its label alone), never trained on.
 `manifest` writes the labels as a clip manifest (trainer/motion/manifest.py) the user can edit and pass back.
 """
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -67,10 +67,10 @@ def find_takes(folder) -> tuple[list[Path], list[str]]:
     folder = Path(folder)
     paths = sorted(p for p in [*folder.iterdir(), *(q for d in folder.iterdir() if d.is_dir() for q in d.iterdir())]
                    if p.is_file() and p.suffix.lower() in SUFFIXES)
-    withheld = [p.name for p in paths if realmocap_takes.is_withheld(p)]
+    withheld = {p for p in paths if realmocap_takes.is_withheld(p)}
     notes = [f"left out {len(withheld)} take(s) held out for evaluation elsewhere, unopened: "
-             f"{', '.join(withheld)}"] if withheld else []
-    return [p for p in paths if not realmocap_takes.is_withheld(p)], notes
+             f"{', '.join(p.name for p in paths if p in withheld)}"] if withheld else []
+    return [p for p in paths if p not in withheld], notes
 
 
 def label_take(path, clip: MotionClip) -> TakeLabel:
@@ -88,9 +88,8 @@ def label_take(path, clip: MotionClip) -> TakeLabel:
     elif behaviours.SHIPPED.get(behaviour) == behaviours.OSCILLATES:
         read = autolabel.label_wave(clip.rotvecs, clip.fps)
         label.arm, label.exaggeration = read.arm, read.exaggeration
-        label.tempo, why = wave_rhythm.tempo_reading(MotionClip(clip.name, clip.source, clip.fps, clip.rotvecs,
-                                                                arm=read.arm))
-        if why and "too short" in why:
+        label.tempo, why = wave_rhythm.tempo_reading(replace(clip, arm=read.arm))
+        if wave_rhythm.too_short(clip):
             label.split = "test"
             label.notes.append(f"{why}: held out, asked with its label alone, never trained on")
         elif why:

@@ -104,10 +104,15 @@ def tempo_reading(clip):
     """(Hz, None): the tempo a request for a wave clip names (clip_tempo), or (None, why not) for a take whose tempo
     cannot be read: one shorter than MIN_SECONDS, or one whose hand does not swing side to side. A request for such
     a take names no tempo: its rhythm comes from its label."""
-    if clip.frames < MIN_SECONDS * clip.fps:
+    if too_short(clip):
         return None, f"{clip.frames} frames, under {MIN_SECONDS:g} s: too short to read its swing"
     tempo = clip_tempo(clip)
     return (tempo, None) if tempo is not None else (None, "its hand does not swing side to side")
+
+
+def too_short(clip):
+    """Whether a wave clip is shorter than MIN_SECONDS, too short to read its swing."""
+    return clip.frames < MIN_SECONDS * clip.fps
 
 
 def swinging(waves):

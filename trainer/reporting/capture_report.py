@@ -3,6 +3,7 @@
 from trainer.motion import capture_folder
 from trainer.reporting.behaviour_report import behaviour_words
 from trainer.reporting.paired import gap_cell, paired_gap
+from trainer.reporting.realmocap_report import PAIRED_MEASURES, take_scores
 from trainer.reporting.tables import markdown_table
 
 LABEL_COLUMNS = ("take", "behaviour (kind)", "arm", "label", "tempo", "frames", "split", "notes")
@@ -21,9 +22,8 @@ def _method_cell(result: dict, behaviour: str) -> str:
 
 
 def _gaps(methods: dict) -> list[str]:
-    ours, theirs = methods["rlanimate"]["clips"], methods["nearest_clip"]["clips"]
-    return [gap_cell(paired_gap([c[key] for c in ours], [c[key] for c in theirs]))
-            for key in ("score", "aligned_score")]
+    ours, theirs = take_scores(methods["rlanimate"]), take_scores(methods["nearest_clip"])
+    return [gap_cell(paired_gap(ours[key], theirs[key])) for key, _ in PAIRED_MEASURES]
 
 
 def comparison_rows(results: dict) -> tuple[list[list[str]], list[list[str]]]:
