@@ -129,6 +129,7 @@ class _PosteriorUnroll(torch.autograd.Function):
         for k in range(len(weights)):  # each later layer: its weight's and its bias's gradient
             d_out = _rows([frame[k] for frame in d_layers])
             later += [d_out.t() @ _rows([frame[k] for frame in kept["activations"]]), d_out.sum(0)]
+        hid_rows = _rows(d_hid)  # (L * C, 3E)
         return (torch.stack(d_in, 1), torch.stack(d_first, 1), None, _rows(d_in).t() @ _rows(z_prev),
-                _rows(d_hid).t() @ _rows(e_prev), _rows(d_hid).sum(0), _rows(d_first).t() @ _rows(kept["e"]),
+                hid_rows.t() @ _rows(e_prev), hid_rows.sum(0), _rows(d_first).t() @ _rows(kept["e"]),
                 None, *later)

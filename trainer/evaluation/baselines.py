@@ -167,7 +167,12 @@ def agent_motion(agent, behaviour, arm, attributes, frame_count, rhythm_seed=Non
 def generate_for(baseline: Any, clips: Sequence[MotionClip], with_tempo: bool = False) -> list[np.ndarray]:
     """The baseline's answer to each clip's own request (label and length, and `with_tempo` a wave's own
     tempo where it can be read, request_tempos): list of (F_i, 15, 3)."""
-    tempos, _ = request_tempos(clips, with_tempo)
+    return generate_at(baseline, clips, request_tempos(clips, with_tempo)[0])
+
+
+def generate_at(baseline: Any, clips: Sequence[MotionClip], tempos: Sequence[float | None]) -> list[np.ndarray]:
+    """The baseline's answer to each clip's request (label and length) naming the tempo of `tempos` (Hz, or None)
+    beside it: list of (F_i, 15, 3)."""
     return [baseline.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs), tempo=tempo)
             for c, tempo in zip(clips, tempos, strict=True)]
 

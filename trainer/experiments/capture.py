@@ -97,12 +97,11 @@ def capture_settings(settings: RunSettings, labelled: Labelled) -> RunSettings:
                    **{name: value for name, value in CAPTURE_DEFAULTS.items() if getattr(settings, name) is None})
 
 
-def compare_held_out(agent_path: Path, session: Any) -> dict:
+def compare_held_out(agent: baselines.AgentMethod, retrieval: baselines.NearestClip, session: Any) -> dict:
     """{behaviour key: {request: realmocap.compare's {method: result}}} on the session's held-out takes of each
-    behaviour the agent performs: RLAnimate (agent.npz) against retrieval from the training takes; a wave's
-    requests asked the paper's way ("paper") and naming its tempo ("tempo")."""
-    agent = baselines.AgentMethod(agent_path)
-    methods = {"rlanimate": agent, "nearest_clip": baselines.NearestClip(session.train_clips)}
+    behaviour the agent performs: RLAnimate (`agent`, its agent.npz) against `retrieval` from the training takes; a
+    wave's requests asked the paper's way ("paper") and naming its tempo ("tempo")."""
+    methods = {"rlanimate": agent, "nearest_clip": retrieval}
     results = {}
     for behaviour in agent.agent.behaviours:
         held = [clip for clip in session.test_clips if clip.behaviour == behaviour]
@@ -121,12 +120,11 @@ PATH_TAKES = 3
 TITLE_CHARACTERS = 24
 
 
-def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
+def hand_paths(agent: baselines.AgentMethod, retrieval: baselines.NearestClip, session: Any, path: Path) -> list[str]:
     """Plot the hand paths of up to PATH_TAKES held-out takes of each behaviour the agent performs, lowest to highest
     label: the take, the agent and retrieval (a wave asked its tempo) into `path`, the waves' side to side where there
     are waves, else the other gestures' held reach; the takes drawn."""
-    agent = baselines.AgentMethod(agent_path)
-    methods: dict[str, Any] = {"RLAnimate": agent, "retrieval": baselines.NearestClip(session.train_clips)}
+    methods: dict[str, Any] = {"RLAnimate": agent, "retrieval": retrieval}
     waves: list[Any] = []
     held: list[Any] = []
     for behaviour in agent.agent.behaviours:
@@ -151,12 +149,13 @@ def hand_paths(agent_path: Path, session: Any, path: Path) -> list[str]:
 def write_report(labelled: Labelled, report: dict, session: Any, output: str, command: str) -> Path:
     """<output>/capture_report.json and .md: the comparison on the held-out takes, with the labels table, and
     capture_hand_paths.png; returns the page's path."""
+    agent, retrieval = baselines.AgentMethod(Path(output) / "agent.npz"), baselines.NearestClip(session.train_clips)
     results = {"folder": labelled.folder, "command": command, "manifest": str(labelled.manifest),
                "labels": capture_folder.table_rows(labelled.labels), "notes": labelled.notes,
                "training_takes": len(session.train_clips), "held_out_takes": len(session.test_clips),
                "run": {key: report[key] for key in ("preset", "epochs", "seed", "train_cpu_seconds")},
-               "behaviours": compare_held_out(Path(output) / "agent.npz", session),
-               "hand_paths": hand_paths(Path(output) / "agent.npz", session, Path(output) / PATHS_FIGURE)}
+               "behaviours": compare_held_out(agent, retrieval, session),
+               "hand_paths": hand_paths(agent, retrieval, session, Path(output) / PATHS_FIGURE)}
     atomic_write_text(Path(output) / f"{REPORT}.json", json.dumps(results, indent=1) + "\n")
     page = Path(output) / f"{REPORT}.md"
     atomic_write_text(page, capture_markdown(results))

@@ -226,9 +226,9 @@ def compare(methods, clips, env, references, with_tempo=False):
     baselines.request_tempos); for waves also `label_error`, the mean |autolabel exaggeration of the generated wave -
     requested exaggeration| (does it portray the label?)."""
     results = {}
-    _, fallbacks = baselines.request_tempos(clips, with_tempo)
+    tempos, fallbacks = baselines.request_tempos(clips, with_tempo)  # read once for every method
     for name, method in methods.items():
-        motions = baselines.generate_for(method, clips, with_tempo)
+        motions = baselines.generate_at(method, clips, tempos)
         result = scoring.score_motions(env, motions, clips, references)
         if all(c.declared.oscillates for c in clips):
             result["label_error"] = float(np.mean([abs(autolabel.label_wave(m).exaggeration - c.exaggeration)

@@ -78,13 +78,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     command = parse_settings(argv)
     settings = replace(command.run, progress=not command.quiet)
     output = settings.output
+    limits = import_limits(command)  # before a capture folder's takes are imported and labelled
     labelled = None
     if not settings.resume and capture.is_capture_folder(settings.clips):  # a studio's folder of takes, no manifest
         check_settings(settings)
         labelled = capture.label_folder(settings.clips, output, command.hold_out, command.verbose)
         settings = capture.capture_settings(settings, labelled)
     settings = resolve(settings)
-    limits = import_limits(command)
     session = LibrarySession(settings.clips, verbose=command.verbose, import_workers=command.import_workers,
                              import_limits=limits)
     report, _ = train(settings, session)
