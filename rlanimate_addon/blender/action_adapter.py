@@ -20,6 +20,13 @@ _BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZI
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
 #: A linear key's interpolation, as Keyframe.interpolation stores it.
 LINEAR_KEY = _LINEAR
+#: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
+_ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
+
+
+def rotation_path(mode: str) -> str:
+    """The pose-bone property a bone in rotation mode `mode` keys its rotation on."""
+    return _ROTATION_PATHS.get(mode, "rotation_euler")
 
 
 class ActionTarget:

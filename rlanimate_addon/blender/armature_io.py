@@ -16,13 +16,6 @@ from ..core.gesture import RigState, role_skeleton
 from ..core.regular_file import open_regular
 from . import action_adapter, playback, pose_underneath, rigify, vrm_map
 
-#: Pose-bone property keyed for each rotation mode (the Euler orders key rotation_euler).
-ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
-
-
-def rotation_path(mode):
-    return ROTATION_PATHS.get(mode, "rotation_euler")
-
 
 def rig_roles_of(obj, bone_map_path="", read_vrm=True):
     """(family name, {role: bone name}) of an armature: from the bone-map file when one is given, else

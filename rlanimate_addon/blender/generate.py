@@ -626,7 +626,7 @@ def _write(plan, agent, scene):
         "end": end, "settings": gestures.snapshot(settings), "under": made.under, "aimed_at": made.targets,
         "influence_before": influence_before, "animated": not request.still},
         memories, {(path, i) for path, i, *_ in memories[MAIN].curves if gestures.bone_of(path) in other})
-    placed = next(g for g in gestures.placed_gestures(obj) if g.action == action)
+    placed = gestures.find(obj, action.name)
     if request.taking is not None:  # plays until the later gesture on its arm takes over
         key_layers.trim(placed, request.taking.start, gesture.blend_ramp(request.taking.end - request.taking.start + 1))
     gestures.renamed(obj, request.before.id if request.before else "", action.name)

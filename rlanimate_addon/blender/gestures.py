@@ -28,7 +28,7 @@ from ..core import composition
 from ..core.behaviours import KNOWN_KINDS, TARGET
 from ..core.gesture import slerp
 from ..core.rotations import quat_multiply
-from . import action_adapter, armature_io, pose_underneath
+from . import action_adapter, fcurve_values
 
 #: The custom property of a gesture's main action that holds its record.
 RECORD = "rlanimate_gesture"
@@ -194,7 +194,7 @@ def detached(placed, view_layer):
         for bone, values in gesture.record.get("under", {}).items():
             pose_bone = gesture.obj.pose.bones.get(bone)
             if pose_bone is not None:
-                path = armature_io.rotation_path(pose_bone.rotation_mode)
+                path = action_adapter.rotation_path(pose_bone.rotation_mode)
                 standing.setdefault((pose_bone, path), tuple(getattr(pose_bone, path)))
                 setattr(pose_bone, path, list(values))
     view_layer.update()
@@ -239,7 +239,7 @@ def torso_layers(obj, values, frames, above=None):
         if not influence.any():
             continue
         keys = {}
-        for fcurve, row in zip(curves, pose_underneath.evaluate_fcurves(curves, frames), strict=True):
+        for fcurve, row in zip(curves, fcurve_values.evaluate_fcurves(curves, frames), strict=True):
             bone = bone_of(fcurve.data_path)
             keys.setdefault(bone, np.zeros_like(values[bone]))[:, fcurve.array_index] = row
         added = over if level is not None and tracks.index(layer.track) > level else below

@@ -10,7 +10,7 @@ import bpy
 import numpy as np
 
 from ..core import behaviours, easing, key_reduction
-from . import action_adapter, armature_io
+from . import action_adapter
 from .gestures import MAIN, RECORD, TORSO, TORSO_OF, Layer
 
 #: What a gesture's torso layer is called after its main one.
@@ -25,7 +25,7 @@ def key_action(target, start_frame, keys, memory=None, properties=None):
     action_adapter.KeyMemory)."""
     for bone, (mode, values, kept) in keys.items():
         frames = start_frame + np.arange(len(values))
-        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{armature_io.rotation_path(mode)}'
+        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{action_adapter.rotation_path(mode)}'
         tangents = None if kept is None else key_reduction.slopes(values)
         for channel in range(values.shape[1]):
             fcurve = target.new_fcurve(path, channel, bone)
@@ -47,7 +47,7 @@ def key_values(fcurves, start_frame, keys, memory, properties=None):
     for bone, (mode, rotation, kept) in keys.items():
         if kept is not None:
             return False
-        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{armature_io.rotation_path(mode)}'
+        path = f'pose.bones["{bpy.utils.escape_identifier(bone)}"].{action_adapter.rotation_path(mode)}'
         values.update({(path, channel): rotation[:, channel] for channel in range(rotation.shape[1])})
     values.update({(path, 0): np.asarray(series) for path, series in (properties or {}).items()})
     curves = {(f.data_path, f.array_index): f for f in fcurves}

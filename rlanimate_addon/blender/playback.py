@@ -14,8 +14,9 @@ import bpy
 import numpy as np
 import numpy.typing as npt
 
+from . import action_adapter
+
 Array = npt.NDArray[np.float64]
-_ROTATIONS = {"QUATERNION": ("rotation_quaternion", 4), "AXIS_ANGLE": ("rotation_axis_angle", 4)}
 
 
 def _targets_of(holder) -> list:
@@ -78,17 +79,13 @@ class Played:
         self.basis, self.pose, self.values, self.targets, self.properties = basis, pose, values, targets, properties
 
 
-def rotation_path(pose_bone) -> str:
-    return _ROTATIONS.get(pose_bone.rotation_mode, ("rotation_euler", 3))[0]
-
-
 def play(scene: bpy.types.Scene, obj: bpy.types.Object, names: Sequence[str], frames: Array, moving: bool,
          target: Callable[[], Array], properties: Sequence[tuple[str, str]] = ()) -> Played:
     """Played: the bones `names` of the armature, the target (`target()`, read at each frame) and the custom
     properties (bone, name) as Blender plays them at each frame (N,), each frame set once; when nothing moves,
     the first frame as it stands, broadcast. The caller restores the scene's frame."""
     pose_bones = [obj.pose.bones[name] for name in names]
-    paths = [rotation_path(pose_bone) for pose_bone in pose_bones]
+    paths = [action_adapter.rotation_path(pose_bone.rotation_mode) for pose_bone in pose_bones]
     basis: list = []
     pose: list = []
     targets: list = []

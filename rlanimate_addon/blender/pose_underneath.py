@@ -41,10 +41,6 @@ class _Unsupported(Exception):
     """Something of the rig's animation that only Blender evaluates exactly."""
 
 
-def rotation_path(mode: str) -> str:
-    return {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}.get(mode, "rotation_euler")
-
-
 def rotation_matrices(mode: str, values: Array) -> Array:
     """(N, 3, 3) rotations of (N, C) channel values in a bone's rotation mode."""
     if mode == "QUATERNION":
@@ -53,11 +49,6 @@ def rotation_matrices(mode: str, values: Array) -> Array:
         axis = values[:, 1:] / np.maximum(np.linalg.norm(values[:, 1:], axis=1, keepdims=True), 1e-12)
         return rotvec_to_matrix(axis * values[:, :1])
     return euler_to_matrix(values, mode)
-
-
-def evaluate_fcurves(fcurves: Sequence[Any], frames: ArrayLike) -> Array:
-    """(F, N) values of F-curves at frames (N,), as Blender evaluates them (blender/fcurve_values.py)."""
-    return fcurve_values.evaluate_fcurves(fcurves, frames)
 
 
 def sample(obj: Any, names: Sequence[str], frames: ArrayLike) -> tuple[Array, Array, dict[str, Array]] | None:
@@ -243,7 +234,7 @@ def _basis(pose_bone: Any, channels: dict[Channel, Array], count: int) -> Array 
     """(N, 4, 4) the bone's basis matrix from its channels' values (the animation's where keyed), or None when
     nothing keys it, or its keys hold it where it stands (as Blender last evaluated it)."""
     name = pose_bone.name
-    paths = ("location", "scale", rotation_path(pose_bone.rotation_mode))
+    paths = ("location", "scale", action_adapter.rotation_path(pose_bone.rotation_mode))
     own = {path: np.array(getattr(pose_bone, path), dtype=np.float64) for path in paths}
     if all((channels[name, path] == own[path]).all() for path in paths if (name, path) in channels):
         return None  # keyed to stand as it stands on every frame: Blender's own pose of it holds
@@ -326,7 +317,7 @@ def _outputs(obj: Any, names: list[str], channels: dict[Channel, Array], basis: 
     values, bases = {}, []
     for name in names:
         pose_bone = pose_bones[name]
-        path = rotation_path(pose_bone.rotation_mode)
+        path = action_adapter.rotation_path(pose_bone.rotation_mode)
         own = np.array(getattr(pose_bone, path), dtype=np.float64)
         values[name] = channels.get((name, path), np.broadcast_to(own, (count, len(own))))
         keyed = basis[name]
