@@ -9,7 +9,7 @@ rotation part of each 3 x 3 (polar decomposition) slerped, its stretch mixed).
 import numpy as np
 import numpy.typing as npt
 
-from .rotations import matrix_to_quat, quat_to_matrix
+from .rotations import matrix_to_quat, quat_to_matrix, rotation_part
 
 Array = npt.NDArray[np.float64]
 
@@ -32,7 +32,7 @@ def copy(kind: str, owner: Array, target: Array) -> Array:
         result[:, :3, 3] = target[:, :3, 3]
         return result
     # Copy Rotation: the target's rotation, normalized, at the owner's scale and location.
-    rotation = target[:, :3, :3] / np.linalg.norm(target[:, :3, :3], axis=1, keepdims=True)
+    rotation = rotation_part(target)
     result[:, :3, :3] = rotation * np.linalg.norm(owner[:, :3, :3], axis=1, keepdims=True)
     return result
 
@@ -40,7 +40,7 @@ def copy(kind: str, owner: Array, target: Array) -> Array:
 def unsupported(matrices: Array) -> bool:
     """Whether any (N, 4, 4) matrix mirrors (a determinant <= 0) or shears, which these constraints leave to
     Blender (its Copy Rotation reads a sheared target through Euler angles; interpolation flips a mirror)."""
-    rotation = matrices[:, :3, :3] / np.linalg.norm(matrices[:, :3, :3], axis=1, keepdims=True)
+    rotation = rotation_part(matrices)
     gram = np.swapaxes(rotation, -1, -2) @ rotation
     return bool((np.linalg.det(rotation) <= 0.0).any() or np.abs(gram - np.eye(3)).max() > _SHEAR)
 

@@ -75,12 +75,12 @@ def dependants(spans: list[Span], before: Span | None, after: Span | None) -> li
     ids = {s.id for s in changed}
     others = [s for s in spans if s.id not in ids]
     found = {}
+    moved = before is None or after is None or before.start != after.start
     for span in changed:
         for other in others:
             if not other.overlaps(span):
                 continue
             took_over = other.arm == span.arm and other.start < span.start and not (other.layered or span.layered)
-            moved = before is None or after is None or before.start != after.start
             if (other.target or other.arm == span.arm and not took_over or took_over and moved
                     or span.still and other.arm != span.arm):
                 found[other.id] = other

@@ -43,6 +43,7 @@ from .rotations import (
     quat_multiply,
     quat_to_matrix,
     quat_to_rotvec,
+    rotation_part,
     rotvec_to_matrix,
     rotvec_to_quat,
 )
@@ -528,13 +529,6 @@ def aim_rig(rig: "RigState", basis: Array, changed: Sequence[int], arm: str, tar
     return aimed
 
 
-def _rotation_part(matrices: Array) -> Array:
-    """(..., 3, 3) rotations of (..., 4, 4) matrices, scale removed."""
-    rotation = matrices[..., :3, :3]
-    unscaled: Array = rotation / np.linalg.norm(rotation, axis=-2, keepdims=True)
-    return unscaled
-
-
 def look_at(rig: "RigState", basis: Array, changed: Sequence[int], eye_bones: Sequence[str], to_character: Array,
             targets: Array, weights: ArrayLike) -> Array:
     """(N, E, 4) local quaternions turning each eye so it looks at targets (N, 3) by `weights` (N,).
@@ -548,14 +542,14 @@ def look_at(rig: "RigState", basis: Array, changed: Sequence[int], eye_bones: Se
     forward = to_character.T @ np.array([0.0, -1.0, 0.0])  # armature space
     rows = [rig.skeleton.index[bone] for bone in eye_bones]
     count, eyes = len(basis), len(rows)
-    world = _rotation_part(pose[:, rows])  # (N, E, 3, 3)
+    world = rotation_part(pose[:, rows])  # (N, E, 3, 3)
     resting = np.stack([rig.skeleton.rest_frame(bone).T @ forward for bone in eye_bones])  # (E, 3)
     looking = (world @ resting[:, :, None])[..., 0].reshape(-1, 3)  # (N E, 3)
     wanted = (targets[:, None] - pose[:, rows][..., :3, 3]).reshape(-1, 3)
     turn = aim.rotation_between(looking / np.linalg.norm(looking, axis=1, keepdims=True),
                                 wanted / np.linalg.norm(wanted, axis=1, keepdims=True)).reshape(count, eyes, 3, 3)
     turn = rotvec_to_matrix(matrix_to_rotvec(turn) * np.asarray(weights)[:, None, None])
-    return matrix_to_quat(_rotation_part(basis[:, rows]) @ np.swapaxes(world, -1, -2) @ turn @ world)
+    return matrix_to_quat(rotation_part(basis[:, rows]) @ np.swapaxes(world, -1, -2) @ turn @ world)
 
 
 def hips_relative_targets(rig: "RigState", targets: ArrayLike, count: int) -> Array:
@@ -591,10 +585,15 @@ def played_finger_base(canonical: Array, arm: str) -> Array:
 TORSO = rig_roles.SPINE + ("Neck", "Head")
 
 
+def _other_arm_prefix(arm: str) -> str:
+    """The role prefix of the arm other than `arm` ("Right" for "LEFT")."""
+    return skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
+
+
 def free_arm_columns(names: Sequence[str], arm: str) -> list[int]:
     """The columns of `names` (canonical roles) that are the joints of the arm other than `arm`, collar to index
     base."""
-    side = skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
+    side = _other_arm_prefix(arm)
     return [k for k, name in enumerate(names) if name in skeleton.ACTION_JOINTS and name.startswith(side)]
 
 
@@ -602,7 +601,7 @@ def owned_joints(arm: str, still: bool) -> tuple[str, ...]:
     """The action joints a gesture on `arm` keys: the spine, neck and head (a turn added to what plays
     underneath), its own arm, and, made as on a still rig, the other arm too (from its natural standing
     pose; on an animated rig the other arm is the animation's)."""
-    other = skeleton.ARM_PREFIX[skeleton.ARMS[1 - skeleton.ARMS.index(arm)]]
+    other = _other_arm_prefix(arm)
     return tuple(joint for joint in skeleton.ACTION_JOINTS if still or not joint.startswith(other))
 
 
@@ -633,7 +632,8 @@ def _played(request: "GestureRequest", rig: "RigState", canonical: Array,
     """(names of the roles keyed, (N, D, 4) the gesture's rotations of them on the rig, (D, 4) the standing
     pose, to_character): the owned action joints, then, for a `pointing` behaviour, the pointing hand shape."""
     names, canonical = fold_missing(canonical, list(skeleton.ACTION_JOINTS), rig.roles)
-    kept = [k for k, name in enumerate(names) if name in owned_joints(request.arm, rig.still)]
+    owned = owned_joints(request.arm, rig.still)
+    kept = [k for k, name in enumerate(names) if name in owned]
     names, canonical = [names[k] for k in kept], canonical[:, kept]
     joints = len(names)
     if pointing:  # one hand shape, held on every frame
@@ -769,7 +769,7 @@ def _aimed(rig: "RigState", request: "GestureRequest", names: list[str], columns
     if request.exact_aim and blended.aims:
         arm_column = names.index(skeleton.ARM_PREFIX[request.arm] + "Arm")
         aimed = aim_rig(rig, basis, columns, request.arm, targets, phase)
-        keyed[:, arm_column] = matrix_to_quat(_rotation_part(aimed))
+        keyed[:, arm_column] = matrix_to_quat(rotation_part(aimed))
         basis[:, columns[arm_column]] = aimed
     eyes = [role for role in ("LeftEye", "RightEye") if role in rig.roles]
     if not eyes:

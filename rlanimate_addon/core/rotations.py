@@ -210,3 +210,10 @@ def quat_to_axis_angle(quat: ArrayLike) -> npt.NDArray[np.float64]:
     angle = 2.0 * np.arctan2(sin_half, q[..., 0])
     axis = np.where(sin_half[..., None] > _SMALL, q[..., 1:] / np.maximum(sin_half, _SMALL)[..., None], [0.0, 1.0, 0.0])
     return np.concatenate([angle[..., None], axis], axis=-1)
+
+
+def rotation_part(matrices: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """(..., 3, 3) rotations of (..., 4, 4) matrices, scale removed."""
+    rotation = matrices[..., :3, :3]
+    unscaled: npt.NDArray[np.float64] = rotation / np.linalg.norm(rotation, axis=-2, keepdims=True)
+    return unscaled
