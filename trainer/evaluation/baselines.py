@@ -69,10 +69,10 @@ class NearestClip:
         self.clips = list(clips)
         self._tempos = {}  # {id(clip): its tempo (Hz) or None (tempo_reading)}, read when a request first names one
 
-    def nearest(self, behaviour, arm, attributes, tempo=None):
+    def nearest(self, behaviour, arm, attributes, tempo=None, exclude=None):
         """The training clip of `behaviour` and `arm` whose label (and tempo, Hz, when given) is closest to
-        the request's."""
-        candidates = clips_of(self.clips, behaviour, arm, "nearest-clip")
+        the request's; never the clip `exclude` (leave-one-out: the take a request was read from)."""
+        candidates = [c for c in clips_of(self.clips, behaviour, arm, "nearest-clip") if c is not exclude]
         kind = candidates[0].behaviour_kind
         if tempo is not None:
             return self._nearest_in_tempo(candidates, float(np.ravel(attributes)[0]), float(tempo))
@@ -102,9 +102,9 @@ class NearestClip:
             return float(np.arccos(np.clip(cos, -1.0, 1.0)))
         return abs(float(np.ravel(a)[0]) - float(np.ravel(b)[0]))
 
-    def generate(self, behaviour, arm, attributes, frame_count, tempo=None):
+    def generate(self, behaviour, arm, attributes, frame_count, tempo=None, exclude=None):
         spaces.check_arm_and_length(arm, frame_count)
-        return time_warp(self.nearest(behaviour, arm, attributes, tempo).rotvecs, frame_count)
+        return time_warp(self.nearest(behaviour, arm, attributes, tempo, exclude).rotvecs, frame_count)
 
 
 class NoMotion:

@@ -21,6 +21,7 @@ from trainer.scripts import (
     experiments,
     realmocap,
     realmocap_ablation,
+    realmocap_ceiling,
     realmocap_gestures,
     realmocap_length,
     realmocap_model,
@@ -34,6 +35,7 @@ SCRIPTS = ((agent_ablation, agent_ablation.AblationSettings), (baselines, baseli
            (clip_library, clip_library.LibrarySettings), (contact_sheet, contact_sheet.SheetSettings),
            (experiments, experiments.PaperSettings), (realmocap, realmocap.RealMocapSettings),
            (realmocap_ablation, realmocap_ablation.AblationSettings),
+           (realmocap_ceiling, realmocap_ceiling.CeilingSettings),
            (realmocap_gestures, realmocap_gestures.GestureSettings),
            (realmocap_length, realmocap_length.LengthSettings),
            (realmocap_model, realmocap_model.ModelSettings), (train, train.TrainSettings))
