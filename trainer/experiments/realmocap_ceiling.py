@@ -7,13 +7,15 @@ it trains them and reused from its runs) are asked for takes they were trained o
 (TRAINED_TAKES), each request as the tests make it (REQUESTS: the label, then the take's tempo too), and retrieval
 answers from the other training takes (leave one out: never the take asked for). If the agent trails retrieval
 even on takes it has seen, what holds it back is not new takes but what it makes of a request. Beside it, the same
-agents and retrieval from every training take on the test takes 009-010.
+agents and retrieval from every training take on the test takes 009-010. Draws FIGURE: the hand paths of the
+trained takes of the styles where the first seed's agent trails retrieval most.
 """
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from rlanimate_addon.core import behaviours, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent.config import PRESETS
 from trainer.evaluation import baselines, scoring
@@ -31,9 +33,12 @@ from trainer.motion.clip import MotionClip
 from trainer.motion.fk import ClipReferences
 from trainer.motion.realmocap_takes import wave_split
 from trainer.reporting.paired import paired_gap
+from trainer.reporting.plots import wave_hand_paths
 
 #: The training takes the agents are asked for: the two before the test takes, every style and arm (28).
 TRAINED_TAKES = ("007", "008")
+#: The hand-path figure, in the results folder, and how many styles it shows.
+FIGURE, FIGURE_STYLES = "realmocap_ceiling_paths.png", 3
 
 
 @dataclass(frozen=True)
@@ -81,8 +86,37 @@ def run_ceiling(settings: CeilingSettings) -> dict:
                    for seed, agent in agents.items()}
         sets[name + suffix] = {"takes": len(clips), "agents": by_seed, "retrieval": retrieval,
                                "gaps": paired_gaps(by_seed, retrieval)}
+    first = agents[settings.seeds[0]]
+    wave_hand_paths(path_panels(first, train, trained, trailing_styles(sets["trained_tempo"]), env, references),
+                    Path(settings.results) / FIGURE)
     return {"command": command_line(settings), "epochs": settings.epochs, "preset": settings.preset,
-            "seeds": list(settings.seeds), "train_takes": len(train), "sets": sets}
+            "seeds": list(settings.seeds), "train_takes": len(train), "sets": sets, "figure": FIGURE}
+
+
+def trailing_styles(entry: dict) -> list[str]:
+    """The FIGURE_STYLES styles of a set's entry where the first seed's agent trails retrieval most on DTW."""
+    agent = next(iter(entry["agents"].values()))["by_style"]
+    retrieval = entry["retrieval"]["by_style"]
+    gaps = {style: retrieval[style]["aligned_score"] - agent[style]["aligned_score"] for style in retrieval}
+    return sorted(gaps, key=gaps.__getitem__, reverse=True)[:FIGURE_STYLES]
+
+
+def path_panels(agent: baselines.AgentMethod, train: list[MotionClip], trained: list[MotionClip], styles: list[str],
+                env, references) -> list:
+    """plots.wave_hand_paths panels: per style, its first right-arm trained take, then the agent's answer and
+    leave-one-out retrieval's, both asked the take's tempo."""
+    panels = []
+    for style in styles:
+        clip = next(c for c in trained if c.style == style and c.arm == "RIGHT")
+        tempo = baselines.request_tempo(clip, True)
+        answers = {"RLAnimate (trained on this take)": agent.generate(behaviours.WAVE, clip.arm, clip.attributes,
+                                                                      len(clip.rotvecs), tempo=tempo),
+                   "retrieval (another take)": leave_one_out(train, [clip], with_tempo=True)[0]}
+        panels.append((f"{style} {clip.take} right (e = {clip.exaggeration:.2f}), tempo asked", "RIGHT",
+                       {"real take": spaces.description_joint_positions(references.get(clip)[0]),
+                        **{label: spaces.description_joint_positions(env.evaluate(motion).descriptions)
+                           for label, motion in answers.items()}}))
+    return panels
 
 
 def paired_gaps(by_seed: dict, retrieval: dict) -> dict:

@@ -64,4 +64,8 @@ def ceiling_markdown(results):
                          "worst style's last-frame error (deg): RLAnimate / retrieval"], ceiling_rows(results)),
         "", "## DTW score per style, tempo asked", "",
         *markdown_table(["style", "trained takes: RLAnimate", "retrieval (the other takes)", "test takes: RLAnimate",
-                         "retrieval"], style_rows(results)), ""])
+                         "retrieval"], style_rows(results)),
+        "", "## Hand paths, trained takes", "",
+        "The right wrist relative to the shoulder in the styles where the first seed's agent trails retrieval most: "
+        "the real take (black), the agent trained on it and retrieval from the other takes, both asked its tempo.",
+        "", f"![hand paths of trained takes]({results['figure']})", ""])

@@ -5,7 +5,7 @@ import pytest
 
 from rlanimate_addon.core.errors import RLAnimateError
 from tests.trainer.synthetic_library import make_clip
-from trainer.experiments.realmocap_ceiling import CeilingSettings, leave_one_out, paired_gaps
+from trainer.experiments.realmocap_ceiling import CeilingSettings, leave_one_out, paired_gaps, trailing_styles
 from trainer.reporting.realmocap_ceiling_report import ceiling_markdown, ceiling_rows
 
 
@@ -38,11 +38,21 @@ def test_the_page_sets_the_trained_takes_beside_the_test_takes():
     retrieval = _summary(81.0, 95.0, [0.0, 2.0])
     entry = {"takes": 2, "agents": agents, "retrieval": retrieval, "gaps": paired_gaps(agents, retrieval)}
     results = {"command": "nice ...", "epochs": 100, "preset": "end_chunks", "seeds": [0, 1], "train_takes": 249,
+               "figure": "paths.png",
                "sets": {name: entry for name in ("trained", "trained_tempo", "test", "test_tempo")}}
     rows = ceiling_rows(results)
     assert len(rows) == 4 and rows[0][0].startswith("takes 007-008, trained on") and rows[2][0].startswith("takes 009")
     assert rows[1][2:6] == ["81.0 ± 1.4 / 91.0 ± 1.4", "81.0 / 95.0", "+0.0 (+0.0 to +0.0)", "-4.0 (-4.0 to -4.0)"]
-    assert "| normal | 91.0 | 95.0 | 91.0 | 95.0 |" in ceiling_markdown(results)
+    page = ceiling_markdown(results)
+    assert "| normal | 91.0 | 95.0 | 91.0 | 95.0 |" in page and "](paths.png)" in page
+
+
+def test_the_figure_shows_the_styles_where_the_agent_trails_most():
+    agent, retrieval = _summary(80.0, 90.0, [0.0]), _summary(81.0, 95.0, [0.0])
+    agent["by_style"] = {"active": {"aligned_score": 99.0}, "masculine": {"aligned_score": 80.0},
+                         "normal": {"aligned_score": 90.0}, "youthful": {"aligned_score": 85.0}}
+    retrieval["by_style"] = {style: {"aligned_score": 98.0} for style in agent["by_style"]}
+    assert trailing_styles({"agents": {"0": agent}, "retrieval": retrieval}) == ["masculine", "youthful", "normal"]
 
 
 def test_an_unknown_preset_is_refused_before_any_training():
