@@ -104,11 +104,12 @@ def gru_shapes(name: str, inputs: int, size: int, suffix: str = "") -> dict[str,
 
 def task_width(agent_config: Mapping[str, Any], variant: str, objective_size: int) -> int:
     """How wide the task input of f2 and the heads is: the task state, with the wave's phase features beside it
-    for an agent with `phase_input` (rhythm.PHASE_FEATURES), or the objective itself without a task state."""
+    for an agent with `phase_input` (rhythm.PHASE_FEATURES) and its swing rate with `tempo_input` (1), or the
+    objective itself without a task state."""
     if not uses_task_state(variant):
         return objective_size
     width: int = agent_config["task_size"] + (rhythm.PHASE_FEATURES if agent_config.get("phase_input", False) else 0)
-    return width
+    return width + (1 if agent_config.get("tempo_input", False) else 0)
 
 
 def expected_weight_shapes(agent_config: Mapping[str, Any], variant: str, objective_size: int) -> dict[str, Shape]:
@@ -416,9 +417,12 @@ def _check_metadata_values(path: Path, metadata: dict[str, Any]) -> dict[str, Sh
         raise RLAnimateError(f"The agent file {path} has an invalid agent_config (widths 1-{MAX_SIZE}, "
                              f"hidden_layers 1-{MAX_HIDDEN_LAYERS}, {', '.join(_AGENT_SCALARS)} positive and "
                              f"at most {MAX_CONFIG_SCALAR:g}): re-export it with trainer/agent/agent_export.py.")
-    if not isinstance(config.get("phase_input", False), bool):
-        raise RLAnimateError(f"The agent file {path} has an invalid agent_config phase_input (true or false): "
-                             f"re-export it with trainer/agent/agent_export.py.")
+    if not all(isinstance(config.get(flag, False), bool) for flag in ("phase_input", "tempo_input")):
+        raise RLAnimateError(f"The agent file {path} has an invalid agent_config phase_input or tempo_input (true or "
+                             f"false): re-export it with trainer/agent/agent_export.py.")
+    if config.get("tempo_input", False) and not config.get("phase_input", False):
+        raise RLAnimateError(f"The agent file {path} gives tempo_input without phase_input, beside which the tempo "
+                             f"sits: re-export it with trainer/agent/agent_export.py.")
     if config.get("phase_input", False) and not uses_task_state(metadata["variant"]):
         raise RLAnimateError(f"The agent file {path} gives phase_input to a {metadata['variant']} agent, which has "
                              f"no task state to give it beside: re-export it with trainer/agent/agent_export.py.")

@@ -215,6 +215,27 @@ def phase_features(signals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
     return np.stack([sine, cosine, 2.0 * sine * cosine / amplitude, (cosine ** 2 - sine ** 2) / amplitude], axis=-1)
 
 
+#: Below this product of two frames' swing amplitudes the hand does not swing between them (`swing_rate`).
+STILL_PRODUCT = 1e-24
+
+
+def swing_rate(signals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """(..., T, 1) the swing's phase advance per frame (radians: 2 pi x the tempo in cycles a frame) of rhythm signals
+    (..., T, 2), read from each frame and the next (from the one before at the last frame, or where the next is
+    still), 0 where the hand does not swing: the tempo an agent with AgentConfig.tempo_input sees beside the phase
+    (the trainer's torch model computes the same)."""
+    sine, cosine = signals[..., 0], signals[..., 1]
+    real = cosine[..., 1:] * cosine[..., :-1] + sine[..., 1:] * sine[..., :-1]  # (..., T - 1): z_{t+1} conj(z_t)
+    imaginary = sine[..., 1:] * cosine[..., :-1] - cosine[..., 1:] * sine[..., :-1]
+    swinging = real ** 2 + imaginary ** 2 > STILL_PRODUCT
+    advance = np.where(swinging, np.arctan2(imaginary, real), 0.0)
+    none, still = np.zeros(advance.shape[:-1] + (1,)), np.zeros(swinging.shape[:-1] + (1,), bool)
+    ahead, ahead_swings = np.concatenate([advance, none], -1), np.concatenate([swinging, still], -1)
+    behind, behind_swings = np.concatenate([none, advance], -1), np.concatenate([still, swinging], -1)
+    rate: npt.NDArray[np.float64] = np.where(ahead_swings, ahead, np.where(behind_swings, behind, 0.0))
+    return rate[..., None]
+
+
 #: Cycles per frame: the slowest rate a tempo's logarithm is taken of.
 _SLOWEST = 1e-6
 

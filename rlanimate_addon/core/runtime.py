@@ -157,6 +157,7 @@ class GestureAgent:
         self._uses_portrayal = agent_file.uses_portrayal(self.variant)
         self._uses_task_state = agent_file.uses_task_state(self.variant)
         self._phase_input = bool(config.get("phase_input", False))
+        self._tempo_input = bool(config.get("tempo_input", False))
         task_size = agent_file.task_width(config, self.variant, self.space.size)
         if self._uses_portrayal:
             self._portrayal = _mlp_arrays(w, "portrayal", layers)
@@ -227,11 +228,13 @@ class GestureAgent:
 
     def _task(self, objectives: Array) -> Array:
         """(N, K) what f2 and the heads see of the task: the task state (with the wave's phase features beside it,
-        rhythm.phase_features, for a phase-input agent), or the objectives without a task state."""
+        spaces.phase_features, for a phase-input agent), or the objectives without a task state."""
         if not self._uses_task_state:
             return objectives
         task = _gru_sequence(objectives, self._task_rnn)
-        return np.hstack([task, self.space.phase_features(objectives)]) if self._phase_input else task
+        if not self._phase_input:
+            return task
+        return np.hstack([task, self.space.phase_features(objectives, self._tempo_input)])
 
     def _step_inputs(self, objectives: Array) -> tuple[Array, Array, Array]:
         """(cell (N, 3E), belief (N, hidden), animation (N, hidden)): what each step's GRU cell, belief MLP and

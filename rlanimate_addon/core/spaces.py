@@ -138,14 +138,18 @@ class ObjectiveSpace:
         masks = [self.label_mask(objectives, name) for name in self.of_kind(kind)]
         return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
 
-    def phase_features(self, objectives: ArrayLike) -> npt.NDArray[np.float64]:
-        """(..., rhythm.PHASE_FEATURES) of objectives (..., L + 6): an oscillating behaviour's rhythm signals and
-        their second harmonic (rhythm.phase_features); zeros for another behaviour's objectives."""
+    def phase_features(self, objectives: ArrayLike, tempo: bool = False) -> npt.NDArray[np.float64]:
+        """(..., T, rhythm.PHASE_FEATURES (+ 1 with `tempo`)) of objectives (..., T, L + 6): an oscillating
+        behaviour's rhythm signals and their second harmonic (rhythm.phase_features), then with `tempo` its swing
+        rate (rhythm.swing_rate); zeros for another behaviour's objectives."""
         objectives = np.asarray(objectives, dtype=np.float64)
         wave: npt.NDArray[np.bool_] = np.zeros(objectives.shape[:-1], bool)
         for name in self.oscillating():
             wave |= self.label_mask(objectives, name)
-        features: npt.NDArray[np.float64] = rhythm.phase_features(objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:])
+        signals = objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:]
+        features: npt.NDArray[np.float64] = rhythm.phase_features(signals)
+        if tempo:
+            features = np.concatenate([features, rhythm.swing_rate(signals)], -1)
         return features * wave[..., None]
 
     def behaviours_in(self, objectives: ArrayLike) -> set[str]:

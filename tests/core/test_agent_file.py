@@ -364,6 +364,15 @@ def test_agent_config_values_out_of_range_are_refused_at_once(tmp_path, exported
     assert time.perf_counter() - start < 0.5
 
 
+@pytest.mark.parametrize("flags, message", [({"tempo_input": "yes"}, "invalid agent_config phase_input or tempo_input"),
+                                            ({"tempo_input": True}, "tempo_input without phase_input")])
+def test_a_tempo_input_needs_the_phase_input_beside_it(tmp_path, exported, flags, message):
+    weights, metadata = load_agent_file(exported)
+    metadata["agent_config"].update(flags)
+    with pytest.raises(RLAnimateError, match=message):
+        load_agent_file(rewrite(tmp_path / "tempo.npz", weights, metadata))
+
+
 def test_an_agent_too_large_to_run_is_refused(tmp_path, exported):
     weights, metadata = load_agent_file(exported)
     metadata["agent_config"].update(hidden_size=4096, hidden_layers=16)

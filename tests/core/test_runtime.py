@@ -83,6 +83,31 @@ def test_a_phase_input_agent_plays_as_torch_with_the_waves_phase_beside_its_task
         RLAnimateAgent(config, "single_state")
 
 
+@pytest.mark.parametrize("variant", ["rlanimate", "supervised"])
+def test_a_tempo_input_agent_plays_as_torch_with_the_swing_rate_beside_the_phase(tmp_path, variant):
+    """With tempo_input the wave's swing rate (rhythm.swing_rate: 2 pi x its cycles a frame while the hand swings,
+    0 before and after) is a fifth phase feature: the runtime plays torch's rollout, and tempo_input alone is
+    refused."""
+    torch.manual_seed(4)
+    config = replace(load_preset("default")[0], phase_input=True, tempo_input=True)
+    agent = RLAnimateAgent(config, variant)
+    runtime = load_agent(_exported(agent, tmp_path / "tempo.npz", 2.0))
+    assert agent.behaviour_cell.weight_ih.shape[1] == config.task_size + 5 + config.stochastic_size + 45
+    for objectives in objectives_for_tests():
+        assert np.abs(runtime.rollout(objectives) - torch_rollout(agent, objectives)).max() < 1e-5
+    swinging = objectives_for_tests()[2]
+    drawn = RHYTHM.draw(0.3, 4)
+    rate = spaces.PAPER_SPACE.phase_features(swinging, tempo=True)[:, 4]
+    signals = rhythm.signals(drawn, len(swinging))
+    moving = np.hypot(signals[:, 0], signals[:, 1]) > 0
+    assert np.allclose(rate[moving], 2 * np.pi * drawn.frequency) and not rate[~moving].any()
+    assert moving.sum() < len(moving), "the rhythm starts and ends still"
+    torch_rate = agent.phase_features(torch.as_tensor(swinging, dtype=torch.float32)[None])[0, :, 4].numpy()
+    assert np.allclose(torch_rate, rate, atol=1e-5)
+    with pytest.raises(RLAnimateError, match="tempo_input needs phase_input"):
+        RLAnimateAgent(replace(config, phase_input=False), variant)
+
+
 @pytest.mark.parametrize("variant", VARIANTS)
 def test_in_float64_the_rollout_is_torchs_to_rounding(tmp_path, variant):
     """The in-place per-frame loop (joined weights, halved gates, scratch arrays) computes torch's equations:

@@ -17,11 +17,13 @@
              the default with a fifth of the chunks ending at the gesture's last frame, where the arm
              comes down (trainer/agent/buffer.py), and that with every state and hidden layer twice as
              wide (real capture: docs/results/realmocap.md, realmocap_ablation.md);
-    end_chunks_long, end_chunks_smooth, end_chunks_phase, end_chunks_phase_smooth
+    end_chunks_long, end_chunks_smooth, end_chunks_phase, end_chunks_phase_smooth, end_chunks_tempo_smooth
              end_chunks with chunks of 64 frames (half as many, the same frames an update), so that a
              slow real wave's whole cycle lies in one chunk; or with the pose-velocity term; or with the
              wave's phase and its second harmonic beside the task state, as phase-conditioned motion models
-             give it; or with both of the last two (real capture's model search: docs/results/realmocap_model.md).
+             give it; or with both of the last two; or with those and the wave's swing rate (its tempo) beside
+             the phase, as phase-conditioned models give the frequency (real capture's model search:
+             docs/results/realmocap_model.md).
 Loss terms and their scales are documented in trainer/agent/losses.py and docs/AGENT.md.
 """
 from dataclasses import asdict, dataclass, fields, replace
@@ -42,12 +44,15 @@ class AgentConfig:
     concentration_floor: float = 1.0  # floor of the Beta's alpha and beta (>= 1: unimodal)
     concentration_scale: float = 100.0  # alpha, beta = floor + scale * softplus(output)
     phase_input: bool = False  # f2 and the heads also see the wave's phase and its harmonic (rhythm.phase_features)
+    tempo_input: bool = False  # ... and its swing rate (rhythm.swing_rate); needs phase_input
 
     def to_dict(self):
-        """The fields as a dict; phase_input only when on, so that an agent without it is written as before."""
+        """The fields as a dict; phase_input and tempo_input only when on, so that an agent without them is written
+        as before."""
         values = asdict(self)
-        if not self.phase_input:
-            del values["phase_input"]
+        for flag in ("phase_input", "tempo_input"):
+            if not values[flag]:
+                del values[flag]
         return values
 
     @classmethod
@@ -130,6 +135,8 @@ PRESETS = {
     "end_chunks_smooth": (AgentConfig(), replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
     "end_chunks_phase": (AgentConfig(phase_input=True), replace(_DEFAULT_TRAIN, last_frame_share=0.2)),
     "end_chunks_phase_smooth": (AgentConfig(phase_input=True),
+                                replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
+    "end_chunks_tempo_smooth": (AgentConfig(phase_input=True, tempo_input=True),
                                 replace(_DEFAULT_TRAIN, last_frame_share=0.2, velocity_scale=500.0)),
     "paper": (
         AgentConfig(task_size=200, behaviour_size=200, stochastic_size=30, hidden_size=200,

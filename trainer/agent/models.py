@@ -32,7 +32,7 @@ import torch.nn.functional as F
 from torch import nn
 from torch.distributions import Beta, Independent, Normal
 
-from rlanimate_addon.core import agent_file, spaces
+from rlanimate_addon.core import agent_file, rhythm, spaces
 from rlanimate_addon.core.errors import RLAnimateError
 from trainer.agent import losses as loss_terms
 from trainer.agent import unroll
@@ -44,6 +44,19 @@ def gaussian(mean, std):
     """Diagonal Gaussian over the last axis. Its arguments are not validated: the per-frame checks
     cost about 5% of an update step, and softplus + min_std keeps the sd positive."""
     return Independent(Normal(mean, std, validate_args=False), 1, validate_args=False)
+
+
+def swing_rate(sine, cosine):
+    """(B, T) A sin, A cos -> (B, T, 1): the swing's phase advance per frame (core.rhythm.swing_rate, in torch)."""
+    real = cosine[..., 1:] * cosine[..., :-1] + sine[..., 1:] * sine[..., :-1]  # (B, T - 1): z_{t+1} conj(z_t)
+    imaginary = sine[..., 1:] * cosine[..., :-1] - cosine[..., 1:] * sine[..., :-1]
+    swinging = real ** 2 + imaginary ** 2 > rhythm.STILL_PRODUCT
+    advance = torch.where(swinging, torch.atan2(imaginary, real), torch.zeros_like(real))
+    none = sine.new_zeros(sine.shape[:-1] + (1,))
+    still = none.bool()
+    ahead, ahead_swings = torch.cat([advance, none], -1), torch.cat([swinging, still], -1)
+    behind, behind_swings = torch.cat([none, advance], -1), torch.cat([still, swinging], -1)
+    return torch.where(ahead_swings, ahead, torch.where(behind_swings, behind, none))[..., None]
 
 
 class MLP(nn.Module):
@@ -83,6 +96,8 @@ class RLAnimateAgent(nn.Module):
         if c.phase_input and not self.uses_task_state:
             raise RLAnimateError(f"phase_input needs a task state to give the phase beside: the {variant} variant "
                                  "has none.")
+        if c.tempo_input and not c.phase_input:
+            raise RLAnimateError("tempo_input needs phase_input: the tempo sits beside the phase.")
         task = agent_file.task_width(c.to_dict(), variant, O)
         head_inputs = (task if self.uses_task_state else 0) + E + Z
         self.behaviour_cell = nn.GRUCell(task + Z + A, E)
@@ -105,13 +120,15 @@ class RLAnimateAgent(nn.Module):
         return torch.cat([states, self.phase_features(objectives)], -1) if self.config.phase_input else states
 
     def phase_features(self, objectives):
-        """(B, T, O) -> (B, T, 4): an oscillating behaviour's phase and second harmonic, zeros for other behaviours
-        (core.spaces.ObjectiveSpace.phase_features, in torch)."""
+        """(B, T, O) -> (B, T, 4, or 5 with tempo_input): an oscillating behaviour's phase and second harmonic, then
+        its swing rate, zeros for other behaviours (core.spaces.ObjectiveSpace.phase_features, in torch)."""
         signals = objectives[..., spaces.OBJECTIVE_ATTRIBUTES][..., 1:]  # (B, T, 2) A sin, A cos
         sine, cosine = signals.unbind(-1)
         amplitude = torch.clamp(torch.hypot(sine, cosine), min=1e-9)
         features = torch.stack([sine, cosine, 2.0 * sine * cosine / amplitude,
                                 (cosine ** 2 - sine ** 2) / amplitude], -1)
+        if self.config.tempo_input:
+            features = torch.cat([features, swing_rate(sine, cosine)], -1)
         if not self.space.oscillating():
             return torch.zeros_like(features)
         waving = torch.zeros_like(features[..., :1], dtype=torch.bool)
