@@ -20,7 +20,7 @@ Action a_t (45): the local rotations of skeleton.ACTION_JOINTS, 3 numbers each, 
 The character frame is the armature's object space with its scale removed: +X the character's left,
 -Y forward, +Z up, origin on the ground between the feet.
 """
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -83,7 +83,6 @@ class ObjectiveSpace:
         if len(set(self.names)) != len(self.names):
             raise RLAnimateError(f"The behaviours {', '.join(self.names)} name one behaviour twice.")
         self._declared = {b.name: b for b in self.behaviours}
-        self._kinds = {b.name: b.kind for b in self.behaviours}
         count = len(self.behaviours)
         #: (N, L) each behaviour's label: Table 2's type code for at most two behaviours, else one-hot.
         self.labels: npt.NDArray[np.float64] = np.arange(1.0, count + 1.0)[:, None] if count <= 2 else np.eye(count)
@@ -101,8 +100,7 @@ class ObjectiveSpace:
 
     def kind(self, behaviour: str) -> str:
         """The kind (behaviours.TARGET or INTENSITY) of the behaviour id `behaviour`."""
-        self.check_behaviour(behaviour)
-        return self._kinds[behaviour]
+        return self.behaviour(behaviour).kind
 
     def behaviour(self, behaviour: str) -> Behaviour:
         """The declaration (kind, and what it does) of the behaviour id `behaviour`."""
@@ -111,14 +109,14 @@ class ObjectiveSpace:
 
     def of_kind(self, kind: str) -> tuple[str, ...]:
         """The ids of the behaviours of `kind`, in objective order."""
-        return tuple(name for name in self.names if self._kinds[name] == kind)
+        return tuple(b.name for b in self.behaviours if b.kind == kind)
 
     def oscillating(self) -> tuple[str, ...]:
         """The ids of the behaviours that oscillate (carry a rhythm), in objective order."""
         return tuple(b.name for b in self.behaviours if b.oscillates)
 
     def check_behaviour(self, behaviour: str) -> None:
-        if behaviour not in self._kinds:
+        if behaviour not in self._declared:
             raise RLAnimateError(f"Unknown behaviour {behaviour!r}: use one of {', '.join(self.names)}.")
 
     def check_request(self, behaviour: str, arm: str, frame_count: int) -> None:
@@ -135,7 +133,11 @@ class ObjectiveSpace:
 
     def kind_mask(self, objectives: ArrayLike, kind: str) -> npt.NDArray[np.bool_]:
         """(...,) bool: which objectives (..., L + 6) belong to a behaviour of `kind`."""
-        masks = [self.label_mask(objectives, name) for name in self.of_kind(kind)]
+        return self._labels_mask(objectives, self.of_kind(kind))
+
+    def _labels_mask(self, objectives: ArrayLike, names: Sequence[str]) -> npt.NDArray[np.bool_]:
+        """(...,) bool: which objectives (..., L + 6) carry the label of one of the behaviours `names`."""
+        masks = [self.label_mask(objectives, name) for name in names]
         return np.any(masks, axis=0) if masks else np.zeros(np.shape(objectives)[:-1], dtype=bool)
 
     def phase_features(self, objectives: ArrayLike, tempo: bool = False) -> npt.NDArray[np.float64]:
@@ -143,9 +145,7 @@ class ObjectiveSpace:
         behaviour's rhythm signals and their second harmonic (rhythm.phase_features), then with `tempo` its swing
         rate (rhythm.swing_rate); zeros for another behaviour's objectives."""
         objectives = np.asarray(objectives, dtype=np.float64)
-        wave: npt.NDArray[np.bool_] = np.zeros(objectives.shape[:-1], bool)
-        for name in self.oscillating():
-            wave |= self.label_mask(objectives, name)
+        wave = self._labels_mask(objectives, self.oscillating())
         signals = objectives[..., OBJECTIVE_ATTRIBUTES][..., 1:]
         features: npt.NDArray[np.float64] = rhythm.phase_features(signals)
         if tempo:
@@ -172,7 +172,7 @@ class ObjectiveSpace:
         self.check_request(behaviour, arm, frame_count)
         n = int(frame_count)
         attrs = np.asarray(attributes, dtype=np.float64)
-        if self._kinds[behaviour] == TARGET:
+        if self._declared[behaviour].kind == TARGET:
             attrs = np.broadcast_to(attrs, (n, 3))
             norms = np.linalg.norm(attrs, axis=1, keepdims=True)
             if not np.all(np.isfinite(attrs)) or np.any(norms < 1e-9):

@@ -59,9 +59,10 @@ def epoch_updates(config: "TrainConfig", behaviour_count: int) -> tuple[int, int
     `update_steps` and `chunk_count`; for more, its `update_steps_many` and `chunk_count_many` where given,
     else those and chunks_per_update (docs/TRAINING.md, "The default preset")."""
     steps, chunks = config.update_steps, chunks_per_update(config.chunk_count, behaviour_count)
-    if behaviour_count > 2:
-        steps = config.update_steps if config.update_steps_many is None else config.update_steps_many
-        chunks = chunks if config.chunk_count_many is None else config.chunk_count_many
+    if behaviour_count > 2 and config.update_steps_many is not None:
+        steps = config.update_steps_many
+    if behaviour_count > 2 and config.chunk_count_many is not None:
+        chunks = config.chunk_count_many
     return steps, chunks
 
 

@@ -129,8 +129,6 @@ class RLAnimateAgent(nn.Module):
                                 (cosine ** 2 - sine ** 2) / amplitude], -1)
         if self.config.tempo_input:
             features = torch.cat([features, swing_rate(sine, cosine)], -1)
-        if not self.space.oscillating():
-            return torch.zeros_like(features)
         waving = torch.zeros_like(features[..., :1], dtype=torch.bool)
         for name in self.space.oscillating():
             label = objectives.new_tensor(self.space.labels[self.space.names.index(name)])

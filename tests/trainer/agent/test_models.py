@@ -138,7 +138,7 @@ def test_presets_and_config_round_trip():
     assert set(PRESETS) == {"debug", "default", "paper", "paper_wave_objective", "reference_posterior",
                             "no_random_targets", "no_pointing_term", "velocity_term", "weight_average", "no_wrist_term",
                             "end_chunks", "end_chunks_wide", "end_chunks_long", "end_chunks_smooth",
-                            "end_chunks_phase", "end_chunks_phase_smooth"}
+                            "end_chunks_phase", "end_chunks_phase_smooth", "end_chunks_tempo_smooth"}
     for name in PRESETS:
         agent_config, train_config = load_preset(name)
         assert AgentConfig.from_dict(agent_config.to_dict()) == agent_config
