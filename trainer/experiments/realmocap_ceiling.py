@@ -87,6 +87,7 @@ def run_ceiling(settings: CeilingSettings) -> dict:
         sets[name + suffix] = {"takes": len(clips), "agents": by_seed, "retrieval": retrieval,
                                "gaps": paired_gaps(by_seed, retrieval)}
     first = agents[settings.seeds[0]]
+    Path(settings.results).mkdir(parents=True, exist_ok=True)
     wave_hand_paths(path_panels(first, train, trained, trailing_styles(sets["trained_tempo"]), env, references),
                     Path(settings.results) / FIGURE)
     return {"command": command_line(settings), "epochs": settings.epochs, "preset": settings.preset,
