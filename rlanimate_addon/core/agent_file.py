@@ -407,9 +407,8 @@ def _describe(number: float) -> str:
     return f"{number:.3g}" if isinstance(number, float) or abs(number) < 10 ** 15 else f"about 1e{len(str(number)) - 1}"
 
 
-def _check_metadata_values(path: Path, metadata: dict[str, Any]) -> dict[str, Shape]:
-    """Every metadata value the add-on uses, checked for type and range; returns the expected weight shapes."""
-    config = metadata["agent_config"]
+def _check_agent_config(path: Path, config: Any, variant: Any) -> None:
+    """RLAnimateError for an agent_config whose sizes, scalars or input flags the add-on cannot run."""
     if not isinstance(config, dict) \
             or any(not _is_int(config.get(k)) or not 0 < config[k] <= MAX_SIZE for k in _AGENT_SIZES) \
             or config["hidden_layers"] > MAX_HIDDEN_LAYERS \
@@ -423,9 +422,15 @@ def _check_metadata_values(path: Path, metadata: dict[str, Any]) -> dict[str, Sh
     if config.get("tempo_input", False) and not config.get("phase_input", False):
         raise RLAnimateError(f"The agent file {path} gives tempo_input without phase_input, beside which the tempo "
                              f"sits: re-export it with trainer/agent/agent_export.py.")
-    if config.get("phase_input", False) and not uses_task_state(metadata["variant"]):
-        raise RLAnimateError(f"The agent file {path} gives phase_input to a {metadata['variant']} agent, which has "
+    if config.get("phase_input", False) and not uses_task_state(variant):
+        raise RLAnimateError(f"The agent file {path} gives phase_input to a {variant} agent, which has "
                              f"no task state to give it beside: re-export it with trainer/agent/agent_export.py.")
+
+
+def _check_metadata_values(path: Path, metadata: dict[str, Any]) -> dict[str, Shape]:
+    """Every metadata value the add-on uses, checked for type and range; returns the expected weight shapes."""
+    config = metadata["agent_config"]
+    _check_agent_config(path, config, metadata["variant"])
     if not isinstance(metadata["variant"], str):
         raise RLAnimateError(f"The agent file {path} names no agent variant: it must name one of "
                              f"{', '.join(VARIANTS)}.")
