@@ -72,7 +72,7 @@ class NearestClip:
     def nearest(self, behaviour, arm, attributes, tempo=None, exclude=None):
         """The training clip of `behaviour` and `arm` whose label (and tempo, Hz, when given) is closest to
         the request's; never the clip `exclude` (leave-one-out: the take a request was read from)."""
-        candidates = [c for c in clips_of(self.clips, behaviour, arm, "nearest-clip") if c is not exclude]
+        candidates = clips_of([c for c in self.clips if c is not exclude], behaviour, arm, "nearest-clip")
         kind = candidates[0].behaviour_kind
         if tempo is not None:
             return self._nearest_in_tempo(candidates, float(np.ravel(attributes)[0]), float(tempo))

@@ -51,6 +51,8 @@ def test_with_a_tempo_nearest_clip_weighs_the_swing_rate_beside_the_exaggeration
     assert nearest.nearest("WAVE", "RIGHT", 0.52, tempo=1.3).name == "slow"
     assert nearest.nearest("WAVE", "RIGHT", 0.52, tempo=2.4).name == "same_label"
     assert nearest.nearest("WAVE", "RIGHT", 0.52, tempo=2.4, exclude=library[1]).name == "big", "leave one out"
+    with pytest.raises(RLAnimateError, match="No wave training clip uses the right arm"):
+        baselines.NearestClip(library[:1]).nearest("WAVE", "RIGHT", 0.5, exclude=library[0])
     assert baselines.request_tempo(library[0], True) == pytest.approx(1.2, rel=0.05)
     assert baselines.request_tempo(library[0], False) is None
 
