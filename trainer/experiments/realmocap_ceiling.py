@@ -10,6 +10,7 @@ even on takes it has seen, what holds it back is not new takes but what it makes
 agents and retrieval from every training take on the test takes 009-010. Draws FIGURE: the hand paths of the
 trained takes of the styles where the first seed's agent trails retrieval most.
 """
+import itertools
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -54,10 +55,9 @@ class CeilingSettings(RealCaptureSettings):
                                  "one seed and at least one epoch.")
 
 
-def leave_one_out(train_clips: list[MotionClip], clips: list[MotionClip], with_tempo: bool) -> list[np.ndarray]:
-    """(F_i, 15, 3) nearest-clip retrieval's answer to each clip's request (its tempo too when `with_tempo`) from
-    `train_clips` but that clip."""
-    retrieval = baselines.NearestClip(train_clips)
+def leave_one_out(retrieval: baselines.NearestClip, clips: list[MotionClip], with_tempo: bool) -> list[np.ndarray]:
+    """(F_i, 15, 3) `retrieval`'s answer to each clip's request (its tempo too when `with_tempo`) from its clips but
+    that clip."""
     tempos, _ = baselines.request_tempos(clips, with_tempo)
     return [retrieval.generate(c.behaviour, c.arm, c.attributes, len(c.rotvecs), tempo=tempo, exclude=c)
             for c, tempo in zip(clips, tempos, strict=True)]
@@ -74,13 +74,14 @@ def run_ceiling(settings: CeilingSettings) -> dict:
     runs = {seed: real_run("wave", train, test, seed, mocap) for seed in settings.seeds}
     train_real_runs(runs.values(), workers=settings.workers)
     agents = {seed: baselines.AgentMethod(Path(run.settings.output) / "agent.npz") for seed, run in runs.items()}
+    retrieval_method = baselines.NearestClip(train)  # one, so each training take's tempo is read once
     sets = {}
-    for (name, clips), (suffix, with_tempo) in ((s, r) for s in (("trained", trained), ("test", test))
-                                                for r in REQUESTS.items()):
+    for (name, clips), (suffix, with_tempo) in itertools.product((("trained", trained), ("test", test)),
+                                                                 REQUESTS.items()):
         if name == "trained":
-            scored = scoring.score_motions(env, leave_one_out(train, clips, with_tempo), clips, references)
+            scored = scoring.score_motions(env, leave_one_out(retrieval_method, clips, with_tempo), clips, references)
         else:
-            scored = compare({"r": baselines.NearestClip(train)}, clips, env, references, with_tempo)["r"]
+            scored = compare({"r": retrieval_method}, clips, env, references, with_tempo)["r"]
         retrieval = validation_summary(scored)
         by_seed = {str(seed): validation_summary(compare({"a": agent}, clips, env, references, with_tempo)["a"])
                    for seed, agent in agents.items()}
@@ -88,8 +89,8 @@ def run_ceiling(settings: CeilingSettings) -> dict:
                                "gaps": paired_gaps(by_seed, retrieval)}
     first = agents[settings.seeds[0]]
     Path(settings.results).mkdir(parents=True, exist_ok=True)
-    wave_hand_paths(path_panels(first, train, trained, trailing_styles(sets["trained_tempo"]), env, references),
-                    Path(settings.results) / FIGURE)
+    wave_hand_paths(path_panels(first, retrieval_method, trained, trailing_styles(sets["trained_tempo"]), env,
+                                references), Path(settings.results) / FIGURE)
     return {"command": command_line(settings), "epochs": settings.epochs, "preset": settings.preset,
             "seeds": list(settings.seeds), "train_takes": len(train), "sets": sets, "figure": FIGURE}
 
@@ -102,8 +103,8 @@ def trailing_styles(entry: dict) -> list[str]:
     return sorted(gaps, key=gaps.__getitem__, reverse=True)[:FIGURE_STYLES]
 
 
-def path_panels(agent: baselines.AgentMethod, train: list[MotionClip], trained: list[MotionClip], styles: list[str],
-                env, references) -> list:
+def path_panels(agent: baselines.AgentMethod, retrieval: baselines.NearestClip, trained: list[MotionClip],
+                styles: list[str], env, references) -> list:
     """plots.wave_hand_paths panels: per style, its first right-arm trained take, then the agent's answer and
     leave-one-out retrieval's, both asked the take's tempo."""
     panels = []
@@ -112,7 +113,7 @@ def path_panels(agent: baselines.AgentMethod, train: list[MotionClip], trained: 
         tempo = baselines.request_tempo(clip, True)
         answers = {"RLAnimate (trained on this take)": agent.generate(behaviours.WAVE, clip.arm, clip.attributes,
                                                                       len(clip.rotvecs), tempo=tempo),
-                   "retrieval (another take)": leave_one_out(train, [clip], with_tempo=True)[0]}
+                   "retrieval (another take)": leave_one_out(retrieval, [clip], with_tempo=True)[0]}
         panels.append((f"{style} {clip.take} right (e = {clip.exaggeration:.2f}), tempo asked", "RIGHT",
                        {"real take": spaces.description_joint_positions(references.get(clip)[0]),
                         **{label: spaces.description_joint_positions(env.evaluate(motion).descriptions)

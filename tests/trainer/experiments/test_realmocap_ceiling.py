@@ -5,6 +5,7 @@ import pytest
 
 from rlanimate_addon.core.errors import RLAnimateError
 from tests.trainer.synthetic_library import make_clip
+from trainer.evaluation import baselines
 from trainer.experiments.realmocap_ceiling import CeilingSettings, leave_one_out, paired_gaps, trailing_styles
 from trainer.reporting.realmocap_ceiling_report import ceiling_markdown, ceiling_rows
 
@@ -12,7 +13,7 @@ from trainer.reporting.realmocap_ceiling_report import ceiling_markdown, ceiling
 def test_leave_one_out_retrieval_answers_each_take_with_another():
     library = [make_clip(name, "WAVE", "RIGHT", e, 90 + 10 * k, hz) for k, (name, e, hz) in
                enumerate((("slow", 0.5, 1.2), ("fast", 0.52, 2.5), ("faster", 0.55, 2.8)))]
-    motions = leave_one_out(library, library, with_tempo=True)
+    motions = leave_one_out(baselines.NearestClip(library), library, with_tempo=True)
     assert [len(m) for m in motions] == [90, 100, 110], "each answer at its take's length"
     for motion, take in zip(motions, library, strict=True):
         assert not np.allclose(motion, take.rotvecs), f"{take.name} was answered with itself"
