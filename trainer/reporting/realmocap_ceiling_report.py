@@ -3,13 +3,12 @@ they were trained on beside retrieval that may not return the take, and for the 
 import numpy as np
 
 from trainer.reporting.paired import gap_cell
-from trainer.reporting.realmocap_report import mean_and_sd
+from trainer.reporting.realmocap_report import REQUEST_LABELS, over_seeds
 from trainer.reporting.tables import markdown_table
 
 #: What the page calls each set and request of run_ceiling's results.
 SETS = {"trained": "takes 007-008, trained on (retrieval: the other takes)",
         "test": "takes 009-010, never seen (retrieval: every training take)"}
-REQUESTS = {"": "label only (the paper's)", "_tempo": "tempo asked"}
 
 
 def ceiling_rows(results):
@@ -17,13 +16,12 @@ def ceiling_rows(results):
     (mean ± sd over the seeds), retrieval's, and the paired score and DTW gaps."""
     rows = []
     for set_name, set_label in SETS.items():
-        for suffix, request_label in REQUESTS.items():
+        for suffix, request_label in REQUEST_LABELS.items():
             entry = results["sets"][set_name + suffix]
             agents, retrieval = list(entry["agents"].values()), entry["retrieval"]
 
             def agent_cell(key, digits, agents=agents):
-                values = [a[key] for a in agents]
-                return mean_and_sd(values, digits) if len(values) > 1 else f"{values[0]:.{digits}f}"
+                return over_seeds([a[key] for a in agents], digits)
             rows.append([f"{set_label} ({entry['takes']})", request_label,
                          f"{agent_cell('score', 1)} / {agent_cell('aligned_score', 1)}",
                          f"{retrieval['score']:.1f} / {retrieval['aligned_score']:.1f}",

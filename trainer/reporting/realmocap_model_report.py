@@ -1,7 +1,7 @@
 """The model search on real capture's validation takes as a page (docs/results/realmocap_model.md)."""
 import numpy as np
 
-from trainer.reporting.realmocap_report import mean_and_sd
+from trainer.reporting.realmocap_report import over_seeds
 from trainer.reporting.tables import markdown_table
 
 _REQUESTS = {"paper": "label only (the paper's)", "_tempo": "tempo asked"}
@@ -12,9 +12,7 @@ MODEL_METRICS = (("score", 1), ("aligned_score", 1), ("smoothness_min", 2), ("ro
 
 def _cells(summaries):
     """Cells of MODEL_METRICS over one preset's seeds (mean ± sd when several)."""
-    if len(summaries) > 1:
-        return [mean_and_sd([s[key] for s in summaries], digits) for key, digits in MODEL_METRICS]
-    return [f"{summaries[0][key]:.{digits}f}" for key, digits in MODEL_METRICS]
+    return [over_seeds([s[key] for s in summaries], digits) for key, digits in MODEL_METRICS]
 
 
 def model_rows(results):

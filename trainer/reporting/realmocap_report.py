@@ -91,6 +91,11 @@ def mean_and_sd(values, digits):
     return f"{values.mean():.{digits}f} ± {values.std(ddof=1):.{digits}f}"
 
 
+def over_seeds(values, digits):
+    """'mean ± sd' of several seeds' values (mean_and_sd), or one seed's value at `digits` decimals."""
+    return mean_and_sd(values, digits) if len(values) > 1 else f"{values[0]:.{digits}f}"
+
+
 def per_style_rows(set_label, methods, seeds):
     """Rows of the per-style table for one test set: per style, RLAnimate (each seed's agent, from `seeds`
     {seed: seed_summary}: their mean ± sd when there are several), then the other methods of `methods`
@@ -192,8 +197,7 @@ def request_cells(methods, seeds):
     ours, used = seed_take_means(methods, seeds)
     theirs = take_scores(methods["nearest_clip"])
     per_seed = [[summary[key] for key, _ in PAIRED_MEASURES] for summary in seeds.values()]
-    agent = " / ".join(mean_and_sd(values, 1) if len(per_seed) > 1 else f"{values[0]:.1f}"
-                       for values in zip(*per_seed, strict=True))
+    agent = " / ".join(over_seeds(values, 1) for values in zip(*per_seed, strict=True))
     retrieval = " / ".join(f"{np.mean(theirs[key]):.1f}" for key, _ in PAIRED_MEASURES)
     return [agent, retrieval, *(gap_cell(paired_gap(ours[key], theirs[key])) for key, _ in PAIRED_MEASURES),
             f"{used}"]
